@@ -1,0 +1,144 @@
+// Brick-based temporal coding of a probe grid and its container (CODEC.md §5, §7).
+//
+// The grid (nx, ny, nz probes, probe (x, y, z) at index x + nx (y + ny z)) is split into bricks of
+// brickDim³ probes (smaller at the far edges), brick (bx, by, bz) at index bx + nbx (by + nby bz).
+// Each brick has versions: version 0 is "nothing held" (every probe inactive, all symbols 0).
+// A new version is made when a frame changes a brick's quantised symbols by more than the
+// dead-zone or changes which probes are active. Every version can be sent as
+//   - a keyframe: the active mask and the records (record.h) of the active probes, or
+//   - a delta from the previous version: active mask, changed mask, and per changed probe the
+//     symbol differences (DC in the monotone code domain of rgb9e5.h, ratios in quantisation
+//     steps), zig-zag coded.
+// Payloads are split into byte planes and zstd-compressed (stored raw when that is smaller).
+// Inactive probes are never encoded. The encoder keeps exactly the state a decoder reaches, so
+// decoding is bit-identical to the encoder's reconstruction after every frame.
+//
+// Wire format, little-endian. Frame = header (32 bytes) + sections:
+//   header:  magic "PRBC" | u8 formatVersion (1) | u8 representation | u8 brickDim | u8 flags (0)
+//            | u16 nx, ny, nz | u16 reserved (0) | u32 frameSequence | u32 sectionCount
+//            | u32 sectionBytes | u32 CRC-32C of the preceding 28 bytes
+//   section: u32 brick | u32 version | u8 kind (1 keyframe, 2 delta) | u8 compression (0 raw,
+//            1 zstd) | u32 rawSize | u32 storedSize | u32 CRC-32C of the preceding 18 bytes and
+//            the data | data[storedSize]
+// A section is encoded once per brick version; frames for different subscribers reuse the same
+// section bytes and differ only in their header.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "probecast/codec/record.h"
+#include "probecast/codec/status.h"
+
+namespace probecast {
+
+constexpr uint8_t kFormatVersion = 1;
+constexpr size_t kFrameHeaderSize = 32;
+constexpr size_t kSectionHeaderSize = 22;
+constexpr int kMaxGridDim = 1024;
+constexpr int kMinBrickDim = 1;
+constexpr int kMaxBrickDim = 8;
+constexpr uint32_t kMaxProbes = 1u << 24;
+
+enum class SectionKind : uint8_t { Keyframe = 1, Delta = 2 };
+
+struct StreamLayout {
+  uint16_t grid[3] = {0, 0, 0};  // probes along x, y, z
+  uint8_t brickDim = 4;          // probes per brick edge
+  Representation repr = Representation::L1;
+};
+
+bool isValidLayout(const StreamLayout& layout);
+uint32_t probeCount(const StreamLayout& layout);
+uint32_t brickCount(const StreamLayout& layout);
+void brickGridSize(const StreamLayout& layout, uint32_t counts[3]);
+// First probe coordinate and extent of a brick.
+void brickProbeRange(const StreamLayout& layout, uint32_t brick, uint32_t begin[3], uint32_t size[3]);
+uint32_t brickProbeCount(const StreamLayout& layout, uint32_t brick);
+// Grid indices of the brick's probes in brick-local order (x fastest); `out` has brickProbeCount.
+void brickProbeIndices(const StreamLayout& layout, uint32_t brick, uint32_t* out);
+
+struct EncoderOptions {
+  int deadzone = 0;    // changes of at most this many quantisation steps are not sent
+  int zstdLevel = 3;
+};
+
+struct FrameHeader {
+  StreamLayout layout;
+  uint32_t frameSequence = 0;
+  uint32_t sectionCount = 0;
+  uint32_t sectionBytes = 0;
+};
+
+// Parses and checks a frame header (magic, version, representation, layout, CRC, total size).
+CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* header);
+
+// Writes a frame: header plus the given sections (as produced by StreamEncoder) back to back.
+void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
+                std::vector<uint8_t>& out);
+
+class StreamEncoder {
+ public:
+  explicit StreamEncoder(const StreamLayout& layout, const EncoderOptions& options = {});
+  ~StreamEncoder();
+  StreamEncoder(const StreamEncoder&) = delete;
+  StreamEncoder& operator=(const StreamEncoder&) = delete;
+
+  // Ingests a frame: probeCount(layout) probes of 27 floats (sh.h layout) and one state byte each
+  // (nonzero = active; null = all active). Returns the number of bricks given a new version.
+  uint32_t update(const float* probes, const uint8_t* active);
+
+  const StreamLayout& layout() const;
+  uint32_t frameSequence() const;  // number of update() calls so far
+  uint32_t brickVersion(uint32_t brick) const;
+  // Relative change of the brick's reconstruction made by its latest version (sum |Δc| / sum |c|).
+  float brickChange(uint32_t brick) const;
+  // The section taking a holder of version-1 to the current version; empty at version 0.
+  std::span<const uint8_t> deltaSection(uint32_t brick) const;
+  // A keyframe section of the current version (encoded on first request, then cached).
+  std::span<const uint8_t> keyframeSection(uint32_t brick);
+  // What a holder of `heldVersion` needs: empty if current, the delta if one version behind,
+  // a keyframe otherwise.
+  std::span<const uint8_t> sectionFor(uint32_t brick, uint32_t heldVersion);
+  // Convenience: a frame with every brick's latest delta that changed in the last update()
+  // (what a subscriber that holds everything needs).
+  void writeChangedFrame(std::vector<uint8_t>& out) const;
+  // A frame of keyframes of every brick (what a new subscriber needs).
+  void writeKeyframeFrame(std::vector<uint8_t>& out);
+
+  // The decoder's reconstruction: 27 floats per probe (0 for inactive probes), and active flags.
+  const float* reconstruction() const;
+  const uint8_t* activeMask() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class StreamDecoder {
+ public:
+  explicit StreamDecoder(const StreamLayout& layout);
+  ~StreamDecoder();
+  StreamDecoder(const StreamDecoder&) = delete;
+  StreamDecoder& operator=(const StreamDecoder&) = delete;
+
+  // Applies one frame. All or nothing: on any error the decoder's state is unchanged.
+  CodecStatus apply(const uint8_t* data, size_t size);
+
+  const StreamLayout& layout() const;
+  uint32_t brickVersion(uint32_t brick) const;
+  uint32_t lastFrameSequence() const;
+  const float* probes() const;      // 27 floats per probe, 0 for inactive probes
+  const uint8_t* activeMask() const;  // 1 = active
+  // zh3h only: decode L1 without hallucination (for interpolate-then-hallucinate).
+  void setHallucinate(bool hallucinate);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace probecast

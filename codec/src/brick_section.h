@@ -1,0 +1,54 @@
+// Sections: the immutable encoded form of one brick version (private to the codec).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "probe_symbols.h"
+#include "probecast/codec/status.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast {
+
+constexpr uint8_t kCompressionRaw = 0;
+constexpr uint8_t kCompressionZstd = 1;
+
+inline uint32_t maskBytes(uint32_t probes) { return (probes + 7) / 8; }
+inline bool maskBit(const uint8_t* mask, uint32_t i) { return (mask[i >> 3] >> (i & 7)) & 1u; }
+inline void setMaskBit(uint8_t* mask, uint32_t i) { mask[i >> 3] = static_cast<uint8_t>(mask[i >> 3] | (1u << (i & 7))); }
+
+// Largest raw payload any valid section of this brick can have.
+size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick);
+
+// Raw payloads (before compression). `active` has one byte per brick probe (0/1).
+void buildKeyframePayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* symbols,
+                          std::vector<uint8_t>& out);
+void buildDeltaPayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* base,
+                       const ProbeSymbols* next, std::vector<uint8_t>& out);
+
+// Appends section header + (possibly compressed) payload. `zstdContext` is a ZSTD_CCtx* or null.
+void writeSection(uint32_t brick, uint32_t version, SectionKind kind, const std::vector<uint8_t>& raw, int zstdLevel,
+                  void* zstdContext, std::vector<uint8_t>& out);
+
+struct SectionView {
+  uint32_t brick = 0;
+  uint32_t version = 0;
+  SectionKind kind = SectionKind::Keyframe;
+  uint8_t compression = 0;
+  uint32_t rawSize = 0;
+  const uint8_t* data = nullptr;
+  uint32_t storedSize = 0;
+};
+
+// Parses one section header at data[0..size) and checks its CRC and sizes against the layout.
+// On success *consumed is the section's full length.
+CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
+                         size_t* consumed);
+
+// Applies a decompressed payload to a brick's symbols. `active`/`symbols` hold the brick's state
+// on entry (the base) and the new state on success. `scratch` avoids allocation.
+CodecStatus applyPayload(Representation repr, uint32_t probes, SectionKind kind, const uint8_t* raw, size_t rawSize,
+                         uint8_t* active, ProbeSymbols* symbols);
+
+}  // namespace probecast

@@ -1,0 +1,207 @@
+// Grid/brick layout, frame header, and the section format (CODEC.md §7).
+#include <algorithm>
+#include <cassert>
+#include <cstring>
+
+#include <zstd.h>
+
+#include "brick_section.h"
+#include "byte_io.h"
+#include "crc32c.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast {
+namespace {
+
+constexpr uint8_t kMagic[4] = {'P', 'R', 'B', 'C'};
+
+uint32_t ceilDiv(uint32_t a, uint32_t b) { return (a + b - 1) / b; }
+
+}  // namespace
+
+const char* codecStatusName(CodecStatus status) {
+  switch (status) {
+    case CodecStatus::Ok: return "ok";
+    case CodecStatus::Truncated: return "truncated";
+    case CodecStatus::BadMagic: return "bad magic";
+    case CodecStatus::UnsupportedVersion: return "unsupported format version";
+    case CodecStatus::BadRepresentation: return "bad representation";
+    case CodecStatus::BadLayout: return "bad grid layout";
+    case CodecStatus::LayoutMismatch: return "layout mismatch";
+    case CodecStatus::HeaderChecksum: return "header checksum mismatch";
+    case CodecStatus::SectionChecksum: return "section checksum mismatch";
+    case CodecStatus::BadBrickIndex: return "brick index out of range";
+    case CodecStatus::DuplicateBrick: return "duplicate brick in frame";
+    case CodecStatus::BadSectionKind: return "bad section kind or compression";
+    case CodecStatus::SectionTooLarge: return "section too large";
+    case CodecStatus::DecompressFailed: return "decompression failed";
+    case CodecStatus::SizeMismatch: return "size mismatch";
+    case CodecStatus::BaseVersionMismatch: return "delta base version not held";
+    case CodecStatus::BadVersion: return "version goes backwards";
+    case CodecStatus::BadMask: return "bad probe mask";
+    case CodecStatus::BadSymbol: return "symbol out of range";
+    case CodecStatus::TrailingBytes: return "trailing bytes";
+  }
+  return "unknown status";
+}
+
+bool isValidLayout(const StreamLayout& layout) {
+  uint64_t total = 1;
+  for (uint16_t n : layout.grid) {
+    if (n < 1 || n > kMaxGridDim) return false;
+    total *= n;
+  }
+  return total <= kMaxProbes && layout.brickDim >= kMinBrickDim && layout.brickDim <= kMaxBrickDim &&
+         isValidRepresentation(static_cast<uint8_t>(layout.repr));
+}
+
+uint32_t probeCount(const StreamLayout& layout) {
+  return static_cast<uint32_t>(layout.grid[0]) * layout.grid[1] * layout.grid[2];
+}
+
+void brickGridSize(const StreamLayout& layout, uint32_t counts[3]) {
+  for (int a = 0; a < 3; ++a) counts[a] = ceilDiv(layout.grid[a], layout.brickDim);
+}
+
+uint32_t brickCount(const StreamLayout& layout) {
+  uint32_t n[3];
+  brickGridSize(layout, n);
+  return n[0] * n[1] * n[2];
+}
+
+void brickProbeRange(const StreamLayout& layout, uint32_t brick, uint32_t begin[3], uint32_t size[3]) {
+  uint32_t n[3];
+  brickGridSize(layout, n);
+  assert(brick < n[0] * n[1] * n[2]);
+  const uint32_t coord[3] = {brick % n[0], (brick / n[0]) % n[1], brick / (n[0] * n[1])};
+  for (int a = 0; a < 3; ++a) {
+    begin[a] = coord[a] * layout.brickDim;
+    size[a] = std::min<uint32_t>(layout.brickDim, layout.grid[a] - begin[a]);
+  }
+}
+
+uint32_t brickProbeCount(const StreamLayout& layout, uint32_t brick) {
+  uint32_t begin[3], size[3];
+  brickProbeRange(layout, brick, begin, size);
+  return size[0] * size[1] * size[2];
+}
+
+void brickProbeIndices(const StreamLayout& layout, uint32_t brick, uint32_t* out) {
+  uint32_t begin[3], size[3];
+  brickProbeRange(layout, brick, begin, size);
+  uint32_t k = 0;
+  for (uint32_t z = 0; z < size[2]; ++z)
+    for (uint32_t y = 0; y < size[1]; ++y)
+      for (uint32_t x = 0; x < size[0]; ++x)
+        out[k++] = (begin[0] + x) + layout.grid[0] * ((begin[1] + y) + layout.grid[1] * (begin[2] + z));
+}
+
+void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
+                std::vector<uint8_t>& out) {
+  assert(isValidLayout(layout));
+  size_t sectionBytes = 0;
+  for (const auto& s : sections) sectionBytes += s.size();
+  out.clear();
+  out.reserve(kFrameHeaderSize + sectionBytes);
+  out.insert(out.end(), kMagic, kMagic + 4);
+  out.push_back(kFormatVersion);
+  out.push_back(static_cast<uint8_t>(layout.repr));
+  out.push_back(layout.brickDim);
+  out.push_back(0);  // flags
+  for (uint16_t n : layout.grid) putU16(out, n);
+  putU16(out, 0);  // reserved
+  putU32(out, frameSequence);
+  putU32(out, static_cast<uint32_t>(sections.size()));
+  putU32(out, static_cast<uint32_t>(sectionBytes));
+  putU32(out, crc32c(out.data(), out.size()));
+  for (const auto& s : sections) out.insert(out.end(), s.begin(), s.end());
+}
+
+CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* header) {
+  if (size < kFrameHeaderSize) return CodecStatus::Truncated;
+  if (std::memcmp(data, kMagic, 4) != 0) return CodecStatus::BadMagic;
+  if (data[4] != kFormatVersion) return CodecStatus::UnsupportedVersion;
+  if (crc32c(data, 28) != getU32(data + 28)) return CodecStatus::HeaderChecksum;
+  if (!isValidRepresentation(data[5])) return CodecStatus::BadRepresentation;
+  FrameHeader h;
+  h.layout.repr = static_cast<Representation>(data[5]);
+  h.layout.brickDim = data[6];
+  for (int a = 0; a < 3; ++a) h.layout.grid[a] = getU16(data + 8 + 2 * a);
+  if (data[7] != 0 || getU16(data + 14) != 0 || !isValidLayout(h.layout)) return CodecStatus::BadLayout;
+  h.frameSequence = getU32(data + 16);
+  h.sectionCount = getU32(data + 20);
+  h.sectionBytes = getU32(data + 24);
+  if (h.sectionCount > brickCount(h.layout)) return CodecStatus::BadBrickIndex;
+  if (size - kFrameHeaderSize < h.sectionBytes) return CodecStatus::Truncated;
+  if (size - kFrameHeaderSize > h.sectionBytes) return CodecStatus::TrailingBytes;
+  *header = h;
+  return CodecStatus::Ok;
+}
+
+size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick) {
+  const uint32_t probes = brickProbeCount(layout, brick);
+  const SymbolShape shape = symbolShape(layout.repr);
+  const size_t perProbe = std::max<size_t>(recordSize(layout.repr), 2u * shape.wide + shape.narrow);
+  return 2u * maskBytes(probes) + probes * perProbe;
+}
+
+void writeSection(uint32_t brick, uint32_t version, SectionKind kind, const std::vector<uint8_t>& raw, int zstdLevel,
+                  void* zstdContext, std::vector<uint8_t>& out) {
+  out.clear();
+  putU32(out, brick);
+  putU32(out, version);
+  out.push_back(static_cast<uint8_t>(kind));
+  out.push_back(kCompressionRaw);
+  putU32(out, static_cast<uint32_t>(raw.size()));
+  putU32(out, 0);  // stored size, patched below
+  putU32(out, 0);  // CRC, patched below
+  const size_t headerEnd = out.size();
+  if (!raw.empty()) {
+    const size_t bound = ZSTD_compressBound(raw.size());
+    out.resize(headerEnd + bound);
+    const size_t n = zstdContext
+                         ? ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstdContext), out.data() + headerEnd, bound,
+                                             raw.data(), raw.size(), zstdLevel)
+                         : ZSTD_compress(out.data() + headerEnd, bound, raw.data(), raw.size(), zstdLevel);
+    if (!ZSTD_isError(n) && n < raw.size()) {
+      out.resize(headerEnd + n);
+      out[9] = kCompressionZstd;
+    } else {
+      out.resize(headerEnd);
+      out.insert(out.end(), raw.begin(), raw.end());
+    }
+  }
+  setU32(out.data() + 14, static_cast<uint32_t>(out.size() - headerEnd));
+  uint32_t crc = crc32c(out.data(), 18);
+  crc = crc32c(out.data() + headerEnd, out.size() - headerEnd, crc);
+  setU32(out.data() + 18, crc);
+}
+
+CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
+                         size_t* consumed) {
+  if (size < kSectionHeaderSize) return CodecStatus::Truncated;
+  SectionView v;
+  v.brick = getU32(data);
+  v.version = getU32(data + 4);
+  const uint8_t kind = data[8];
+  v.compression = data[9];
+  v.rawSize = getU32(data + 10);
+  v.storedSize = getU32(data + 14);
+  if (size - kSectionHeaderSize < v.storedSize) return CodecStatus::Truncated;
+  uint32_t crc = crc32c(data, 18);
+  crc = crc32c(data + kSectionHeaderSize, v.storedSize, crc);
+  if (crc != getU32(data + 18)) return CodecStatus::SectionChecksum;
+  if (v.brick >= brickCount(layout)) return CodecStatus::BadBrickIndex;
+  if (kind != static_cast<uint8_t>(SectionKind::Keyframe) && kind != static_cast<uint8_t>(SectionKind::Delta))
+    return CodecStatus::BadSectionKind;
+  if (v.compression != kCompressionRaw && v.compression != kCompressionZstd) return CodecStatus::BadSectionKind;
+  v.kind = static_cast<SectionKind>(kind);
+  if (v.rawSize > maxRawSectionSize(layout, v.brick)) return CodecStatus::SectionTooLarge;
+  if (v.compression == kCompressionRaw && v.storedSize != v.rawSize) return CodecStatus::SizeMismatch;
+  v.data = data + kSectionHeaderSize;
+  *view = v;
+  *consumed = kSectionHeaderSize + v.storedSize;
+  return CodecStatus::Ok;
+}
+
+}  // namespace probecast

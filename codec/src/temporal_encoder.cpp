@@ -1,0 +1,176 @@
+// The stream encoder: quantises frames, versions bricks, encodes each version once.
+#include <cassert>
+#include <cmath>
+#include <cstring>
+
+#include <zstd.h>
+
+#include "brick_section.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast {
+
+struct StreamEncoder::Impl {
+  StreamLayout layout;
+  EncoderOptions options;
+  uint32_t frame = 0;
+  std::vector<ProbeSymbols> symbols;       // decoder-side symbols per probe (0 when inactive)
+  std::vector<uint8_t> active;             // per probe
+  std::vector<float> reconstruction;       // 27 floats per probe
+  std::vector<uint32_t> brickProbes;       // grid indices, brick-local order, all bricks
+  std::vector<uint32_t> brickFirst;        // offset of each brick in brickProbes
+  std::vector<uint32_t> versions;
+  std::vector<float> change;
+  std::vector<uint32_t> changedThisFrame;  // bricks given a version by the last update
+  std::vector<std::vector<uint8_t>> deltas;
+  std::vector<std::vector<uint8_t>> keyframes;
+  std::vector<uint8_t> keyframeValid;
+  ZSTD_CCtx* cctx = nullptr;
+
+  // Scratch, sized for one brick.
+  std::vector<ProbeSymbols> base, next;
+  std::vector<uint8_t> nextActive, raw;
+
+  ~Impl() { ZSTD_freeCCtx(cctx); }
+};
+
+StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& options) : impl_(new Impl) {
+  assert(isValidLayout(layout));
+  Impl& s = *impl_;
+  s.layout = layout;
+  s.options = options;
+  const uint32_t probes = probeCount(layout);
+  const uint32_t bricks = brickCount(layout);
+  s.symbols.assign(probes, ProbeSymbols{});
+  s.active.assign(probes, 0);
+  s.reconstruction.assign(static_cast<size_t>(probes) * kProbeFloats, 0.0f);
+  s.brickFirst.resize(bricks + 1);
+  s.brickProbes.resize(probes);
+  uint32_t at = 0;
+  for (uint32_t b = 0; b < bricks; ++b) {
+    s.brickFirst[b] = at;
+    brickProbeIndices(layout, b, s.brickProbes.data() + at);
+    at += brickProbeCount(layout, b);
+  }
+  s.brickFirst[bricks] = at;
+  s.versions.assign(bricks, 0);
+  s.change.assign(bricks, 0.0f);
+  s.deltas.resize(bricks);
+  s.keyframes.resize(bricks);
+  s.keyframeValid.assign(bricks, 0);
+  s.cctx = ZSTD_createCCtx();
+}
+
+StreamEncoder::~StreamEncoder() = default;
+
+uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
+  Impl& s = *impl_;
+  const Representation repr = s.layout.repr;
+  const uint32_t bricks = brickCount(s.layout);
+  s.changedThisFrame.clear();
+  ++s.frame;
+  for (uint32_t b = 0; b < bricks; ++b) {
+    const uint32_t first = s.brickFirst[b];
+    const uint32_t n = s.brickFirst[b + 1] - first;
+    s.base.resize(n);
+    s.next.resize(n);
+    s.nextActive.resize(n);
+    bool changed = false;
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t p = s.brickProbes[first + k];
+      s.base[k] = s.symbols[p];
+      const bool isActive = activeIn == nullptr || activeIn[p] != 0;
+      s.nextActive[k] = isActive ? 1 : 0;
+      if (isActive) {
+        const ProbeSymbols* previous = s.active[p] ? &s.symbols[p] : nullptr;
+        quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
+      } else {
+        s.next[k] = ProbeSymbols{};
+      }
+      changed = changed || s.nextActive[k] != s.active[p] ||
+                std::memcmp(&s.next[k], &s.base[k], sizeof(ProbeSymbols)) != 0;
+    }
+    if (!changed) continue;
+
+    buildDeltaPayload(repr, n, s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
+    ++s.versions[b];
+    writeSection(b, s.versions[b], SectionKind::Delta, s.raw, s.options.zstdLevel, s.cctx, s.deltas[b]);
+    s.keyframeValid[b] = 0;
+    s.changedThisFrame.push_back(b);
+
+    double diff = 0.0, total = 0.0;
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t p = s.brickProbes[first + k];
+      s.symbols[p] = s.next[k];
+      s.active[p] = s.nextActive[k];
+      float decoded[kProbeFloats] = {};
+      if (s.active[p]) {
+        const bool ok = dequantizeProbe(repr, s.next[k], decoded, true);
+        assert(ok && "the encoder only makes valid symbols");
+        (void)ok;
+      }
+      float* out = s.reconstruction.data() + static_cast<size_t>(p) * kProbeFloats;
+      for (int i = 0; i < kProbeFloats; ++i) {
+        diff += std::fabs(decoded[i] - out[i]);
+        total += std::fabs(decoded[i]);
+        out[i] = decoded[i];
+      }
+    }
+    s.change[b] = total > 0.0 ? static_cast<float>(diff / total) : (diff > 0.0 ? 1.0f : 0.0f);
+  }
+  return static_cast<uint32_t>(s.changedThisFrame.size());
+}
+
+const StreamLayout& StreamEncoder::layout() const { return impl_->layout; }
+uint32_t StreamEncoder::frameSequence() const { return impl_->frame; }
+uint32_t StreamEncoder::brickVersion(uint32_t brick) const { return impl_->versions.at(brick); }
+float StreamEncoder::brickChange(uint32_t brick) const { return impl_->change.at(brick); }
+
+std::span<const uint8_t> StreamEncoder::deltaSection(uint32_t brick) const { return impl_->deltas.at(brick); }
+
+std::span<const uint8_t> StreamEncoder::keyframeSection(uint32_t brick) {
+  Impl& s = *impl_;
+  if (!s.keyframeValid.at(brick)) {
+    const uint32_t first = s.brickFirst[brick];
+    const uint32_t n = s.brickFirst[brick + 1] - first;
+    s.next.resize(n);
+    s.nextActive.resize(n);
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t p = s.brickProbes[first + k];
+      s.next[k] = s.symbols[p];
+      s.nextActive[k] = s.active[p];
+    }
+    buildKeyframePayload(s.layout.repr, n, s.nextActive.data(), s.next.data(), s.raw);
+    writeSection(brick, s.versions[brick], SectionKind::Keyframe, s.raw, s.options.zstdLevel, s.cctx,
+                 s.keyframes[brick]);
+    s.keyframeValid[brick] = 1;
+  }
+  return s.keyframes[brick];
+}
+
+std::span<const uint8_t> StreamEncoder::sectionFor(uint32_t brick, uint32_t heldVersion) {
+  const uint32_t current = impl_->versions.at(brick);
+  if (heldVersion == current) return {};
+  if (heldVersion + 1 == current) return deltaSection(brick);
+  return keyframeSection(brick);
+}
+
+void StreamEncoder::writeChangedFrame(std::vector<uint8_t>& out) const {
+  std::vector<std::span<const uint8_t>> sections;
+  sections.reserve(impl_->changedThisFrame.size());
+  for (uint32_t b : impl_->changedThisFrame) sections.push_back(impl_->deltas[b]);
+  writeFrame(impl_->layout, impl_->frame, sections, out);
+}
+
+void StreamEncoder::writeKeyframeFrame(std::vector<uint8_t>& out) {
+  const uint32_t bricks = brickCount(impl_->layout);
+  std::vector<std::span<const uint8_t>> sections;
+  sections.reserve(bricks);
+  for (uint32_t b = 0; b < bricks; ++b) sections.push_back(keyframeSection(b));
+  writeFrame(impl_->layout, impl_->frame, sections, out);
+}
+
+const float* StreamEncoder::reconstruction() const { return impl_->reconstruction.data(); }
+const uint8_t* StreamEncoder::activeMask() const { return impl_->active.data(); }
+
+}  // namespace probecast
