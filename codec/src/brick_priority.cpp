@@ -60,6 +60,14 @@ bool boxIntersectsFrustum(const float m[16], const float boxMin[3], const float 
 
 void scoreBricks(const StreamLayout& layout, const GridBounds& bounds, std::span<const View> views,
                  std::span<const BrickCandidate> candidates, const PriorityParams& params, float* scores) {
+  // Distances are measured in full-brick diagonals, the same scale for every brick.
+  float diag2 = 0.0f;
+  for (int a = 0; a < 3; ++a) {
+    const int n = layout.grid[a];
+    const float cell = n > 1 ? (bounds.max[a] - bounds.min[a]) / static_cast<float>(n - 1) : 0.0f;
+    diag2 += (cell * layout.brickDim) * (cell * layout.brickDim);
+  }
+  const float diag = std::max(std::sqrt(diag2), 1e-6f);
   for (uint32_t b = 0; b < candidates.size(); ++b) {
     const BrickCandidate& c = candidates[b];
     if (!(c.change > 0.0f) || c.bytes == 0) {
@@ -75,9 +83,7 @@ void scoreBricks(const StreamLayout& layout, const GridBounds& bounds, std::span
       nearest = std::min(nearest, distanceToBox(v.eye, lo, hi));
     }
     if (views.empty()) visible = true;
-    const float diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    const float distanceTerm = 1.0f / (1.0f + nearest / std::max(diag, 1e-6f));
+    const float distanceTerm = 1.0f / (1.0f + nearest / diag);
     const float changeTerm = std::max(c.change, params.minChange);
     const float ageTerm = 1.0f + params.ageWeight * static_cast<float>(c.ageFrames);
     scores[b] = (visible ? 1.0f : params.outOfViewWeight) * changeTerm * distanceTerm * ageTerm;

@@ -27,7 +27,7 @@ void buildKeyframePayload(Representation repr, uint32_t probes, const uint8_t* a
 void buildDeltaPayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* base,
                        const ProbeSymbols* next, std::vector<uint8_t>& out);
 
-// Appends section header + (possibly compressed) payload. `zstdContext` is a ZSTD_CCtx* or null.
+// Appends section header + (possibly compressed) payload. `zstdContext` is a ZSTD_CCtx*, or null to store the payload raw.
 void writeSection(uint32_t brick, uint32_t version, SectionKind kind, const std::vector<uint8_t>& raw, int zstdLevel,
                   void* zstdContext, std::vector<uint8_t>& out);
 

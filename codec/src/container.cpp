@@ -156,13 +156,13 @@ void writeSection(uint32_t brick, uint32_t version, SectionKind kind, const std:
   putU32(out, 0);  // stored size, patched below
   putU32(out, 0);  // CRC, patched below
   const size_t headerEnd = out.size();
-  if (!raw.empty()) {
+  if (!raw.empty() && zstdContext == nullptr) {
+    out.insert(out.end(), raw.begin(), raw.end());
+  } else if (!raw.empty()) {
     const size_t bound = ZSTD_compressBound(raw.size());
     out.resize(headerEnd + bound);
-    const size_t n = zstdContext
-                         ? ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstdContext), out.data() + headerEnd, bound,
-                                             raw.data(), raw.size(), zstdLevel)
-                         : ZSTD_compress(out.data() + headerEnd, bound, raw.data(), raw.size(), zstdLevel);
+    const size_t n = ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstdContext), out.data() + headerEnd, bound,
+                                       raw.data(), raw.size(), zstdLevel);
     if (!ZSTD_isError(n) && n < raw.size()) {
       out.resize(headerEnd + n);
       out[9] = kCompressionZstd;

@@ -94,7 +94,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
 
     buildDeltaPayload(repr, n, s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
     ++s.versions[b];
-    writeSection(b, s.versions[b], SectionKind::Delta, s.raw, s.options.zstdLevel, s.cctx, s.deltas[b]);
+    writeSection(b, s.versions[b], SectionKind::Delta, s.raw, s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);
     s.keyframeValid[b] = 0;
     s.changedThisFrame.push_back(b);
 
@@ -141,7 +141,7 @@ std::span<const uint8_t> StreamEncoder::keyframeSection(uint32_t brick) {
       s.nextActive[k] = s.active[p];
     }
     buildKeyframePayload(s.layout.repr, n, s.nextActive.data(), s.next.data(), s.raw);
-    writeSection(brick, s.versions[brick], SectionKind::Keyframe, s.raw, s.options.zstdLevel, s.cctx,
+    writeSection(brick, s.versions[brick], SectionKind::Keyframe, s.raw, s.options.zstdLevel, s.options.compress ? s.cctx : nullptr,
                  s.keyframes[brick]);
     s.keyframeValid[brick] = 1;
   }

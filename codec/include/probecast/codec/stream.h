@@ -64,6 +64,7 @@ void brickProbeIndices(const StreamLayout& layout, uint32_t brick, uint32_t* out
 struct EncoderOptions {
   int deadzone = 0;    // changes of at most this many quantisation steps are not sent
   int zstdLevel = 3;
+  bool compress = true;  // false: every section stored raw (byte-exact across zstd versions)
 };
 
 struct FrameHeader {

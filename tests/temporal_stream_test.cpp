@@ -1,0 +1,284 @@
+// Brick versions, deltas, keyframes and the container: drift-free, golden bytes, masks, atomicity.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "probecast/codec/stream.h"
+#include "test_probes.h"
+
+namespace probecast {
+namespace {
+
+StreamLayout makeLayout(uint16_t x, uint16_t y, uint16_t z, Representation repr, uint8_t brick = 4) {
+  StreamLayout l;
+  l.grid[0] = x;
+  l.grid[1] = y;
+  l.grid[2] = z;
+  l.brickDim = brick;
+  l.repr = repr;
+  return l;
+}
+
+void expectSameState(const StreamEncoder& enc, const StreamDecoder& dec, const std::string& where) {
+  const uint32_t n = probeCount(enc.layout());
+  ASSERT_EQ(0, std::memcmp(enc.reconstruction(), dec.probes(), n * kProbeFloats * sizeof(float))) << where;
+  ASSERT_EQ(0, std::memcmp(enc.activeMask(), dec.activeMask(), n)) << where;
+  for (uint32_t b = 0; b < brickCount(enc.layout()); ++b) ASSERT_EQ(enc.brickVersion(b), dec.brickVersion(b)) << where;
+}
+
+struct DriftCase {
+  Representation repr;
+  int deadzone;
+};
+
+class DriftFree : public ::testing::TestWithParam<DriftCase> {};
+
+TEST_P(DriftFree, DecoderMatchesEncoderOver1000NoisyFrames) {
+  // 8×4×6 probes: 4 bricks, two of them cut at the z edge. Noise 3 % per coefficient, probes
+  // switching between active and inactive, a subscriber joining late from keyframes.
+  const auto [repr, deadzone] = GetParam();
+  const StreamLayout layout = makeLayout(8, 4, 6, repr);
+  EncoderOptions options;
+  options.deadzone = deadzone;
+  StreamEncoder enc(layout, options);
+  StreamDecoder dec(layout);
+  std::unique_ptr<StreamDecoder> late;
+  const int count = static_cast<int>(probeCount(layout));
+  std::mt19937 rng(1234);
+  std::vector<uint8_t> active(count, 1), frame;
+  for (int f = 0; f < 1000; ++f) {
+    if (f % 50 == 0)
+      for (int p = 0; p < count; ++p) active[p] = (rng() % 10) != 0;
+    const std::vector<float> probes = test::movingLightFrame(count, f, 0.03f, rng);
+    enc.update(probes.data(), active.data());
+    enc.writeChangedFrame(frame);
+    ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok) << "frame " << f;
+    expectSameState(enc, dec, "frame " + std::to_string(f));
+    if (f == 500) {
+      late = std::make_unique<StreamDecoder>(layout);
+      enc.writeKeyframeFrame(frame);
+      ASSERT_EQ(late->apply(frame.data(), frame.size()), CodecStatus::Ok);
+    } else if (late) {
+      ASSERT_EQ(late->apply(frame.data(), frame.size()), CodecStatus::Ok) << "late, frame " << f;
+    }
+    if (late) expectSameState(enc, *late, "late joiner, frame " + std::to_string(f));
+  }
+  // The reconstruction follows the input: DC within the dead-zone's reach of the last frame.
+  const std::vector<float> last = test::movingLightFrame(count, 999, 0.0f, rng);
+  double num = 0, den = 0;
+  for (int p = 0; p < count; ++p) {
+    if (!active[p]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double d = enc.reconstruction()[p * kProbeFloats + c] - last[p * kProbeFloats + c];
+      num += d * d;
+      den += last[p * kProbeFloats + c] * last[p * kProbeFloats + c];
+    }
+  }
+  EXPECT_LT(std::sqrt(num / den), 0.06 + 0.01 * deadzone);  // noise 3 % + quantisation + dead-zone
+}
+
+INSTANTIATE_TEST_SUITE_P(RepresentationsAndDeadzones, DriftFree,
+                         ::testing::Values(DriftCase{Representation::L1, 0}, DriftCase{Representation::Zh3, 0},
+                                           DriftCase{Representation::Zh3, 3}, DriftCase{Representation::L2, 0},
+                                           DriftCase{Representation::L2, 2}, DriftCase{Representation::Fp16, 0},
+                                           DriftCase{Representation::Zh3Hallucinated, 1}),
+                         [](const auto& p) {
+                           return std::string(representationName(p.param.repr)) + "_dz" +
+                                  std::to_string(p.param.deadzone);
+                         });
+
+// Probes for the golden stream: deterministic, no randomness.
+std::vector<float> goldenProbes(int frame) {
+  std::vector<float> p(4 * kProbeFloats, 0.0f);
+  for (int i = 0; i < 4; ++i) {
+    float* q = p.data() + i * kProbeFloats;
+    q[0] = 1.0f + 0.25f * static_cast<float>(i);
+    q[1] = 0.5f;
+    q[2] = 0.25f;
+    q[3 * 3 + 0] = 0.3f;                    // R L1 toward +x
+    q[2 * 3 + 1] = frame == 0 ? 0.2f : 0.1f;  // G L1 toward +z, changes in frame 1 (probe 2 only)
+    if (frame == 1 && i != 2) q[2 * 3 + 1] = 0.2f;
+  }
+  return p;
+}
+
+std::string hex(const std::vector<uint8_t>& bytes) {
+  static const char* digits = "0123456789abcdef";
+  std::string s;
+  for (uint8_t b : bytes) {
+    s.push_back(digits[b >> 4]);
+    s.push_back(digits[b & 15]);
+  }
+  return s;
+}
+
+TEST(Stream, GoldenBytes) {
+  // A 2×2×1 grid, one brick, l1, stored raw. Pins the format of CODEC.md §7 byte for byte:
+  // frame 0 keyframe of 4 probes (probe 3 inactive), frame 1 delta of probe 2.
+  // Derivation of the first record: DC (1, 0.5, 0.25) → RGB9E5 0x81010100 (CODEC.md §8.5);
+  // R ratio of c11: 0.3 / 1 / √3 · 127 = 22.0 → 0x16; G ratio of c10: 0.2 / 0.5 / √3 · 127 = 29.3 → 0x1d.
+  const StreamLayout layout = makeLayout(2, 2, 1, Representation::L1, 2);
+  EncoderOptions options;
+  options.compress = false;
+  StreamEncoder enc(layout, options);
+  const uint8_t active[4] = {1, 1, 1, 0};
+  std::vector<uint8_t> frame;
+  enc.update(goldenProbes(0).data(), active);
+  enc.writeKeyframeFrame(frame);
+  EXPECT_EQ(hex(frame),
+            "50524243" "01" "01" "02" "00" "0200" "0200" "0100" "0000"  // magic, version, l1, brick 2, grid
+            "01000000" "01000000" "3e000000" "596bfa2e"                 // frame 1, 1 section, 62 bytes, CRC
+            "00000000" "01000000" "01" "00" "28000000" "28000000" "5a83f9fe"  // brick 0 v1 keyframe raw
+            "07"                                                        // active mask: probes 0, 1, 2
+            "004080" "010101" "010101" "818181"                         // RGB9E5 bytes 0..3, one plane each
+            "000000" "000000" "000000"                                  // c1-1 R, G, B
+            "000000" "1d1d1d" "000000"                                  // c10: G 0.4/√3·127 = 29.3
+            "16120f" "000000" "000000");                                // c11: R 0.3/(1, 1.25, 1.5)/√3·127
+  StreamDecoder dec(layout);
+  ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  enc.update(goldenProbes(1).data(), active);
+  enc.writeChangedFrame(frame);
+  ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  // Delta: probe 2's G c10 ratio goes 0.2/0.5 → 0.1/0.5, symbol 29 → 15, zig-zag(−14) = 27 = 0x1b.
+  EXPECT_EQ(hex(frame),
+            "50524243" "01" "01" "02" "00" "0200" "0200" "0100" "0000"
+            "02000000" "01000000" "27000000" "6a6f0dbf"
+            "00000000" "02000000" "02" "00" "11000000" "11000000" "33b2653c"  // brick 0 v2 delta raw
+            "07" "04"                                                   // active mask, changed mask
+            "0000" "0000" "0000"                                        // DC code deltas (lo, hi planes)
+            "000000" "00" "1b" "00" "000000");                          // ratio deltas
+}
+
+TEST(Stream, InactiveProbesAreNeverEncoded) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::L2);
+  std::mt19937 rng(3);
+  std::vector<float> a = test::movingLightFrame(64, 0, 0.0f, rng);
+  std::vector<float> b = a;
+  std::vector<uint8_t> active(64, 1);
+  for (int p = 0; p < 64; p += 3) {
+    active[p] = 0;
+    for (int i = 0; i < kProbeFloats; ++i) {
+      a[p * kProbeFloats + i] = std::nanf("");
+      b[p * kProbeFloats + i] = 1e30f * static_cast<float>(i);
+    }
+  }
+  StreamEncoder ea(layout), eb(layout);
+  ea.update(a.data(), active.data());
+  eb.update(b.data(), active.data());
+  std::vector<uint8_t> fa, fb;
+  ea.writeKeyframeFrame(fa);
+  eb.writeKeyframeFrame(fb);
+  EXPECT_EQ(fa, fb);
+  StreamDecoder dec(layout);
+  ASSERT_EQ(dec.apply(fa.data(), fa.size()), CodecStatus::Ok);
+  for (int p = 0; p < 64; p += 3) {
+    EXPECT_EQ(dec.activeMask()[p], 0);
+    for (int i = 0; i < kProbeFloats; ++i) EXPECT_EQ(dec.probes()[p * kProbeFloats + i], 0.0f);
+  }
+}
+
+TEST(Stream, UnchangedFrameMakesNoVersions) {
+  const StreamLayout layout = makeLayout(5, 5, 5, Representation::Zh3);
+  std::mt19937 rng(5);
+  const std::vector<float> probes = test::movingLightFrame(125, 3, 0.02f, rng);
+  StreamEncoder enc(layout);
+  EXPECT_EQ(enc.update(probes.data(), nullptr), brickCount(layout));
+  EXPECT_EQ(enc.update(probes.data(), nullptr), 0u);
+  std::vector<uint8_t> frame;
+  enc.writeChangedFrame(frame);
+  EXPECT_EQ(frame.size(), kFrameHeaderSize);
+}
+
+TEST(Stream, DeadzoneSavesBytesWithBoundedError) {
+  const StreamLayout layout = makeLayout(8, 4, 8, Representation::L2);
+  size_t bytes[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    EncoderOptions options;
+    options.deadzone = k == 0 ? 0 : 3;
+    StreamEncoder enc(layout, options);
+    std::mt19937 rng(77);
+    std::vector<uint8_t> frame;
+    for (int f = 0; f < 60; ++f) {
+      const std::vector<float> probes = test::movingLightFrame(256, f, 0.01f, rng);
+      enc.update(probes.data(), nullptr);
+      enc.writeChangedFrame(frame);
+      if (f > 0) bytes[k] += frame.size();
+    }
+  }
+  EXPECT_LT(bytes[1], bytes[0] * 3 / 4) << bytes[0] << " vs " << bytes[1];
+}
+
+TEST(Stream, SectionForPicksDeltaOrKeyframe) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::L1);
+  StreamEncoder enc(layout);
+  StreamDecoder dec(layout);
+  std::mt19937 rng(8);
+  std::vector<uint8_t> frame;
+  for (int f = 0; f < 3; ++f) enc.update(test::movingLightFrame(64, f * 10, 0.0f, rng).data(), nullptr);
+  ASSERT_EQ(enc.brickVersion(0), 3u);
+  EXPECT_TRUE(enc.sectionFor(0, 3).empty());
+  EXPECT_EQ(enc.sectionFor(0, 2).data(), enc.deltaSection(0).data());
+  const std::span<const uint8_t> key = enc.sectionFor(0, 0);
+  const std::span<const uint8_t> sections[] = {key};
+  writeFrame(layout, enc.frameSequence(), sections, frame);
+  ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  expectSameState(enc, dec, "after keyframe");
+}
+
+TEST(Stream, DeltaAgainstMissingBaseIsRejectedAndStateKept) {
+  const StreamLayout layout = makeLayout(4, 4, 8, Representation::L1);
+  StreamEncoder enc(layout);
+  StreamDecoder dec(layout);
+  std::mt19937 rng(9);
+  std::vector<uint8_t> frame;
+  enc.update(test::movingLightFrame(128, 0, 0.0f, rng).data(), nullptr);
+  enc.writeChangedFrame(frame);
+  ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  enc.update(test::movingLightFrame(128, 20, 0.0f, rng).data(), nullptr);
+  enc.update(test::movingLightFrame(128, 40, 0.0f, rng).data(), nullptr);  // decoder misses version 2
+  enc.writeChangedFrame(frame);
+  const std::vector<float> before(dec.probes(), dec.probes() + 128 * kProbeFloats);
+  EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::BaseVersionMismatch);
+  EXPECT_EQ(0, std::memcmp(before.data(), dec.probes(), before.size() * sizeof(float)));
+  EXPECT_EQ(dec.brickVersion(0), 1u);
+}
+
+TEST(Stream, FrameIsAllOrNothing) {
+  // Two bricks; the second section is a delta the decoder cannot apply: the first brick must not
+  // change either.
+  const StreamLayout layout = makeLayout(4, 4, 8, Representation::L2);
+  StreamEncoder enc(layout);
+  StreamDecoder dec(layout);
+  std::mt19937 rng(10);
+  enc.update(test::movingLightFrame(128, 0, 0.0f, rng).data(), nullptr);
+  const std::vector<uint8_t> key0(enc.keyframeSection(0).begin(), enc.keyframeSection(0).end());
+  enc.update(test::movingLightFrame(128, 30, 0.0f, rng).data(), nullptr);
+  const std::span<const uint8_t> sections[] = {key0, enc.deltaSection(1)};  // brick 1 base not held
+  std::vector<uint8_t> frame;
+  writeFrame(layout, 2, sections, frame);
+  EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::BaseVersionMismatch);
+  EXPECT_EQ(dec.brickVersion(0), 0u);
+  EXPECT_EQ(dec.activeMask()[0], 0);
+}
+
+TEST(Stream, RejectsLayoutMismatchAndDuplicates) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::L1);
+  StreamEncoder enc(layout);
+  std::mt19937 rng(12);
+  enc.update(test::movingLightFrame(64, 0, 0.0f, rng).data(), nullptr);
+  std::vector<uint8_t> frame;
+  enc.writeKeyframeFrame(frame);
+  StreamDecoder other(makeLayout(4, 4, 4, Representation::L2));
+  EXPECT_EQ(other.apply(frame.data(), frame.size()), CodecStatus::LayoutMismatch);
+  const std::span<const uint8_t> twice[] = {enc.keyframeSection(0), enc.keyframeSection(0)};
+  writeFrame(makeLayout(4, 4, 8, Representation::L1), 1, twice, frame);
+  StreamDecoder dec(makeLayout(4, 4, 8, Representation::L1));
+  EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::DuplicateBrick);
+}
+
+}  // namespace
+}  // namespace probecast
