@@ -18,6 +18,14 @@ inline uint32_t maskBytes(uint32_t probes) { return (probes + 7) / 8; }
 inline bool maskBit(const uint8_t* mask, uint32_t i) { return (mask[i >> 3] >> (i & 7)) & 1u; }
 inline void setMaskBit(uint8_t* mask, uint32_t i) { mask[i >> 3] = static_cast<uint8_t>(mask[i >> 3] | (1u << (i & 7))); }
 
+// Grid indices of every brick's probes, bricks back to back (brick b owns [first[b], first[b+1])).
+struct BrickTable {
+  std::vector<uint32_t> probes;
+  std::vector<uint32_t> first;
+  void build(const StreamLayout& layout);
+  uint32_t size(uint32_t brick) const { return first[brick + 1] - first[brick]; }
+};
+
 // Largest raw payload any valid section of this brick can have.
 size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick);
 

@@ -138,6 +138,19 @@ CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* heade
   return CodecStatus::Ok;
 }
 
+void BrickTable::build(const StreamLayout& layout) {
+  const uint32_t bricks = brickCount(layout);
+  first.resize(bricks + 1);
+  probes.resize(probeCount(layout));
+  uint32_t at = 0;
+  for (uint32_t b = 0; b < bricks; ++b) {
+    first[b] = at;
+    brickProbeIndices(layout, b, probes.data() + at);
+    at += brickProbeCount(layout, b);
+  }
+  first[bricks] = at;
+}
+
 size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick) {
   const uint32_t probes = brickProbeCount(layout, brick);
   const SymbolShape shape = symbolShape(layout.repr);

@@ -17,8 +17,7 @@ struct StreamDecoder::Impl {
   std::vector<uint8_t> active;
   std::vector<float> probes;
   std::vector<uint32_t> versions;
-  std::vector<uint32_t> brickProbes;
-  std::vector<uint32_t> brickFirst;
+  BrickTable table;
   std::vector<uint32_t> seenInFrame;  // frame stamp per brick, for duplicate detection
   uint32_t stamp = 0;
   ZSTD_DCtx* dctx = nullptr;
@@ -48,15 +47,7 @@ StreamDecoder::StreamDecoder(const StreamLayout& layout) : impl_(new Impl) {
   s.probes.assign(static_cast<size_t>(probes) * kProbeFloats, 0.0f);
   s.versions.assign(bricks, 0);
   s.seenInFrame.assign(bricks, 0);
-  s.brickFirst.resize(bricks + 1);
-  s.brickProbes.resize(probes);
-  uint32_t at = 0;
-  for (uint32_t b = 0; b < bricks; ++b) {
-    s.brickFirst[b] = at;
-    brickProbeIndices(layout, b, s.brickProbes.data() + at);
-    at += brickProbeCount(layout, b);
-  }
-  s.brickFirst[bricks] = at;
+  s.table.build(layout);
   s.dctx = ZSTD_createDCtx();
 }
 
@@ -101,16 +92,16 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
       raw = s.raw.data();
     }
 
-    const uint32_t first = s.brickFirst[view.brick];
-    const uint32_t n = s.brickFirst[view.brick + 1] - first;
+    const uint32_t first = s.table.first[view.brick];
+    const uint32_t n = s.table.first[view.brick + 1] - first;
     Impl::Staged st;
     st.brick = view.brick;
     st.version = view.version;
     st.active.resize(n);
     st.symbols.resize(n);
     for (uint32_t k = 0; k < n; ++k) {
-      st.active[k] = s.active[s.brickProbes[first + k]];
-      st.symbols[k] = s.symbols[s.brickProbes[first + k]];
+      st.active[k] = s.active[s.table.probes[first + k]];
+      st.symbols[k] = s.symbols[s.table.probes[first + k]];
     }
     if (CodecStatus r = applyPayload(s.layout.repr, n, view.kind, raw, view.rawSize, st.active.data(),
                                      st.symbols.data());
@@ -126,9 +117,9 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
   if (left != 0) return CodecStatus::TrailingBytes;
 
   for (const Impl::Staged& st : s.staged) {
-    const uint32_t first = s.brickFirst[st.brick];
+    const uint32_t first = s.table.first[st.brick];
     for (uint32_t k = 0; k < st.active.size(); ++k) {
-      const uint32_t probe = s.brickProbes[first + k];
+      const uint32_t probe = s.table.probes[first + k];
       s.active[probe] = st.active[k];
       s.symbols[probe] = st.symbols[k];
       std::copy(st.probes.begin() + k * kProbeFloats, st.probes.begin() + (k + 1) * kProbeFloats,

@@ -17,8 +17,7 @@ struct StreamEncoder::Impl {
   std::vector<ProbeSymbols> symbols;       // decoder-side symbols per probe (0 when inactive)
   std::vector<uint8_t> active;             // per probe
   std::vector<float> reconstruction;       // 27 floats per probe
-  std::vector<uint32_t> brickProbes;       // grid indices, brick-local order, all bricks
-  std::vector<uint32_t> brickFirst;        // offset of each brick in brickProbes
+  BrickTable table;                        // grid indices of each brick's probes
   std::vector<uint32_t> versions;
   std::vector<float> change;
   std::vector<uint32_t> changedThisFrame;  // bricks given a version by the last update
@@ -44,15 +43,7 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
   s.symbols.assign(probes, ProbeSymbols{});
   s.active.assign(probes, 0);
   s.reconstruction.assign(static_cast<size_t>(probes) * kProbeFloats, 0.0f);
-  s.brickFirst.resize(bricks + 1);
-  s.brickProbes.resize(probes);
-  uint32_t at = 0;
-  for (uint32_t b = 0; b < bricks; ++b) {
-    s.brickFirst[b] = at;
-    brickProbeIndices(layout, b, s.brickProbes.data() + at);
-    at += brickProbeCount(layout, b);
-  }
-  s.brickFirst[bricks] = at;
+  s.table.build(layout);
   s.versions.assign(bricks, 0);
   s.change.assign(bricks, 0.0f);
   s.deltas.resize(bricks);
@@ -70,14 +61,14 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
   s.changedThisFrame.clear();
   ++s.frame;
   for (uint32_t b = 0; b < bricks; ++b) {
-    const uint32_t first = s.brickFirst[b];
-    const uint32_t n = s.brickFirst[b + 1] - first;
+    const uint32_t first = s.table.first[b];
+    const uint32_t n = s.table.first[b + 1] - first;
     s.base.resize(n);
     s.next.resize(n);
     s.nextActive.resize(n);
     bool changed = false;
     for (uint32_t k = 0; k < n; ++k) {
-      const uint32_t p = s.brickProbes[first + k];
+      const uint32_t p = s.table.probes[first + k];
       s.base[k] = s.symbols[p];
       const bool isActive = activeIn == nullptr || activeIn[p] != 0;
       s.nextActive[k] = isActive ? 1 : 0;
@@ -100,7 +91,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
 
     double diff = 0.0, total = 0.0;
     for (uint32_t k = 0; k < n; ++k) {
-      const uint32_t p = s.brickProbes[first + k];
+      const uint32_t p = s.table.probes[first + k];
       s.symbols[p] = s.next[k];
       s.active[p] = s.nextActive[k];
       float decoded[kProbeFloats] = {};
@@ -131,12 +122,12 @@ std::span<const uint8_t> StreamEncoder::deltaSection(uint32_t brick) const { ret
 std::span<const uint8_t> StreamEncoder::keyframeSection(uint32_t brick) {
   Impl& s = *impl_;
   if (!s.keyframeValid.at(brick)) {
-    const uint32_t first = s.brickFirst[brick];
-    const uint32_t n = s.brickFirst[brick + 1] - first;
+    const uint32_t first = s.table.first[brick];
+    const uint32_t n = s.table.first[brick + 1] - first;
     s.next.resize(n);
     s.nextActive.resize(n);
     for (uint32_t k = 0; k < n; ++k) {
-      const uint32_t p = s.brickProbes[first + k];
+      const uint32_t p = s.table.probes[first + k];
       s.next[k] = s.symbols[p];
       s.nextActive[k] = s.active[p];
     }

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# One entry point for a new machine: installs what is missing (Debian 12), builds, and runs.
+#   scripts/dev.sh demo          build, then run `probecast demo` (writes out/)
+#   scripts/dev.sh test          build, then run the whole test suite (ctest)
+#   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec tests under it
+#   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ROOT"
+JOBS=$(nproc 2>/dev/null || echo 2)
+WERROR=${PROBECAST_WERROR:-OFF}
+[ "${CI:-}" = "true" ] && WERROR=ON
+
+configure_and_build() {  # DIR [cmake args...]
+  local dir=$1
+  shift
+  if [ ! -f "$dir/build.ninja" ]; then
+    cmake -S . -B "$dir" -G Ninja -DPROBECAST_WERROR="$WERROR" "$@"
+  else
+    cmake "$dir" -DPROBECAST_WERROR="$WERROR" "$@" >/dev/null
+  fi
+  cmake --build "$dir" -j "$JOBS"
+}
+
+cmd=${1:-demo}
+shift || true
+bash scripts/setup.sh
+
+case "$cmd" in
+  demo)
+    configure_and_build build
+    ./build/probecast demo "$@"
+    ;;
+  test)
+    configure_and_build build
+    ctest --test-dir build --output-on-failure -j "$JOBS" "$@"
+    ;;
+  memsafe)
+    configure_and_build build-asan -DPROBECAST_SANITIZE=ON -DPROBECAST_APP=OFF
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L codec "$@"
+    ;;
+  fuzz)
+    secs=${1:-60}
+    configure_and_build build-fuzz -DPROBECAST_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14
+    seeds=build-fuzz/seeds
+    corpus=build-fuzz/corpus
+    mkdir -p "$seeds" "$corpus"
+    ./build-fuzz/fuzz/codec_fuzz_seeds "$seeds"
+    echo "fuzz: running codec_fuzz for ${secs}s"
+    ./build-fuzz/fuzz/codec_fuzz -max_total_time="$secs" -print_final_stats=1 -artifact_prefix=build-fuzz/ \
+      "$corpus" "$seeds" 2>&1 | grep -E '^(#[0-9]+ +DONE|Done|stat::|==|SUMMARY|artifact)' || true
+    # libFuzzer exits non-zero on a finding; PIPESTATUS keeps that through the filter.
+    [ "${PIPESTATUS[0]}" -eq 0 ] || { echo "fuzz: codec_fuzz found a failure (see build-fuzz/)"; exit 1; }
+    ;;
+  *)
+    echo "usage: scripts/dev.sh demo|test|memsafe|fuzz [args]" >&2
+    exit 2
+    ;;
+esac
