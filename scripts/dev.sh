@@ -49,10 +49,16 @@ case "$cmd" in
     mkdir -p "$seeds" "$corpus"
     ./build-fuzz/fuzz/codec_fuzz_seeds "$seeds"
     echo "fuzz: running codec_fuzz for ${secs}s"
+    rc=0
     ./build-fuzz/fuzz/codec_fuzz -max_total_time="$secs" -print_final_stats=1 -artifact_prefix=build-fuzz/ \
-      "$corpus" "$seeds" 2>&1 | grep -E '^(#[0-9]+ +DONE|Done|stat::|==|SUMMARY|artifact)' || true
-    # libFuzzer exits non-zero on a finding; PIPESTATUS keeps that through the filter.
-    [ "${PIPESTATUS[0]}" -eq 0 ] || { echo "fuzz: codec_fuzz found a failure (see build-fuzz/)"; exit 1; }
+      "$corpus" "$seeds" >build-fuzz/fuzz.log 2>&1 || rc=$?
+    grep -E '^(Done|stat::(number_of_executed_units|new_units_added)|==[0-9]+==|SUMMARY|.*artifact)' build-fuzz/fuzz.log || true
+    if [ "$rc" -ne 0 ]; then
+      tail -40 build-fuzz/fuzz.log
+      echo "fuzz: codec_fuzz found a failure (rc $rc, log build-fuzz/fuzz.log)"
+      exit 1
+    fi
+    echo "fuzz: clean after ${secs}s" 
     ;;
   *)
     echo "usage: scripts/dev.sh demo|test|memsafe|fuzz [args]" >&2

@@ -1,0 +1,101 @@
+// `probecast bench codec`.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "codec_bench.h"
+#include "commands.h"
+
+namespace probecast::app {
+namespace {
+
+std::string gCommandLine;
+
+std::vector<bench::EnvMap> loadEnvMapDir(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw std::runtime_error(dir + ": not a directory");
+  std::vector<std::string> paths;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (entry.is_regular_file() && (ext == ".hdr" || ext == ".exr")) paths.push_back(entry.path().string());
+  }
+  if (ec) throw std::runtime_error(dir + ": " + ec.message());
+  std::sort(paths.begin(), paths.end());
+  if (paths.empty()) throw std::runtime_error(dir + ": no .hdr or .exr environment maps");
+  std::vector<bench::EnvMap> maps;
+  for (const std::string& p : paths) {
+    bench::EnvMap map;
+    std::string error;
+    if (!bench::loadEnvMap(p, map, error)) throw std::runtime_error(error);
+    maps.push_back(std::move(map));
+  }
+  return maps;
+}
+
+}  // namespace
+
+void setCommandLine(int argc, char** argv) {
+  gCommandLine = "probecast";
+  for (int i = 1; i < argc; ++i) gCommandLine += std::string(" ") + argv[i];
+}
+const std::string& commandLine() { return gCommandLine; }
+
+void writeTextFile(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  std::error_code ec;
+  if (p.has_parent_path()) fs::create_directories(p.parent_path(), ec);
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+void addBenchCommands(CLI::App& app, int& exitCode) {
+  CLI::App* bench = app.add_subcommand("bench", "measured speed and accuracy, machine-readable");
+  bench->require_subcommand(1);
+  CLI::App* codec = bench->add_subcommand("codec", "codec size against irradiance accuracy, speed, and temporal coding");
+
+  struct Options {
+    std::string envmaps, json, chart;
+    std::vector<int> deadzones{0, 1, 2, 4, 8};
+    int frames = 60;
+    int normals = 2048;
+  };
+  auto opt = std::make_shared<Options>();
+  codec->add_option("--envmaps", opt->envmaps, "folder of equirect .hdr/.exr maps (top row +Y)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  codec->add_option("--json", opt->json, "write the results as JSON here")->required();
+  codec->add_option("--chart", opt->chart, "write an SVG chart of error against bytes here");
+  codec->add_option("--deadzones", opt->deadzones, "dead-zones (quantisation steps) for the temporal part")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 127));
+  codec->add_option("--frames", opt->frames, "frames of the moving-light sequence")->check(CLI::Range(2, 100000));
+  codec->add_option("--normals", opt->normals, "directions for the brute-force irradiance")->check(CLI::Range(16, 1 << 20));
+
+  codec->callback([opt, &exitCode] {
+    bench::CodecBenchOptions options;
+    options.maps = loadEnvMapDir(opt->envmaps);
+    options.deadzones = opt->deadzones;
+    options.frames = opt->frames;
+    options.normals = opt->normals;
+    options.command = commandLine();
+    options.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    const bench::CodecBenchResult r = bench::runCodecBench(options);
+    fmt::print("{}", r.table);
+    writeTextFile(opt->json, r.json.dump(2) + "\n");
+    fmt::print("wrote {}\n", opt->json);
+    if (!opt->chart.empty()) {
+      writeTextFile(opt->chart, r.svg);
+      fmt::print("wrote {}\n", opt->chart);
+    }
+    exitCode = 0;
+  });
+}
+
+}  // namespace probecast::app

@@ -1,0 +1,307 @@
+#include "codec_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <random>
+
+#include <fmt/format.h>
+
+#include "probecast/codec/record.h"
+#include "probecast/codec/stream.h"
+#include "probecast/codec/zh3.h"
+#include "svg_chart.h"
+
+namespace probecast::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Probe = std::array<float, kProbeFloats>;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// Relative RMSE of irradiance over a set of normals, pooled over RGB.
+double rmseAgainst(const Probe& probe, const std::vector<float>& normals, const std::vector<float>& reference) {
+  double num = 0, den = 0;
+  for (size_t n = 0; n < normals.size() / 3; ++n) {
+    float e[3];
+    shEvalIrradiance(probe.data(), normals[n * 3], normals[n * 3 + 1], normals[n * 3 + 2], e);
+    for (int c = 0; c < 3; ++c) {
+      const double d = e[c] - reference[n * 3 + c];
+      num += d * d;
+      den += static_cast<double>(reference[n * 3 + c]) * reference[n * 3 + c];
+    }
+  }
+  return den > 0 ? std::sqrt(num / den) : 0.0;
+}
+
+// Exact irradiance error over the whole sphere between two SH3 probes (orthonormality):
+// ∫ |ΔE|² dω = Σ_l Â_l² Σ_m Δc_lm². Returns the two sums (error, reference energy).
+void irradianceEnergy(const float* test, const float* ref, double& err, double& energy) {
+  for (int i = 0; i < kShCoeffs; ++i) {
+    const double a2 = static_cast<double>(kCosineBand[shBand(i)]) * kCosineBand[shBand(i)];
+    for (int c = 0; c < 3; ++c) {
+      const double d = static_cast<double>(test[i * 3 + c]) - ref[i * 3 + c];
+      err += a2 * d * d;
+      energy += a2 * static_cast<double>(ref[i * 3 + c]) * ref[i * 3 + c];
+    }
+  }
+}
+
+Probe floatVariant(const Probe& l2, const std::string& which) {
+  Probe p = l2;
+  if (which == "l2") return p;
+  for (int i = 12; i < kProbeFloats; ++i) p[i] = 0.0f;
+  if (which == "l1") return p;
+  float axis[3], zonal[3];
+  zh3Axis(l2.data(), axis);
+  if (which == "zh3") zh3Project(l2.data(), axis, zonal);
+  else zh3Hallucinate(l2.data(), axis, zonal);
+  zh3ExpandToL2(p.data(), axis, zonal);
+  return p;
+}
+
+struct StaticResult {
+  double rmseTrue = 0, rmseFloat = 0, encodeRate = 0, decodeRate = 0;
+  std::map<std::string, double> perMap;
+};
+
+}  // namespace
+
+CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
+  const auto say = [&](const std::string& s) {
+    if (opt.progress) opt.progress(s);
+  };
+  const std::vector<float> normals = fibonacciSphere(opt.normals);
+  std::vector<Probe> mapProbes;
+  std::vector<std::vector<float>> trueIrradiance;
+  std::vector<std::string> names;
+
+  // 1. Each map: float L2 SH and the true irradiance by brute force.
+  for (size_t m = 0; m < opt.maps.size(); ++m) {
+    const EnvMap& map = opt.maps[m];
+    say(fmt::format("[{}/{}] {} ({}x{}): projecting, brute-force irradiance at {} normals", m + 1, opt.maps.size(),
+                    map.name, map.width, map.height, opt.normals));
+    Probe p{};
+    projectToSh(map, p.data());
+    mapProbes.push_back(p);
+    const int factor = std::max(1, map.width / 256);
+    std::vector<float> e;
+    bruteForceIrradiance(factor > 1 ? downsample(map, factor) : map, normals, e);
+    trueIrradiance.push_back(std::move(e));
+    names.push_back(map.name);
+  }
+
+  nlohmann::json json;
+  json["command"] = opt.command;
+  json["maps"] = names;
+  json["metric"] =
+      "irradiance relative RMSE, RGB pooled: sqrt(sum |E_test - E_ref|^2) / sqrt(sum |E_ref|^2) over equal-area "
+      "normals, no clamping; 'true' = brute-force cosine convolution of the map, 'vs float l2' = exact over the sphere";
+  json["normals"] = opt.normals;
+
+  // Float baselines: how much each representation loses before quantisation.
+  nlohmann::json baselines;
+  for (const char* which : {"l1", "zh3h", "zh3", "l2"}) {
+    double sum = 0;
+    for (size_t m = 0; m < mapProbes.size(); ++m)
+      sum += rmseAgainst(floatVariant(mapProbes[m], which), normals, trueIrradiance[m]);
+    baselines[which] = mapProbes.empty() ? 0.0 : sum / static_cast<double>(mapProbes.size());
+  }
+  json["float_baselines_irradiance_rmse_rel"] = baselines;
+
+  // Throughput set: the maps' probes at many intensities.
+  std::vector<Probe> many(static_cast<size_t>(opt.throughputProbes));
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> scale(0.05f, 20.0f);
+  for (size_t i = 0; i < many.size() && !mapProbes.empty(); ++i) {
+    const float s = scale(rng);
+    for (int k = 0; k < kProbeFloats; ++k) many[i][k] = mapProbes[i % mapProbes.size()][k] * s;
+  }
+
+  // 2. Every representation: size, error, speed.
+  std::map<std::string, StaticResult> results;
+  nlohmann::json reprJson;
+  for (Representation repr : kAllRepresentations) {
+    const std::string name = representationName(repr);
+    say(fmt::format("representation {}: error on {} maps, throughput on {} probes", name, mapProbes.size(),
+                    many.size()));
+    StaticResult r;
+    const size_t bytes = recordSize(repr);
+    for (size_t m = 0; m < mapProbes.size(); ++m) {
+      uint8_t rec[kMaxRecordBytes];
+      encodeProbeRecord(repr, mapProbes[m].data(), rec);
+      Probe q{};
+      decodeProbeRecord(repr, rec, q.data());
+      const double e = rmseAgainst(q, normals, trueIrradiance[m]);
+      double err = 0, energy = 0;
+      irradianceEnergy(q.data(), mapProbes[m].data(), err, energy);
+      r.rmseTrue += e;
+      r.rmseFloat += std::sqrt(err / energy);
+      r.perMap[names[m]] = e;
+    }
+    if (!mapProbes.empty()) {
+      r.rmseTrue /= static_cast<double>(mapProbes.size());
+      r.rmseFloat /= static_cast<double>(mapProbes.size());
+    }
+    std::vector<uint8_t> encoded(many.size() * bytes);
+    std::vector<Probe> decoded(many.size());
+    std::vector<double> enc, dec;
+    for (int rep = 0; rep < opt.repeats; ++rep) {
+      auto t0 = Clock::now();
+      for (size_t i = 0; i < many.size(); ++i) encodeProbeRecord(repr, many[i].data(), encoded.data() + i * bytes);
+      auto t1 = Clock::now();
+      for (size_t i = 0; i < many.size(); ++i) decodeProbeRecord(repr, encoded.data() + i * bytes, decoded[i].data());
+      auto t2 = Clock::now();
+      enc.push_back(static_cast<double>(many.size()) / std::chrono::duration<double>(t1 - t0).count());
+      dec.push_back(static_cast<double>(many.size()) / std::chrono::duration<double>(t2 - t1).count());
+    }
+    r.encodeRate = median(enc);
+    r.decodeRate = median(dec);
+    reprJson[name] = {{"bytes_per_probe", bytes},
+                      {"irradiance_rmse_rel", r.rmseTrue},
+                      {"irradiance_rmse_rel_vs_float_l2", r.rmseFloat},
+                      {"encode_probes_per_s", r.encodeRate},
+                      {"decode_probes_per_s", r.decodeRate},
+                      {"per_map_irradiance_rmse_rel", r.perMap}};
+    results[name] = r;
+  }
+  json["representations"] = reprJson;
+  json["timing"] = fmt::format("median of {} repeats, one thread", opt.repeats);
+
+  // 3. Temporal: the first map rotating about +Y, 0.5°/frame, on a 16×4×16 grid with per-probe
+  // intensity and phase, plus 1 % Gaussian noise per coefficient (relative to the DC).
+  nlohmann::json temporal = nlohmann::json::array();
+  std::vector<ChartSeries> temporalSeries;
+  if (!opt.maps.empty() && opt.frames > 1) {
+    const EnvMap small = downsample(opt.maps[0], std::max(1, opt.maps[0].width / 128));
+    StreamLayout layout;
+    layout.grid[0] = 16;
+    layout.grid[1] = 4;
+    layout.grid[2] = 16;
+    layout.brickDim = 4;
+    const uint32_t count = probeCount(layout);
+    const int phases = 8;
+    const float noise = 0.01f;
+    const float degPerFrame = 0.5f;
+    say(fmt::format("temporal: {} frames of {} probes from {} ({} phases)", opt.frames, count, small.name, phases));
+    std::vector<float> clean(static_cast<size_t>(opt.frames) * count * kProbeFloats);
+    std::vector<float> noisy(clean.size());
+    std::mt19937 nrng(2);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    std::vector<float> gain(count);
+    for (uint32_t p = 0; p < count; ++p) gain[p] = 0.3f + 1.7f * static_cast<float>((p * 2654435761u) % 1000u) / 1000.0f;
+    for (int f = 0; f < opt.frames; ++f) {
+      Probe byPhase[phases];
+      for (int k = 0; k < phases; ++k)
+        projectToSh(small, byPhase[k].data(), (static_cast<float>(f) * degPerFrame + 15.0f * static_cast<float>(k)) * kPi / 180.0f);
+      for (uint32_t p = 0; p < count; ++p) {
+        const Probe& src = byPhase[(p / 256) * 2 % phases + (p % 2)];
+        float* c = &clean[(static_cast<size_t>(f) * count + p) * kProbeFloats];
+        float* n = &noisy[(static_cast<size_t>(f) * count + p) * kProbeFloats];
+        for (int i = 0; i < kProbeFloats; ++i) {
+          c[i] = src[i] * gain[p];
+          n[i] = c[i] + noise * c[i % 3] * gauss(nrng);
+        }
+      }
+    }
+    for (Representation repr : kAllRepresentations) {
+      const std::string name = representationName(repr);
+      ChartSeries series{name + " stream", {}, true};
+      for (int dz : opt.deadzones) {
+        if (repr == Representation::Fp16 && dz > 0) continue;  // fp16 steps are not ratio steps
+        layout.repr = repr;
+        EncoderOptions eo;
+        eo.deadzone = dz;
+        StreamEncoder encoder(layout, eo);
+        StreamDecoder decoder(layout);
+        std::vector<uint8_t> frame;
+        size_t deltaBytes = 0, keyBytes = 0;
+        double err = 0, energy = 0;
+        bool driftFree = true;
+        for (int f = 0; f < opt.frames; ++f) {
+          const size_t at = static_cast<size_t>(f) * count * kProbeFloats;
+          encoder.update(noisy.data() + at, nullptr);
+          encoder.writeChangedFrame(frame);
+          driftFree = driftFree && decoder.apply(frame.data(), frame.size()) == CodecStatus::Ok;
+          if (f == 0) {
+            keyBytes = frame.size();
+            continue;
+          }
+          deltaBytes += frame.size();
+          for (uint32_t p = 0; p < count; ++p)
+            irradianceEnergy(decoder.probes() + static_cast<size_t>(p) * kProbeFloats,
+                             clean.data() + at + static_cast<size_t>(p) * kProbeFloats, err, energy);
+        }
+        driftFree = driftFree && std::memcmp(decoder.probes(), encoder.reconstruction(),
+                                             static_cast<size_t>(count) * kProbeFloats * sizeof(float)) == 0;
+        const double perProbeFrame = static_cast<double>(deltaBytes) / (static_cast<double>(opt.frames - 1) * count);
+        const double rmse = std::sqrt(err / energy);
+        temporal.push_back({{"representation", name},
+                            {"deadzone", dz},
+                            {"bytes_per_probe_per_frame", perProbeFrame},
+                            {"first_frame_bytes_per_probe", static_cast<double>(keyBytes) / count},
+                            {"irradiance_rmse_rel_vs_clean", rmse},
+                            {"drift_free", driftFree}});
+        series.points.push_back({perProbeFrame, rmse, fmt::format("dz{}", dz)});
+      }
+      temporalSeries.push_back(std::move(series));
+    }
+    json["temporal"] = {{"grid", {16, 4, 16}},
+                        {"brick", 4},
+                        {"frames", opt.frames},
+                        {"map", small.name},
+                        {"rotation_deg_per_frame", degPerFrame},
+                        {"noise_rel_dc", noise},
+                        {"raw_fp16_grid_bytes_per_probe_per_frame", 56},
+                        {"error", "irradiance relative RMSE of the decoded stream against the noise-free float L2, "
+                                  "frames 1.., exact over the sphere"},
+                        {"results", temporal}};
+  }
+  json["temporal_results_note"] = "bytes include frame and section headers; zstd level 3";
+
+  // Table.
+  std::string table = fmt::format("{:<6} {:>8} {:>14} {:>14} {:>14} {:>14}\n", "repr", "B/probe", "E rmse (true)",
+                                  "vs float L2", "encode Mpr/s", "decode Mpr/s");
+  for (Representation repr : kAllRepresentations) {
+    const StaticResult& r = results[representationName(repr)];
+    table += fmt::format("{:<6} {:>8} {:>13.2f}% {:>13.3f}% {:>14.2f} {:>14.2f}\n", representationName(repr),
+                         recordSize(repr), 100 * r.rmseTrue, 100 * r.rmseFloat, r.encodeRate / 1e6,
+                         r.decodeRate / 1e6);
+  }
+  table += fmt::format("float baselines (E rmse vs true): l1 {:.2f}%  zh3h {:.2f}%  zh3 {:.2f}%  l2 {:.2f}%\n",
+                       100 * baselines["l1"].get<double>(), 100 * baselines["zh3h"].get<double>(),
+                       100 * baselines["zh3"].get<double>(), 100 * baselines["l2"].get<double>());
+  if (!temporal.empty()) {
+    table += fmt::format("\ntemporal ({} frames, 1024 probes, 1% noise): {:<6} {:>4} {:>14} {:>14}\n", opt.frames,
+                         "repr", "dz", "B/probe/frame", "E rmse (clean)");
+    for (const auto& t : temporal)
+      table += fmt::format("{:>44} {:<6} {:>4} {:>14.3f} {:>13.2f}%{}\n", "", t["representation"].get<std::string>(),
+                           t["deadzone"].get<int>(), t["bytes_per_probe_per_frame"].get<double>(),
+                           100 * t["irradiance_rmse_rel_vs_clean"].get<double>(),
+                           t["drift_free"].get<bool>() ? "" : "  DRIFT");
+  }
+
+  // Chart: error against bytes.
+  ChartSeries keyframes{"records (static maps)", {}, false};
+  for (Representation repr : kAllRepresentations)
+    keyframes.points.push_back({static_cast<double>(recordSize(repr)), results[representationName(repr)].rmseTrue,
+                                representationName(repr)});
+  std::vector<ChartSeries> all{keyframes};
+  all.insert(all.end(), temporalSeries.begin(), temporalSeries.end());
+  ChartSpec spec;
+  spec.title = "probecast codec: irradiance error against bytes per probe";
+  spec.xLabel = "bytes per probe (records) / per probe per frame (streams)";
+  spec.yLabel = "irradiance relative RMSE";
+  spec.logX = true;
+  spec.logY = true;
+  spec.footnote = opt.command;
+  return {json, table, renderSvgChart(spec, all)};
+}
+
+}  // namespace probecast::bench

@@ -1,0 +1,34 @@
+// `probecast bench codec`: size against irradiance accuracy and speed for every representation,
+// and the temporal coder on a moving-light sequence for several dead-zones.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "envmap.h"
+
+namespace probecast::bench {
+
+struct CodecBenchOptions {
+  std::vector<EnvMap> maps;
+  std::vector<int> deadzones = {0, 1, 2, 4, 8};
+  int frames = 60;         // temporal sequence length
+  int normals = 2048;      // equal-area directions for the brute-force irradiance
+  int throughputProbes = 65536;
+  int repeats = 7;         // timing repeats; the median is reported
+  std::string command;     // recorded in the JSON and the chart
+  std::function<void(const std::string&)> progress;
+};
+
+struct CodecBenchResult {
+  nlohmann::json json;
+  std::string table;  // readable summary
+  std::string svg;    // error against bytes
+};
+
+CodecBenchResult runCodecBench(const CodecBenchOptions& options);
+
+}  // namespace probecast::bench
