@@ -229,6 +229,20 @@ TEST(Stream, SectionForPicksDeltaOrKeyframe) {
   expectSameState(enc, dec, "after keyframe");
 }
 
+TEST(Stream, ChangeSinceAccumulatesOverVersions) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::L2);
+  StreamEncoder enc(layout);
+  std::mt19937 rng(4);
+  for (int f = 0; f < 4; ++f) enc.update(test::movingLightFrame(64, f * 10, 0.0f, rng).data(), nullptr);
+  ASSERT_EQ(enc.brickVersion(0), 4u);
+  EXPECT_EQ(enc.changeSince(0, 4), 0.0f);
+  EXPECT_EQ(enc.changeSince(0, 0), 1.0f);
+  EXPECT_FLOAT_EQ(enc.changeSince(0, 3), enc.brickChange(0));
+  EXPECT_GT(enc.changeSince(0, 1), enc.changeSince(0, 2));
+  EXPECT_GT(enc.changeSince(0, 2), enc.changeSince(0, 3));
+  EXPECT_GT(enc.brickChange(0), 0.0f);
+}
+
 TEST(Stream, DeltaAgainstMissingBaseIsRejectedAndStateKept) {
   const StreamLayout layout = makeLayout(4, 4, 8, Representation::L1);
   StreamEncoder enc(layout);

@@ -20,6 +20,8 @@ struct StreamEncoder::Impl {
   BrickTable table;                        // grid indices of each brick's probes
   std::vector<uint32_t> versions;
   std::vector<float> change;
+  static constexpr uint32_t kHistory = 16;
+  std::vector<float> changeHistory;        // kHistory per brick, indexed by version % kHistory
   std::vector<uint32_t> changedThisFrame;  // bricks given a version by the last update
   std::vector<std::vector<uint8_t>> deltas;
   std::vector<std::vector<uint8_t>> keyframes;
@@ -46,6 +48,7 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
   s.table.build(layout);
   s.versions.assign(bricks, 0);
   s.change.assign(bricks, 0.0f);
+  s.changeHistory.assign(static_cast<size_t>(bricks) * Impl::kHistory, 0.0f);
   s.deltas.resize(bricks);
   s.keyframes.resize(bricks);
   s.keyframeValid.assign(bricks, 0);
@@ -108,6 +111,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
       }
     }
     s.change[b] = total > 0.0 ? static_cast<float>(diff / total) : (diff > 0.0 ? 1.0f : 0.0f);
+    s.changeHistory[static_cast<size_t>(b) * Impl::kHistory + s.versions[b] % Impl::kHistory] = s.change[b];
   }
   return static_cast<uint32_t>(s.changedThisFrame.size());
 }
@@ -116,6 +120,17 @@ const StreamLayout& StreamEncoder::layout() const { return impl_->layout; }
 uint32_t StreamEncoder::frameSequence() const { return impl_->frame; }
 uint32_t StreamEncoder::brickVersion(uint32_t brick) const { return impl_->versions.at(brick); }
 float StreamEncoder::brickChange(uint32_t brick) const { return impl_->change.at(brick); }
+
+float StreamEncoder::changeSince(uint32_t brick, uint32_t heldVersion) const {
+  const Impl& s = *impl_;
+  const uint32_t current = s.versions.at(brick);
+  if (heldVersion >= current) return 0.0f;
+  if (heldVersion == 0 || current - heldVersion > Impl::kHistory) return 1.0f;
+  float sum = 0.0f;
+  for (uint32_t v = heldVersion + 1; v <= current; ++v)
+    sum += s.changeHistory[static_cast<size_t>(brick) * Impl::kHistory + v % Impl::kHistory];
+  return sum;
+}
 
 std::span<const uint8_t> StreamEncoder::deltaSection(uint32_t brick) const { return impl_->deltas.at(brick); }
 

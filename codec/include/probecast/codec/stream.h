@@ -97,6 +97,10 @@ class StreamEncoder {
   uint32_t brickVersion(uint32_t brick) const;
   // Relative change of the brick's reconstruction made by its latest version (sum |Δc| / sum |c|).
   float brickChange(uint32_t brick) const;
+  // Relative change between a holder's version and the current one, for priority: the sum of
+  // brickChange() of the versions after `heldVersion` (remembered for the last 16 versions),
+  // 1 when the holder has nothing or is further behind, 0 when current.
+  float changeSince(uint32_t brick, uint32_t heldVersion) const;
   // The section taking a holder of version-1 to the current version; empty at version 0.
   std::span<const uint8_t> deltaSection(uint32_t brick) const;
   // A keyframe section of the current version (encoded on first request, then cached).
