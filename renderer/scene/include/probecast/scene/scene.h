@@ -1,0 +1,86 @@
+// Scenes in probecast's own types: world-space triangles, materials, punctual lights, cameras.
+// Loaded from glTF 2.0 (tinygltf stays inside the loader) or generated in code (`builtin:NAME`).
+//
+// Units and conventions: metres, Y up (glTF), right-handed. Material emission is radiance
+// (emissiveFactor × KHR_materials_emissive_strength). Point and spot intensity in candela
+// (W/sr in our radiometric use), directional in lux (W/m²), as KHR_lights_punctual.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace probecast::scene {
+
+struct Material {
+  std::string name;
+  glm::vec3 baseColor{0.8f};
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  glm::vec3 emission{0.0f};
+};
+
+enum class LightType : uint32_t { Point = 0, Spot = 1, Directional = 2 };
+
+struct Light {
+  LightType type = LightType::Point;
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  // the way the light travels (spot, directional)
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  float range = 0.0f;  // 0 = unlimited
+  float innerConeAngle = 0.0f;
+  float outerConeAngle = 0.7853982f;
+};
+
+struct Camera {
+  std::string name;
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float yfov = 0.6911f;  // radians
+  float aspect = 0.0f;   // 0 = the viewport's
+  float znear = 0.01f;
+  float zfar = 100.0f;
+};
+
+struct Scene {
+  std::string name;
+  std::vector<glm::vec3> positions;  // world space
+  std::vector<glm::vec3> normals;    // per vertex, unit length
+  std::vector<uint32_t> indices;     // 3 per triangle
+  std::vector<uint32_t> triangleMaterial;
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  std::vector<Camera> cameras;
+  glm::vec3 boundsMin{0.0f};
+  glm::vec3 boundsMax{0.0f};
+
+  uint32_t triangleCount() const { return static_cast<uint32_t>(indices.size() / 3); }
+};
+
+// Loads a .gltf or .glb file. On failure returns false and `error` names the file and the problem.
+bool loadGltf(const std::string& path, Scene& scene, std::string& error);
+
+// Built-in scenes, generated in code. `t` in [0, 1) is the animation parameter.
+//   cornell     Cornell box (open front), ceiling panel + a point light circling under the ceiling
+//   closed-box  a closed 2 m box lit by a point light, for inside/outside tests
+std::vector<std::string> builtinSceneNames();
+bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error);
+
+// "builtin:NAME" or a glTF path.
+bool loadScene(const std::string& spec, float t, Scene& scene, std::string& error);
+
+// Recomputes the bounds and reorders triangles by the Morton code of their centroids, so BVH
+// builders that split at the index midpoint get spatially coherent halves.
+void finalizeScene(Scene& scene);
+
+// Appends a quad (two triangles, counter-clockwise seen from the side `normal` points to).
+void addQuad(Scene& scene, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
+             uint32_t material);
+// Appends an axis-aligned box (outward faces) rotated about +Y by `angle` around its centre.
+void addBox(Scene& scene, const glm::vec3& center, const glm::vec3& halfSize, float angle, uint32_t material);
+
+}  // namespace probecast::scene

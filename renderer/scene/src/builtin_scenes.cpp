@@ -1,0 +1,93 @@
+// Scenes generated in code, so the binary runs with no files.
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+
+#include "probecast/scene/scene.h"
+
+namespace probecast::scene {
+namespace {
+
+uint32_t addMaterial(Scene& s, const std::string& name, glm::vec3 color, glm::vec3 emission = glm::vec3(0.0f)) {
+  Material m;
+  m.name = name;
+  m.baseColor = color;
+  m.emission = emission;
+  s.materials.push_back(m);
+  return static_cast<uint32_t>(s.materials.size() - 1);
+}
+
+// Cornell box proportions: interior x[-1, 1], y[0, 2], z[-1, 1], open towards +Z.
+void makeCornell(float t, Scene& s) {
+  const uint32_t white = addMaterial(s, "white", glm::vec3(0.73f));
+  const uint32_t red = addMaterial(s, "red", glm::vec3(0.63f, 0.065f, 0.05f));
+  const uint32_t green = addMaterial(s, "green", glm::vec3(0.14f, 0.45f, 0.091f));
+  const uint32_t panel = addMaterial(s, "ceiling-panel", glm::vec3(0.78f), glm::vec3(8.0f, 6.5f, 4.5f));
+  const float y0 = 0.0f, y1 = 2.0f, x0 = -1.0f, x1 = 1.0f, z0 = -1.0f, z1 = 1.0f;
+  addQuad(s, {x0, y0, z1}, {x1, y0, z1}, {x1, y0, z0}, {x0, y0, z0}, white);  // floor, normal +Y
+  addQuad(s, {x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1}, white);  // ceiling, normal −Y
+  addQuad(s, {x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0}, white);  // back, normal +Z
+  addQuad(s, {x0, y0, z1}, {x0, y0, z0}, {x0, y1, z0}, {x0, y1, z1}, red);    // left, normal +X
+  addQuad(s, {x1, y0, z0}, {x1, y0, z1}, {x1, y1, z1}, {x1, y1, z0}, green);  // right, normal −X
+  const float p = 0.25f, py = y1 - 0.002f;
+  addQuad(s, {-p, py, -p}, {p, py, -p}, {p, py, p}, {-p, py, p}, panel);      // emissive panel, normal −Y
+  addBox(s, {0.33f, 0.3f, 0.35f}, {0.3f, 0.3f, 0.3f}, -0.29f, white);         // short box
+  addBox(s, {-0.35f, 0.6f, -0.3f}, {0.3f, 0.6f, 0.3f}, 0.29f, white);         // tall box
+  // A warm point light circling under the ceiling: t moves it once around.
+  Light light;
+  light.type = LightType::Point;
+  const float a = glm::two_pi<float>() * t;
+  light.position = {0.6f * std::cos(a), 1.7f, 0.6f * std::sin(a)};
+  light.color = {1.0f, 0.9f, 0.75f};
+  light.intensity = 3.0f;
+  s.lights.push_back(light);
+  Camera cam;
+  cam.name = "front";
+  cam.position = {0.0f, 1.0f, 3.9f};
+  cam.forward = {0.0f, 0.0f, -1.0f};
+  cam.yfov = 0.6911f;
+  s.cameras.push_back(cam);
+}
+
+// A closed box x, y, z in [-1, 1] lit by a point light; probes inside are active, probes inside
+// its solid walls are not (walls have thickness via a second, outer box).
+void makeClosedBox(float t, Scene& s) {
+  const uint32_t white = addMaterial(s, "white", glm::vec3(0.7f));
+  const float a = -1.0f, b = 1.0f;
+  addQuad(s, {a, a, b}, {b, a, b}, {b, a, a}, {a, a, a}, white);  // floor +Y
+  addQuad(s, {a, b, a}, {b, b, a}, {b, b, b}, {a, b, b}, white);  // ceiling −Y
+  addQuad(s, {a, a, a}, {b, a, a}, {b, b, a}, {a, b, a}, white);  // back +Z
+  addQuad(s, {b, a, b}, {a, a, b}, {a, b, b}, {b, b, b}, white);  // front −Z
+  addQuad(s, {a, a, b}, {a, a, a}, {a, b, a}, {a, b, b}, white);  // left +X
+  addQuad(s, {b, a, a}, {b, a, b}, {b, b, b}, {b, b, a}, white);  // right −X
+  addBox(s, {0.0f, 0.0f, 0.0f}, {1.2f, 1.2f, 1.2f}, 0.0f, white);  // outer shell, faces outward
+  Light light;
+  light.position = {0.5f * std::cos(glm::two_pi<float>() * t), 0.5f, 0.0f};
+  light.intensity = 2.0f;
+  s.lights.push_back(light);
+}
+
+}  // namespace
+
+std::vector<std::string> builtinSceneNames() { return {"cornell", "closed-box"}; }
+
+bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error) {
+  scene = Scene{};
+  scene.name = "builtin:" + name;
+  if (name == "cornell") makeCornell(t, scene);
+  else if (name == "closed-box") makeClosedBox(t, scene);
+  else {
+    error = "unknown built-in scene '" + name + "' (have: cornell, closed-box)";
+    return false;
+  }
+  finalizeScene(scene);
+  return true;
+}
+
+bool loadScene(const std::string& spec, float t, Scene& scene, std::string& error) {
+  const std::string prefix = "builtin:";
+  if (spec.rfind(prefix, 0) == 0) return makeBuiltinScene(spec.substr(prefix.size()), t, scene, error);
+  return loadGltf(spec, scene, error);
+}
+
+}  // namespace probecast::scene

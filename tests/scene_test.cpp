@@ -1,0 +1,136 @@
+// Scene loading: the shared Cornell glTF, built-in scenes, and broken files.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "probecast/scene/scene.h"
+
+namespace probecast::scene {
+namespace {
+
+const std::string kCornell = std::string(PROBECAST_SHARED_DATA) + "/scenes/cornell-box/CornellBox-Original.gltf";
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const std::string path = std::string(PROBECAST_TEST_TMP) + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(Scene, CornellGltfLoadsTrianglesMaterialsEmission) {
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(loadGltf(kCornell, s, error)) << error;
+  // 8 meshes: floor, ceiling, back, right, left (2 triangles each), two boxes (10 each: 5 faces),
+  // light (2) = 36 triangles, counted from the file's index accessors.
+  EXPECT_EQ(s.triangleCount(), 36u);
+  EXPECT_EQ(s.positions.size(), s.normals.size());
+  int emissive = 0;
+  for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+    const Material& m = s.materials[s.triangleMaterial[t]];
+    if (m.emission.r > 0) {
+      ++emissive;
+      // emissiveFactor (1, 0.706, 0.235) × KHR_materials_emissive_strength 17.
+      EXPECT_NEAR(m.emission.r, 17.0f, 1e-4f);
+      EXPECT_NEAR(m.emission.g, 17.0f * 0.70588235f, 1e-3f);
+      EXPECT_NEAR(m.emission.b, 17.0f * 0.23529412f, 1e-3f);
+    }
+    if (m.name == "leftWall") {
+      EXPECT_NEAR(m.baseColor.r, 0.63f, 1e-6f);
+    }
+  }
+  EXPECT_EQ(emissive, 2);
+  // Interior x[-1, 1] y[0, 1.99] z[-1.04, 0.99] (CREDITS.md).
+  EXPECT_NEAR(s.boundsMin.x, -1.0f, 0.05f);
+  EXPECT_NEAR(s.boundsMax.y, 1.99f, 0.05f);
+  ASSERT_EQ(s.cameras.size(), 1u);
+  EXPECT_NEAR(s.cameras[0].position.z, 3.9f, 1e-4f);
+  EXPECT_NEAR(s.cameras[0].forward.z, -1.0f, 1e-4f);
+}
+
+TEST(Scene, BuiltinCornellMovesItsLightWithT) {
+  Scene a, b;
+  std::string error;
+  ASSERT_TRUE(makeBuiltinScene("cornell", 0.0f, a, error)) << error;
+  ASSERT_TRUE(makeBuiltinScene("cornell", 0.25f, b, error)) << error;
+  EXPECT_GT(a.triangleCount(), 20u);
+  ASSERT_EQ(a.lights.size(), 1u);
+  EXPECT_GT(glm::distance(a.lights[0].position, b.lights[0].position), 0.5f);
+  EXPECT_EQ(a.positions, b.positions);  // only the light moves
+  bool emissive = false;
+  for (const Material& m : a.materials) emissive = emissive || m.emission.r > 0;
+  EXPECT_TRUE(emissive);
+  EXPECT_FALSE(makeBuiltinScene("atlantis", 0.0f, a, error));
+  EXPECT_NE(error.find("atlantis"), std::string::npos);
+}
+
+TEST(Scene, TrianglesAreSpatiallySorted) {
+  // After finalizeScene, consecutive triangles are near each other: the mean centroid step is
+  // much smaller than for the order they were generated in.
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(makeBuiltinScene("cornell", 0.0f, s, error));
+  auto centroid = [&](uint32_t t) {
+    return (s.positions[s.indices[3 * t]] + s.positions[s.indices[3 * t + 1]] + s.positions[s.indices[3 * t + 2]]) / 3.0f;
+  };
+  float sorted = 0;
+  for (uint32_t t = 1; t < s.triangleCount(); ++t) sorted += glm::distance(centroid(t), centroid(t - 1));
+  std::vector<uint32_t> idx = s.indices;
+  // Reverse pairs of halves: interleave the two halves to make a deliberately scattered order.
+  const uint32_t n = s.triangleCount(), half = n / 2;
+  for (uint32_t k = 0; k < half; ++k)
+    for (int j = 0; j < 3; ++j) {
+      s.indices[3 * (2 * k) + j] = idx[3 * k + j];
+      s.indices[3 * (2 * k + 1) + j] = idx[3 * (half + k) + j];
+    }
+  float scattered = 0;
+  for (uint32_t t = 1; t < 2 * half; ++t) scattered += glm::distance(centroid(t), centroid(t - 1));
+  EXPECT_LT(sorted, scattered * 0.8f);
+}
+
+TEST(Scene, BrokenFilesFailWithClearMessages) {
+  Scene s;
+  std::string error;
+  EXPECT_FALSE(loadScene("/nonexistent/scene.gltf", 0.0f, s, error));
+  EXPECT_NE(error.find("/nonexistent/scene.gltf"), std::string::npos);
+
+  const std::string junk = writeTemp("junk.gltf", "{ this is not json");
+  EXPECT_FALSE(loadGltf(junk, s, error));
+  EXPECT_NE(error.find("junk.gltf"), std::string::npos);
+
+  const std::string empty = writeTemp("empty.gltf", R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": []}], "scene": 0})");
+  EXPECT_FALSE(loadGltf(empty, s, error));
+  EXPECT_NE(error.find("no triangles"), std::string::npos) << error;
+
+  const std::string required = writeTemp(
+      "required.gltf", R"({"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_draco_mesh_compression"],
+                           "extensionsRequired": ["KHR_draco_mesh_compression"]})");
+  EXPECT_FALSE(loadGltf(required, s, error));
+  EXPECT_NE(error.find("KHR_draco_mesh_compression"), std::string::npos) << error;
+
+  // A triangle whose buffer is too short for its accessor.
+  const std::string shortBuffer = writeTemp("short.gltf", R"({"asset": {"version": "2.0"},
+      "buffers": [{"byteLength": 12, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAA"}],
+      "bufferViews": [{"buffer": 0, "byteLength": 12}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+  EXPECT_FALSE(loadGltf(shortBuffer, s, error));
+  EXPECT_FALSE(error.empty());
+}
+
+TEST(Scene, NanPositionsAreRejected) {
+  // One triangle whose first x is NaN (bytes 00 00 c0 7f).
+  Scene s;
+  std::string error;
+  const std::string nan = writeTemp("nan.gltf", R"({"asset": {"version": "2.0"},
+      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AADAfwAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+  EXPECT_FALSE(loadGltf(nan, s, error));
+  EXPECT_NE(error.find("NaN"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace probecast::scene
