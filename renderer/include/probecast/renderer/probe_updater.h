@@ -1,0 +1,70 @@
+// The probe updater: path-traces a grid of L2 SH probes with the Vulkan ray-tracing pipeline.
+//
+// Per update, every active probe traces S paths over a spherical Fibonacci set rotated by a fresh
+// random rotation; path radiance is projected ĉ = (4π/S) Σ L(ω) Y(ω) and blended into the probe
+// with w = max(1/n, w_min). Probes whose rays see back faces too often are inside geometry: they
+// are inactive, get no rays and stay zero. Output uses the codec's probe layout (sh.h): 27 floats
+// per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "probecast/renderer/vulkan_context.h"
+#include "probecast/scene/scene.h"
+
+namespace probecast::renderer {
+
+struct ProbeGrid {
+  glm::vec3 min{-1.0f};  // position of probe (0, 0, 0), metres
+  glm::vec3 max{1.0f};   // position of probe (nx-1, ny-1, nz-1)
+  glm::uvec3 dims{4u};
+  uint32_t count() const { return dims.x * dims.y * dims.z; }
+  glm::vec3 position(uint32_t index) const;
+};
+
+struct UpdaterOptions {
+  uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32
+  uint32_t maxBounces = 4;         // surface interactions per path
+  float indirectClamp = 16.0f;     // max luminance of one contribution after the first bounce; 0 = off
+  float minBlendWeight = 0.05f;    // w_min of the temporal blend
+  uint32_t seed = 1;
+  bool classify = true;            // mark probes inside geometry inactive
+  uint32_t classifySamples = 64;
+  float backFaceThreshold = 0.25f; // inactive above this back-face hit ratio (RTXGI's rule)
+};
+
+struct UpdateStats {
+  double milliseconds = 0.0;
+  uint64_t paths = 0;        // primary samples traced
+  uint32_t activeProbes = 0;
+};
+
+class ProbeUpdater {
+ public:
+  ProbeUpdater(VulkanContext& context, const scene::Scene& scene, const ProbeGrid& grid,
+               const UpdaterOptions& options = {});
+  ~ProbeUpdater();
+  ProbeUpdater(const ProbeUpdater&) = delete;
+  ProbeUpdater& operator=(const ProbeUpdater&) = delete;
+
+  // The animated scene: lights and materials are re-uploaded; changed geometry rebuilds the
+  // acceleration structures and reclassifies the probes.
+  void setScene(const scene::Scene& scene);
+  UpdateStats update();
+
+  uint32_t probeCount() const;
+  uint32_t updates() const;
+  const float* probes() const;        // 27 floats per probe
+  const uint8_t* activeMask() const;  // 1 = active
+  const ProbeGrid& grid() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace probecast::renderer

@@ -1,0 +1,167 @@
+#include "probe_trace_pass.h"
+
+#include <cstring>
+#include <vector>
+
+#include "probe_shadow.rmiss.h"
+#include "probe_trace.rchit.h"
+#include "probe_trace.rgen.h"
+#include "probe_trace.rmiss.h"
+
+namespace probecast::renderer {
+namespace {
+
+VkShaderModule createModule(VulkanDevice& d, const uint32_t* code, size_t bytes) {
+  VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  ci.codeSize = bytes;
+  ci.pCode = code;
+  VkShaderModule m;
+  VK_CHECK(vkCreateShaderModule(d.device, &ci, nullptr, &m));
+  return m;
+}
+
+VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+}  // namespace
+
+void createProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b) {
+    VkDescriptorSetLayoutBinding binding{};
+    binding.binding = b;
+    binding.descriptorType = b == PT_BINDING_TLAS ? VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR
+                                                  : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    binding.descriptorCount = 1;
+    binding.stageFlags = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+    bindings.push_back(binding);
+  }
+  VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  lci.bindingCount = static_cast<uint32_t>(bindings.size());
+  lci.pBindings = bindings.data();
+  VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &pass.setLayout));
+
+  VkPushConstantRange range{VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, sizeof(shaders::PtPushConstants)};
+  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pli.setLayoutCount = 1;
+  pli.pSetLayouts = &pass.setLayout;
+  pli.pushConstantRangeCount = 1;
+  pli.pPushConstantRanges = &range;
+  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &pass.layout));
+
+  const VkShaderModule modules[4] = {
+      createModule(d, kProbeTraceRgen, sizeof kProbeTraceRgen),
+      createModule(d, kProbeTraceRmiss, sizeof kProbeTraceRmiss),
+      createModule(d, kProbeShadowRmiss, sizeof kProbeShadowRmiss),
+      createModule(d, kProbeTraceRchit, sizeof kProbeTraceRchit),
+  };
+  const VkShaderStageFlagBits stageBits[4] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
+                                              VK_SHADER_STAGE_MISS_BIT_KHR, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR};
+  VkPipelineShaderStageCreateInfo stages[4];
+  VkRayTracingShaderGroupCreateInfoKHR groups[4];
+  for (uint32_t i = 0; i < 4; ++i) {
+    stages[i] = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stages[i].stage = stageBits[i];
+    stages[i].module = modules[i];
+    stages[i].pName = "main";
+    groups[i] = VkRayTracingShaderGroupCreateInfoKHR{VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
+    groups[i].type = i == 3 ? VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR
+                            : VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
+    groups[i].generalShader = i == 3 ? VK_SHADER_UNUSED_KHR : i;
+    groups[i].closestHitShader = i == 3 ? 3 : VK_SHADER_UNUSED_KHR;
+    groups[i].anyHitShader = VK_SHADER_UNUSED_KHR;
+    groups[i].intersectionShader = VK_SHADER_UNUSED_KHR;
+  }
+  VkRayTracingPipelineCreateInfoKHR pci{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
+  pci.stageCount = 4;
+  pci.pStages = stages;
+  pci.groupCount = 4;
+  pci.pGroups = groups;
+  pci.maxPipelineRayRecursionDepth = 1;  // only raygen traces
+  pci.layout = pass.layout;
+  VK_CHECK(d.vkCreateRayTracingPipelinesKHR(d.device, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &pci, nullptr, &pass.pipeline));
+  for (VkShaderModule m : modules) vkDestroyShaderModule(d.device, m, nullptr);
+
+  // Shader binding table: raygen | miss, shadow miss | hit, each region base-aligned.
+  const auto& rt = d.rtProperties;
+  const VkDeviceSize handle = rt.shaderGroupHandleSize;
+  const VkDeviceSize stride = alignUp(handle, rt.shaderGroupHandleAlignment);
+  const VkDeviceSize base = rt.shaderGroupBaseAlignment;
+  std::vector<uint8_t> handles(handle * 4);
+  VK_CHECK(d.vkGetRayTracingShaderGroupHandlesKHR(d.device, pass.pipeline, 0, 4, handles.size(), handles.data()));
+  const VkDeviceSize raygenAt = 0, missAt = alignUp(stride, base), hitAt = alignUp(missAt + 2 * stride, base);
+  pass.sbt = createBuffer(d, hitAt + stride + base,
+                          VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
+  const VkDeviceAddress start = alignUp(pass.sbt.address, base);
+  uint8_t* mapped = static_cast<uint8_t*>(pass.sbt.mapped) + (start - pass.sbt.address);
+  std::memcpy(mapped + raygenAt, handles.data(), handle);
+  std::memcpy(mapped + missAt, handles.data() + handle, handle);
+  std::memcpy(mapped + missAt + stride, handles.data() + 2 * handle, handle);
+  std::memcpy(mapped + hitAt, handles.data() + 3 * handle, handle);
+  pass.raygen = {start + raygenAt, stride, stride};
+  pass.miss = {start + missAt, stride, 2 * stride};
+  pass.hit = {start + hitAt, stride, stride};
+
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, PT_BINDING_COUNT - 1}};
+  VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dpi.maxSets = 1;
+  dpi.poolSizeCount = 2;
+  dpi.pPoolSizes = sizes;
+  VK_CHECK(vkCreateDescriptorPool(d.device, &dpi, nullptr, &pass.pool));
+  VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  dai.descriptorPool = pass.pool;
+  dai.descriptorSetCount = 1;
+  dai.pSetLayouts = &pass.setLayout;
+  VK_CHECK(vkAllocateDescriptorSets(d.device, &dai, &pass.set));
+}
+
+void destroyProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
+  destroyBuffer(d, pass.sbt);
+  if (pass.pool) vkDestroyDescriptorPool(d.device, pass.pool, nullptr);
+  if (pass.pipeline) vkDestroyPipeline(d.device, pass.pipeline, nullptr);
+  if (pass.layout) vkDestroyPipelineLayout(d.device, pass.layout, nullptr);
+  if (pass.setLayout) vkDestroyDescriptorSetLayout(d.device, pass.setLayout, nullptr);
+  pass = ProbeTracePass{};
+}
+
+void runProbeTracePass(VulkanDevice& d, ProbeTracePass& pass, const ProbeTraceInputs& in,
+                       const shaders::PtPushConstants& push) {
+  VkWriteDescriptorSetAccelerationStructureKHR asWrite{
+      VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
+  asWrite.accelerationStructureCount = 1;
+  asWrite.pAccelerationStructures = &in.accel->tlas.handle;
+  const Buffer* buffers[PT_BINDING_COUNT] = {nullptr,         &in.accel->positions, &in.accel->indices,
+                                             in.triangleMaterial, in.materials,      in.lights,
+                                             in.directions,   in.probes,            in.partials};
+  VkDescriptorBufferInfo infos[PT_BINDING_COUNT];
+  VkWriteDescriptorSet writes[PT_BINDING_COUNT];
+  for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b) {
+    writes[b] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = pass.set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    if (b == PT_BINDING_TLAS) {
+      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+      writes[b].pNext = &asWrite;
+    } else {
+      infos[b] = {buffers[b]->buffer, 0, VK_WHOLE_SIZE};
+      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[b].pBufferInfo = &infos[b];
+    }
+  }
+  vkUpdateDescriptorSets(d.device, PT_BINDING_COUNT, writes, 0, nullptr);
+  submitAndWait(d, [&](VkCommandBuffer cmd) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pass.pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pass.layout, 0, 1, &pass.set, 0, nullptr);
+    vkCmdPushConstants(cmd, pass.layout, VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, sizeof push, &push);
+    d.vkCmdTraceRaysKHR(cmd, &pass.raygen, &pass.miss, &pass.hit, &pass.callable, PT_LANES_PER_PROBE, push.probeCount, 1);
+    // Make the shader writes visible to the host reading the mapped partials.
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier,
+                         0, nullptr, 0, nullptr);
+  });
+}
+
+}  // namespace probecast::renderer

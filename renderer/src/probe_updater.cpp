@@ -1,0 +1,278 @@
+// Probe updater: sample directions, classification, dispatch, reduction and temporal blend.
+#include "probecast/renderer/probe_updater.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+#include "probe_trace_pass.h"
+
+namespace probecast::renderer {
+namespace {
+
+using shaders::PtLight;
+using shaders::PtMaterial;
+using shaders::PtPushConstants;
+
+constexpr uint32_t kLanes = PT_LANES_PER_PROBE;
+constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+
+uint32_t roundUpLanes(uint32_t n) { return std::max(kLanes, (n + kLanes - 1) / kLanes * kLanes); }
+
+uint32_t spread2(uint32_t v) {  // 16 bits → every other bit
+  v &= 0xffffu;
+  v = (v | (v << 8)) & 0x00ff00ffu;
+  v = (v | (v << 4)) & 0x0f0f0f0fu;
+  v = (v | (v << 2)) & 0x33333333u;
+  v = (v | (v << 1)) & 0x55555555u;
+  return v;
+}
+
+// Spherical Fibonacci directions, reordered along a Morton curve of their octahedral coordinates
+// so consecutive samples (neighbouring invocations) point in nearby directions.
+std::vector<shaders::vec4> coherentFibonacci(uint32_t count) {
+  std::vector<glm::vec3> dirs(count);
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (uint32_t i = 0; i < count; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / count;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    dirs[i] = glm::vec3(static_cast<float>(r * std::cos(golden * i)), static_cast<float>(r * std::sin(golden * i)),
+                        static_cast<float>(z));
+  }
+  std::vector<uint32_t> key(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    const glm::vec3 d = dirs[i] / (std::fabs(dirs[i].x) + std::fabs(dirs[i].y) + std::fabs(dirs[i].z));
+    glm::vec2 o(d.x, d.y);
+    if (d.z < 0) o = (1.0f - glm::abs(glm::vec2(o.y, o.x))) * glm::vec2(o.x >= 0 ? 1 : -1, o.y >= 0 ? 1 : -1);
+    const glm::vec2 u = glm::clamp(o * 0.5f + 0.5f, 0.0f, 1.0f) * 65535.0f;
+    key[i] = spread2(static_cast<uint32_t>(u.x)) | (spread2(static_cast<uint32_t>(u.y)) << 1);
+  }
+  std::vector<uint32_t> order(count);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key[a] < key[b]; });
+  std::vector<shaders::vec4> out(count);
+  for (uint32_t i = 0; i < count; ++i) out[i] = {dirs[order[i]].x, dirs[order[i]].y, dirs[order[i]].z, 0.0f};
+  return out;
+}
+
+// A uniformly random rotation (Shoemake's quaternion), deterministic in (seed, update).
+shaders::mat4 randomRotation(uint32_t seed, uint32_t update) {
+  std::seed_seq seq{seed, update, 0x9e3779b9u};
+  std::mt19937 rng(seq);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+  const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
+  const double x = a * std::sin(2 * M_PI * u2), y = a * std::cos(2 * M_PI * u2), z = b * std::sin(2 * M_PI * u3),
+               w = b * std::cos(2 * M_PI * u3);
+  const float m[3][3] = {{float(1 - 2 * (y * y + z * z)), float(2 * (x * y + w * z)), float(2 * (x * z - w * y))},
+                         {float(2 * (x * y - w * z)), float(1 - 2 * (x * x + z * z)), float(2 * (y * z + w * x))},
+                         {float(2 * (x * z + w * y)), float(2 * (y * z - w * x)), float(1 - 2 * (x * x + y * y))}};
+  shaders::mat4 r{};
+  for (int c = 0; c < 3; ++c) r.c[c] = {m[c][0], m[c][1], m[c][2], 0.0f};
+  r.c[3] = {0, 0, 0, 1};
+  return r;
+}
+
+shaders::mat4 identity() {
+  shaders::mat4 r{};
+  r.c[0] = {1, 0, 0, 0};
+  r.c[1] = {0, 1, 0, 0};
+  r.c[2] = {0, 0, 1, 0};
+  r.c[3] = {0, 0, 0, 1};
+  return r;
+}
+
+}  // namespace
+
+glm::vec3 ProbeGrid::position(uint32_t index) const {
+  const glm::uvec3 c(index % dims.x, (index / dims.x) % dims.y, index / (dims.x * dims.y));
+  glm::vec3 t;
+  for (int a = 0; a < 3; ++a) t[a] = dims[a] > 1 ? static_cast<float>(c[a]) / static_cast<float>(dims[a] - 1) : 0.5f;
+  return min + (max - min) * t;
+}
+
+struct ProbeUpdater::Impl {
+  VulkanDevice* d = nullptr;
+  ProbeGrid grid;
+  UpdaterOptions options;
+  uint32_t samples = 0;
+  uint32_t updates = 0;
+  std::vector<float> probes;
+  std::vector<uint8_t> active;
+  std::vector<uint32_t> activeList;
+  std::vector<uint32_t> blendCount;
+  size_t geometryVertices = 0, geometryTriangles = 0;
+  std::vector<glm::vec3> geometryPositions;
+  std::vector<uint32_t> geometryIndices;
+
+  ProbeTracePass pass;
+  SceneAccel accel;
+  Buffer triangleMaterial, materials, lights, directions, classifyDirections, probeList, partials;
+  uint32_t lightCount = 0;
+
+  void uploadShading(const scene::Scene& s) {
+    destroyBuffer(*d, triangleMaterial);
+    destroyBuffer(*d, materials);
+    destroyBuffer(*d, lights);
+    triangleMaterial = createBufferWithData(*d, s.triangleMaterial.data(), s.triangleMaterial.size() * 4, kStorage);
+    std::vector<PtMaterial> mats;
+    for (const scene::Material& m : s.materials)
+      mats.push_back({{m.baseColor.r, m.baseColor.g, m.baseColor.b, m.metallic},
+                      {m.emission.r, m.emission.g, m.emission.b, m.roughness}});
+    materials = createBufferWithData(*d, mats.data(), mats.size() * sizeof(PtMaterial), kStorage);
+    std::vector<PtLight> ls;
+    for (const scene::Light& l : s.lights) {
+      const glm::vec3 dir = glm::length(l.direction) > 0 ? glm::normalize(l.direction) : glm::vec3(0, -1, 0);
+      ls.push_back({{l.position.x, l.position.y, l.position.z, static_cast<float>(static_cast<uint32_t>(l.type))},
+                    {dir.x, dir.y, dir.z, l.range},
+                    {l.color.r, l.color.g, l.color.b, l.intensity},
+                    {std::cos(l.outerConeAngle), std::cos(l.innerConeAngle), 0.0f, 0.0f}});
+    }
+    lights = createBufferWithData(*d, ls.data(), ls.size() * sizeof(PtLight), kStorage);
+    lightCount = static_cast<uint32_t>(ls.size());
+  }
+
+  void uploadProbeList(const std::vector<uint32_t>& list) {
+    destroyBuffer(*d, probeList);
+    destroyBuffer(*d, partials);
+    std::vector<shaders::vec4> data(list.size());
+    for (size_t i = 0; i < list.size(); ++i) {
+      const glm::vec3 p = grid.position(list[i]);
+      float key;
+      std::memcpy(&key, &list[i], sizeof key);  // the grid index as bits: the shader's RNG stream
+      data[i] = {p.x, p.y, p.z, key};
+    }
+    probeList = createBufferWithData(*d, data.data(), data.size() * sizeof(shaders::vec4), kStorage);
+    partials = createBuffer(*d, list.size() * kLanes * PT_PARTIAL_FLOATS * sizeof(float), kStorage);
+  }
+
+  void dispatch(uint32_t count, uint32_t sampleCount, const Buffer& dirs, uint32_t mode, const shaders::mat4& rotation) {
+    PtPushConstants push{};
+    push.rotation = rotation;
+    push.sampleCount = sampleCount;
+    push.probeCount = count;
+    push.lightCount = lightCount;
+    push.maxBounces = std::clamp<uint32_t>(options.maxBounces, 1, PT_MAX_BOUNCES_LIMIT);
+    push.seed = options.seed;
+    push.updateIndex = updates;
+    push.mode = mode;
+    push.indirectClamp = options.indirectClamp;
+    const ProbeTraceInputs in{&accel, &triangleMaterial, &materials, &lights, &dirs, &probeList, &partials};
+    runProbeTracePass(*d, pass, in, push);
+  }
+
+  void classify() {
+    std::vector<uint32_t> all(grid.count());
+    std::iota(all.begin(), all.end(), 0u);
+    std::fill(active.begin(), active.end(), 1);
+    if (options.classify) {
+      uploadProbeList(all);
+      const uint32_t n = roundUpLanes(options.classifySamples);
+      dispatch(grid.count(), n, classifyDirections, PT_MODE_CLASSIFY, identity());
+      const float* part = static_cast<const float*>(partials.mapped);
+      for (uint32_t p = 0; p < grid.count(); ++p) {
+        float back = 0.0f;
+        for (uint32_t lane = 0; lane < kLanes; ++lane) back += part[(p * kLanes + lane) * PT_PARTIAL_FLOATS + 27];
+        active[p] = back / static_cast<float>(n) > options.backFaceThreshold ? 0 : 1;
+      }
+    }
+    activeList.clear();
+    for (uint32_t p = 0; p < grid.count(); ++p) {
+      if (active[p]) activeList.push_back(p);
+      else std::fill(probes.begin() + p * 27, probes.begin() + (p + 1) * 27, 0.0f);
+    }
+    uploadProbeList(activeList);
+  }
+
+  void setGeometry(const scene::Scene& s) {
+    if (accel.tlas.handle) destroySceneAccel(*d, accel);
+    buildSceneAccel(*d, s, accel);
+    geometryPositions = s.positions;
+    geometryIndices = s.indices;
+  }
+};
+
+ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, const ProbeGrid& grid,
+                           const UpdaterOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
+  if (grid.count() == 0) throw std::invalid_argument("probe grid has no probes");
+  Impl& s = *impl_;
+  s.d = &context.device();
+  s.grid = grid;
+  s.options = options;
+  s.samples = roundUpLanes(options.samplesPerProbe);
+  s.probes.assign(static_cast<size_t>(grid.count()) * 27, 0.0f);
+  s.active.assign(grid.count(), 1);
+  s.blendCount.assign(grid.count(), 0);
+  createProbeTracePass(*s.d, s.pass);
+  const auto dirs = coherentFibonacci(s.samples);
+  s.directions = createBufferWithData(*s.d, dirs.data(), dirs.size() * sizeof(shaders::vec4), kStorage);
+  const auto cdirs = coherentFibonacci(roundUpLanes(options.classifySamples));
+  s.classifyDirections = createBufferWithData(*s.d, cdirs.data(), cdirs.size() * sizeof(shaders::vec4), kStorage);
+  s.setGeometry(scene);
+  s.uploadShading(scene);
+  s.classify();
+}
+
+ProbeUpdater::~ProbeUpdater() {
+  Impl& s = *impl_;
+  destroySceneAccel(*s.d, s.accel);
+  for (Buffer* b : {&s.triangleMaterial, &s.materials, &s.lights, &s.directions, &s.classifyDirections, &s.probeList,
+                    &s.partials})
+    destroyBuffer(*s.d, *b);
+  destroyProbeTracePass(*s.d, s.pass);
+}
+
+void ProbeUpdater::setScene(const scene::Scene& scene) {
+  Impl& s = *impl_;
+  if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
+  const bool geometryChanged = scene.positions != s.geometryPositions || scene.indices != s.geometryIndices;
+  if (geometryChanged) s.setGeometry(scene);
+  s.uploadShading(scene);
+  if (geometryChanged) s.classify();
+}
+
+UpdateStats ProbeUpdater::update() {
+  Impl& s = *impl_;
+  const auto t0 = std::chrono::steady_clock::now();
+  UpdateStats stats;
+  stats.activeProbes = static_cast<uint32_t>(s.activeList.size());
+  if (!s.activeList.empty()) {
+    s.dispatch(static_cast<uint32_t>(s.activeList.size()), s.samples, s.directions, PT_MODE_TRACE,
+               randomRotation(s.options.seed, s.updates));
+    // ĉ = (4π/S) Σ lanes, summed in a fixed order (deterministic), then c ← (1−w) c + w ĉ.
+    const float* part = static_cast<const float*>(s.partials.mapped);
+    const float scale = 4.0f * 3.14159265358979f / static_cast<float>(s.samples);
+    for (size_t i = 0; i < s.activeList.size(); ++i) {
+      const uint32_t p = s.activeList[i];
+      float sum[27] = {};
+      for (uint32_t lane = 0; lane < kLanes; ++lane) {
+        const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
+        for (int k = 0; k < 27; ++k) sum[k] += src[k];
+      }
+      const uint32_t n = ++s.blendCount[p];
+      const float w = std::max(1.0f / static_cast<float>(n), s.options.minBlendWeight);
+      float* c = &s.probes[static_cast<size_t>(p) * 27];
+      for (int k = 0; k < 27; ++k) {
+        const float fresh = sum[k] * scale;
+        c[k] = std::isfinite(fresh) ? (1.0f - w) * c[k] + w * fresh : c[k];
+      }
+    }
+    stats.paths = static_cast<uint64_t>(s.activeList.size()) * s.samples;
+  }
+  ++s.updates;
+  stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return stats;
+}
+
+uint32_t ProbeUpdater::probeCount() const { return impl_->grid.count(); }
+uint32_t ProbeUpdater::updates() const { return impl_->updates; }
+const float* ProbeUpdater::probes() const { return impl_->probes.data(); }
+const uint8_t* ProbeUpdater::activeMask() const { return impl_->active.data(); }
+const ProbeGrid& ProbeUpdater::grid() const { return impl_->grid; }
+
+}  // namespace probecast::renderer

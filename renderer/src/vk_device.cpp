@@ -1,0 +1,196 @@
+#include "vk_device.h"
+
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "probecast/renderer/vulkan_context.h"
+
+namespace probecast::renderer {
+namespace {
+
+const char* kDeviceExtensions[] = {
+    VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+    VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
+    VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
+};
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
+    static_cast<VulkanDevice*>(user)->validationMessages++;
+    std::fprintf(stderr, "vulkan validation: %s\n", data->pMessage);
+  }
+  return VK_FALSE;
+}
+
+bool hasExtensions(VkPhysicalDevice physical) {
+  uint32_t count = 0;
+  vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr);
+  std::vector<VkExtensionProperties> props(count);
+  vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, props.data());
+  for (const char* want : kDeviceExtensions) {
+    bool found = false;
+    for (const auto& p : props) found = found || std::strcmp(p.extensionName, want) == 0;
+    if (!found) return false;
+  }
+  return true;
+}
+
+template <typename T>
+void load(VkDevice device, T& fn, const char* name) {
+  fn = reinterpret_cast<T>(vkGetDeviceProcAddr(device, name));
+  if (!fn) throw std::runtime_error(std::string("Vulkan entry point missing: ") + name);
+}
+
+}  // namespace
+
+void vkFail(VkResult result, const char* call, const char* file, int line) {
+  throw std::runtime_error("Vulkan call failed (VkResult " + std::to_string(static_cast<int>(result)) + "): " + call +
+                           " at " + file + ":" + std::to_string(line));
+}
+
+void createDevice(VulkanDevice& d, bool validation, bool preferGpu) {
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "probecast";
+  app.apiVersion = VK_API_VERSION_1_3;
+  std::vector<const char*> layers, extensions;
+  if (validation) {
+    layers.push_back("VK_LAYER_KHRONOS_validation");
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  ici.enabledLayerCount = static_cast<uint32_t>(layers.size());
+  ici.ppEnabledLayerNames = layers.data();
+  ici.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+  ici.ppEnabledExtensionNames = extensions.data();
+  const VkResult created = vkCreateInstance(&ici, nullptr, &d.instance);
+  if (created == VK_ERROR_LAYER_NOT_PRESENT)
+    throw std::runtime_error("Vulkan validation layer not installed (package vulkan-validationlayers)");
+  if (created == VK_ERROR_INCOMPATIBLE_DRIVER)
+    throw std::runtime_error("no Vulkan driver (install mesa-vulkan-drivers >= 24 for lavapipe; see README)");
+  VK_CHECK(created);
+
+  if (validation) {
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mci.pfnUserCallback = onValidationMessage;
+    mci.pUserData = &d;
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(d.instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (create) VK_CHECK(create(d.instance, &mci, nullptr, &d.messenger));
+  }
+
+  uint32_t count = 0;
+  VK_CHECK(vkEnumeratePhysicalDevices(d.instance, &count, nullptr));
+  std::vector<VkPhysicalDevice> devices(count);
+  VK_CHECK(vkEnumeratePhysicalDevices(d.instance, &count, devices.data()));
+  int best = -1;
+  for (uint32_t i = 0; i < count; ++i) {
+    if (!hasExtensions(devices[i])) continue;
+    VkPhysicalDeviceProperties p;
+    vkGetPhysicalDeviceProperties(devices[i], &p);
+    const bool isCpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    if (best < 0 || (preferGpu ? !isCpu : isCpu)) best = static_cast<int>(i);
+  }
+  if (best < 0)
+    throw std::runtime_error(
+        "no Vulkan device with ray tracing (VK_KHR_ray_tracing_pipeline); lavapipe needs Mesa >= 24 from "
+        "bookworm-backports (scripts/setup.sh installs it)");
+  d.physical = devices[best];
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  d.rtProperties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
+  props.pNext = &d.rtProperties;
+  vkGetPhysicalDeviceProperties2(d.physical, &props);
+  d.name = props.properties.deviceName;
+  vkGetPhysicalDeviceMemoryProperties(d.physical, &d.memory);
+
+  uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(d.physical, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> qf(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(d.physical, &families, qf.data());
+  d.queueFamily = UINT32_MAX;
+  for (uint32_t i = 0; i < families; ++i)
+    if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && d.queueFamily == UINT32_MAX) d.queueFamily = i;
+  if (d.queueFamily == UINT32_MAX) throw std::runtime_error("no compute queue");
+
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR rt{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  rt.rayTracingPipeline = VK_TRUE;
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  as.accelerationStructure = VK_TRUE;
+  as.pNext = &rt;
+  VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  v12.bufferDeviceAddress = VK_TRUE;
+  v12.pNext = &as;
+  VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  v13.synchronization2 = VK_TRUE;
+  v13.dynamicRendering = VK_TRUE;
+  v13.pNext = &v12;
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  features.pNext = &v13;
+
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = d.queueFamily;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.pNext = &features;
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  dci.enabledExtensionCount = static_cast<uint32_t>(std::size(kDeviceExtensions));
+  dci.ppEnabledExtensionNames = kDeviceExtensions;
+  VK_CHECK(vkCreateDevice(d.physical, &dci, nullptr, &d.device));
+  vkGetDeviceQueue(d.device, d.queueFamily, 0, &d.queue);
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = d.queueFamily;
+  VK_CHECK(vkCreateCommandPool(d.device, &pci, nullptr, &d.commandPool));
+
+  load(d.device, d.vkCreateAccelerationStructureKHR, "vkCreateAccelerationStructureKHR");
+  load(d.device, d.vkDestroyAccelerationStructureKHR, "vkDestroyAccelerationStructureKHR");
+  load(d.device, d.vkGetAccelerationStructureBuildSizesKHR, "vkGetAccelerationStructureBuildSizesKHR");
+  load(d.device, d.vkCmdBuildAccelerationStructuresKHR, "vkCmdBuildAccelerationStructuresKHR");
+  load(d.device, d.vkGetAccelerationStructureDeviceAddressKHR, "vkGetAccelerationStructureDeviceAddressKHR");
+  load(d.device, d.vkCreateRayTracingPipelinesKHR, "vkCreateRayTracingPipelinesKHR");
+  load(d.device, d.vkGetRayTracingShaderGroupHandlesKHR, "vkGetRayTracingShaderGroupHandlesKHR");
+  load(d.device, d.vkCmdTraceRaysKHR, "vkCmdTraceRaysKHR");
+}
+
+void destroyDevice(VulkanDevice& d) {
+  if (d.device) {
+    vkDeviceWaitIdle(d.device);
+    vkDestroyCommandPool(d.device, d.commandPool, nullptr);
+    vkDestroyDevice(d.device, nullptr);
+  }
+  if (d.messenger) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(d.instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(d.instance, d.messenger, nullptr);
+  }
+  if (d.instance) vkDestroyInstance(d.instance, nullptr);
+  d.device = VK_NULL_HANDLE;
+  d.messenger = VK_NULL_HANDLE;
+  d.instance = VK_NULL_HANDLE;
+}
+
+VulkanContext::VulkanContext(const ContextOptions& options) : device_(std::make_unique<VulkanDevice>()) {
+  try {
+    createDevice(*device_, options.validation, options.preferGpu);
+  } catch (...) {
+    destroyDevice(*device_);
+    throw;
+  }
+}
+
+VulkanContext::~VulkanContext() { destroyDevice(*device_); }
+const std::string& VulkanContext::deviceName() const { return device_->name; }
+uint32_t VulkanContext::validationMessages() const { return device_->validationMessages.load(); }
+VulkanDevice& VulkanContext::device() { return *device_; }
+
+}  // namespace probecast::renderer

@@ -1,0 +1,37 @@
+// Instance, device, queue, and the extension entry points the renderer uses.
+#pragma once
+
+#include <atomic>
+#include <string>
+
+#include "vk_common.h"
+
+namespace probecast::renderer {
+
+struct VulkanDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  uint32_t queueFamily = 0;
+  VkCommandPool commandPool = VK_NULL_HANDLE;
+  std::string name;
+  VkPhysicalDeviceMemoryProperties memory{};
+  VkPhysicalDeviceRayTracingPipelinePropertiesKHR rtProperties{};
+  std::atomic<uint32_t> validationMessages{0};
+
+  PFN_vkCreateAccelerationStructureKHR vkCreateAccelerationStructureKHR = nullptr;
+  PFN_vkDestroyAccelerationStructureKHR vkDestroyAccelerationStructureKHR = nullptr;
+  PFN_vkGetAccelerationStructureBuildSizesKHR vkGetAccelerationStructureBuildSizesKHR = nullptr;
+  PFN_vkCmdBuildAccelerationStructuresKHR vkCmdBuildAccelerationStructuresKHR = nullptr;
+  PFN_vkGetAccelerationStructureDeviceAddressKHR vkGetAccelerationStructureDeviceAddressKHR = nullptr;
+  PFN_vkCreateRayTracingPipelinesKHR vkCreateRayTracingPipelinesKHR = nullptr;
+  PFN_vkGetRayTracingShaderGroupHandlesKHR vkGetRayTracingShaderGroupHandlesKHR = nullptr;
+  PFN_vkCmdTraceRaysKHR vkCmdTraceRaysKHR = nullptr;
+};
+
+void createDevice(VulkanDevice& d, bool validation, bool preferGpu);
+void destroyDevice(VulkanDevice& d);
+
+}  // namespace probecast::renderer

@@ -1,0 +1,71 @@
+// Constants and layouts shared by the probe tracer's C++ and GLSL (one place for both).
+#ifndef PROBECAST_PROBE_TRACE_SHARED_H
+#define PROBECAST_PROBE_TRACE_SHARED_H
+
+#define PT_LANES_PER_PROBE 32   // invocations per probe; each sums its samples into one partial SH
+#define PT_PARTIAL_FLOATS 28    // 27 SH floats + 1 back-face counter per lane
+#define PT_MAX_BOUNCES_LIMIT 16
+
+#define PT_MODE_TRACE 0u        // full paths, projected to SH
+#define PT_MODE_CLASSIFY 1u     // first segment only: count back-face hits
+
+#define PT_BINDING_TLAS 0
+#define PT_BINDING_POSITIONS 1  // float[3 * vertices]
+#define PT_BINDING_INDICES 2    // uint[3 * triangles]
+#define PT_BINDING_TRIANGLE_MATERIAL 3
+#define PT_BINDING_MATERIALS 4  // PtMaterial[]
+#define PT_BINDING_LIGHTS 5     // PtLight[]
+#define PT_BINDING_DIRECTIONS 6 // vec4[samples], unit directions in a coherent order
+#define PT_BINDING_PROBES 7     // vec4[active probes]: world position, w = grid index
+#define PT_BINDING_PARTIALS 8   // float[active probes * LANES * PARTIAL_FLOATS]
+#define PT_BINDING_COUNT 9
+
+#define PT_LIGHT_POINT 0u
+#define PT_LIGHT_SPOT 1u
+#define PT_LIGHT_DIRECTIONAL 2u
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace probecast::shaders {
+using uint = uint32_t;
+struct vec4 {
+  float x, y, z, w;
+};
+struct mat4 {
+  vec4 c[4];
+};
+#endif
+
+// std430 layouts.
+struct PtMaterial {
+  vec4 baseColorMetallic;   // rgb base colour, a metallic
+  vec4 emissionRoughness;   // rgb emitted radiance, a roughness
+};
+
+struct PtLight {
+  vec4 positionType;        // xyz position, w type (as float)
+  vec4 directionRange;      // xyz direction the light travels, w range (0 = none)
+  vec4 colorIntensity;      // rgb colour, a intensity (cd or lx)
+  vec4 cone;                // x cos(outer), y cos(inner)
+};
+
+struct PtPushConstants {
+  mat4 rotation;            // random rotation of the sample set for this update
+  uint sampleCount;         // samples per probe (multiple of LANES)
+  uint probeCount;          // active probes in this dispatch
+  uint lightCount;
+  uint maxBounces;
+  uint seed;
+  uint updateIndex;
+  uint mode;                // PT_MODE_*
+  float indirectClamp;      // max luminance of one indirect contribution; 0 = off
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(PtMaterial) == 32);
+static_assert(sizeof(PtLight) == 64);
+static_assert(sizeof(PtPushConstants) == 96);
+}  // namespace probecast::shaders
+#endif
+
+#endif

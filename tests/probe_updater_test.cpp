@@ -1,0 +1,239 @@
+// The Vulkan probe updater against analytic answers (CODEC.md §8), determinism, classification
+// and validation (zero messages). Runs on lavapipe in CI.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "probecast/codec/sh.h"
+#include "probecast/renderer/probe_updater.h"
+
+namespace probecast::renderer {
+namespace {
+
+using scene::Material;
+using scene::Scene;
+
+// Every test checks the validation layer stayed silent.
+class Updater : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ContextOptions options;
+    options.validation = true;
+    context_ = std::make_unique<VulkanContext>(options);
+  }
+  void TearDown() override { EXPECT_EQ(context_->validationMessages(), 0u) << "Vulkan validation messages"; }
+  std::unique_ptr<VulkanContext> context_;
+};
+
+uint32_t addMaterial(Scene& s, glm::vec3 base, glm::vec3 emission) {
+  Material m;
+  m.baseColor = base;
+  m.emission = emission;
+  s.materials.push_back(m);
+  return static_cast<uint32_t>(s.materials.size() - 1);
+}
+
+// Inward-facing box x, y, z in [-1, 1]; `material(face, upperHalf)` picks each half-face's material
+// (faces split at z = 0 where they cross it).
+template <typename Pick>
+Scene halfSplitBox(Pick material) {
+  Scene s;
+  s.name = "test-box";
+  const float a = -1, b = 1;
+  // z = ±1 caps.
+  scene::addQuad(s, {a, a, a}, {b, a, a}, {b, b, a}, {a, b, a}, material(0, false));  // z = −1, normal +Z
+  scene::addQuad(s, {b, a, b}, {a, a, b}, {a, b, b}, {b, b, b}, material(1, true));   // z = +1, normal −Z
+  for (int half = 0; half < 2; ++half) {
+    const float z0 = half ? 0.0f : a, z1 = half ? b : 0.0f;
+    const bool upper = half == 1;
+    scene::addQuad(s, {a, a, z1}, {b, a, z1}, {b, a, z0}, {a, a, z0}, material(2, upper));  // y = −1, normal +Y
+    scene::addQuad(s, {a, b, z0}, {b, b, z0}, {b, b, z1}, {a, b, z1}, material(3, upper));  // y = +1, normal −Y
+    scene::addQuad(s, {a, a, z1}, {a, a, z0}, {a, b, z0}, {a, b, z1}, material(4, upper));  // x = −1, normal +X
+    scene::addQuad(s, {b, a, z0}, {b, a, z1}, {b, b, z1}, {b, b, z0}, material(5, upper));  // x = +1, normal −X
+  }
+  scene::finalizeScene(s);
+  return s;
+}
+
+ProbeGrid singleProbe(glm::vec3 p) {
+  ProbeGrid g;
+  g.min = g.max = p;
+  g.dims = glm::uvec3(1);
+  return g;
+}
+
+TEST_F(Updater, ClosedEmissiveBoxGivesConstantRadiance) {
+  // Radiance L from every inner face, black albedo: c00 = 2√π L and the rest 0 (CODEC.md §8.1).
+  const glm::vec3 L(1.0f, 0.5f, 0.25f);
+  Scene s;
+  const uint32_t m = addMaterial(s, glm::vec3(0.0f), L);
+  s = halfSplitBox([&](int, bool) { return m; });
+  s.materials.clear();
+  addMaterial(s, glm::vec3(0.0f), L);
+  UpdaterOptions o;
+  o.samplesPerProbe = 256;
+  o.maxBounces = 1;  // the emission the probe sees, no reflections of it (GGX reflects even black)
+  ProbeUpdater updater(*context_, s, singleProbe({0.1f, -0.2f, 0.05f}), o);
+  ASSERT_EQ(updater.activeMask()[0], 1);
+  for (int u = 0; u < 3; ++u) updater.update();
+  const float* p = updater.probes();
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(p[c], 3.5449077f * L[c], 1e-4f * L[c]);  // every ray sees L exactly
+    for (int i = 1; i < kShCoeffs; ++i) EXPECT_NEAR(p[i * 3 + c], 0.0f, 0.02f * p[c]) << "coefficient " << i;
+  }
+}
+
+TEST_F(Updater, HalfEmissiveBoxGivesHemisphereAnswer) {
+  // Radiance 1 for z > 0, 0 below (CODEC.md §8.2): c00 = √π, c10 = √(3π)/2, c20 = 0, E(+z) = π.
+  Scene s;
+  s = halfSplitBox([](int, bool upper) { return upper ? 1u : 0u; });
+  s.materials.clear();
+  addMaterial(s, glm::vec3(0.0f), glm::vec3(0.0f));
+  addMaterial(s, glm::vec3(0.0f), glm::vec3(1.0f));
+  UpdaterOptions o;
+  o.samplesPerProbe = 1024;
+  o.maxBounces = 1;
+  ProbeUpdater updater(*context_, s, singleProbe({0.0f, 0.0f, 0.0f}), o);
+  for (int u = 0; u < 8; ++u) updater.update();
+  const float* p = updater.probes();
+  EXPECT_NEAR(p[0], 1.7724539f, 0.01f);
+  EXPECT_NEAR(p[2 * 3], 1.5349900f, 0.015f);
+  EXPECT_NEAR(p[6 * 3], 0.0f, 0.015f);
+  float e[3];
+  shEvalIrradiance(p, 0, 0, 1, e);
+  EXPECT_NEAR(e[0], kPi, 0.03f);
+  shEvalIrradiance(p, 0, 0, -1, e);
+  EXPECT_NEAR(e[0], 0.0f, 0.03f);
+}
+
+// glTF metallic-roughness BRDF for a dielectric (metallic 0): Lambert + GGX with Smith-Schlick G
+// and Schlick Fresnel, F0 = 0.04 — written independently of the shader.
+double dielectricBrdf(double rho, double roughness, const glm::dvec3& n, const glm::dvec3& wo, const glm::dvec3& wi) {
+  const double nl = glm::dot(n, wi), nv = glm::dot(n, wo);
+  if (nl <= 0 || nv <= 0) return 0;
+  const glm::dvec3 h = glm::normalize(wo + wi);
+  const double nh = glm::dot(n, h), vh = glm::dot(wo, h);
+  const double a = roughness * roughness, a2 = a * a;
+  const double d = a2 / (M_PI * std::pow(nh * nh * (a2 - 1) + 1, 2));
+  const double k = a / 2;
+  const double g = nl / (nl * (1 - k) + k) * nv / (nv * (1 - k) + k);
+  const double f = 0.04 + 0.96 * std::pow(1 - vh, 5);
+  return rho / M_PI + d * g * f / (4 * nl * nv);
+}
+
+// Radiance at the probe from a floor lit by a point light, integrated on the CPU.
+TEST_F(Updater, PointLightOnFloorMatchesNumericalIntegral) {
+  const float rho = 0.5f, intensity = 4.0f, half = 5.0f;
+  const glm::vec3 light(0.3f, 2.0f, 0.0f), probe(0.0f, 1.0f, 0.0f);
+  Scene s;
+  addMaterial(s, glm::vec3(rho), glm::vec3(0.0f));
+  s.materials[0].roughness = 0.6f;
+  scene::addQuad(s, {-half, 0, half}, {half, 0, half}, {half, 0, -half}, {-half, 0, -half}, 0);
+  scene::Light l;
+  l.position = light;
+  l.intensity = intensity;
+  s.lights.push_back(l);
+  scene::finalizeScene(s);
+  UpdaterOptions o;
+  o.samplesPerProbe = 1024;
+  o.maxBounces = 1;  // direct light only: nothing else to bounce off
+  ProbeUpdater updater(*context_, s, singleProbe(probe), o);
+  for (int u = 0; u < 8; ++u) updater.update();
+
+  // c_i = ∫ L(x) Y_i(ω) dω with dω = cos θ_x dA / r², L(x) = f(x) · I cos θ_l / d².
+  double ref[kShCoeffs] = {};
+  const int n = 1000;
+  const double cell = 2.0 * half / n;
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < n; ++k) {
+      const glm::dvec3 x(-half + (i + 0.5) * cell, 0.0, -half + (k + 0.5) * cell);
+      const glm::dvec3 toLight = glm::dvec3(light) - x, toProbe = glm::dvec3(probe) - x;
+      const double dl2 = glm::dot(toLight, toLight), r2 = glm::dot(toProbe, toProbe);
+      const double f = dielectricBrdf(rho, 0.6, glm::dvec3(0, 1, 0), glm::normalize(toProbe), glm::normalize(toLight));
+      const double radiance = f * intensity * (toLight.y / std::sqrt(dl2)) / dl2;
+      const double domega = (toProbe.y / std::sqrt(r2)) * cell * cell / r2;
+      const glm::dvec3 w = -toProbe / std::sqrt(r2);
+      float y[kShCoeffs];
+      shEvalBasis(static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z), y);
+      for (int c = 0; c < kShCoeffs; ++c) ref[c] += radiance * y[c] * domega;
+    }
+  }
+  const float* p = updater.probes();
+  for (int c = 0; c < kShCoeffs; ++c)
+    EXPECT_NEAR(p[c * 3], ref[c], 0.03 * ref[0]) << "coefficient " << c;
+}
+
+TEST_F(Updater, SameSeedIsBitIdenticalOtherSeedIsNot) {
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error)) << error;
+  ProbeGrid g;
+  g.min = {-0.8f, 0.2f, -0.8f};
+  g.max = {0.8f, 1.8f, 0.8f};
+  g.dims = glm::uvec3(3);
+  UpdaterOptions o;
+  o.samplesPerProbe = 64;
+  std::vector<float> results[3];
+  for (int run = 0; run < 3; ++run) {
+    o.seed = run < 2 ? 7u : 8u;
+    ProbeUpdater updater(*context_, s, g, o);
+    updater.update();
+    updater.update();
+    results[run].assign(updater.probes(), updater.probes() + g.count() * 27);
+  }
+  EXPECT_EQ(results[0], results[1]);
+  EXPECT_NE(results[0], results[2]);
+  for (float v : results[0]) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST_F(Updater, ProbeInsideClosedWallIsInactive) {
+  // builtin:closed-box: inner room [-1, 1]³, outer shell [-1.2, 1.2]³. A probe between them sees
+  // only back faces; one in the room and one outside see front faces.
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("closed-box", 0.0f, s, error)) << error;
+  ProbeGrid g;
+  g.min = {0.0f, 0.0f, 0.0f};
+  g.max = {1.6f, 0.0f, 0.0f};
+  g.dims = {5, 1, 1};  // x = 0, 0.4, 0.8, 1.2 (on the outer face: skip), 1.6
+  UpdaterOptions o;
+  o.samplesPerProbe = 64;
+  ProbeUpdater updater(*context_, s, g, o);
+  EXPECT_EQ(updater.activeMask()[0], 1);  // room centre
+  EXPECT_EQ(updater.activeMask()[2], 1);  // inside the room near the wall
+  EXPECT_EQ(updater.activeMask()[4], 1);  // outside the box
+  ProbeGrid wall = singleProbe({1.1f, 0.3f, -0.2f});
+  ProbeUpdater inWall(*context_, s, wall, o);
+  EXPECT_EQ(inWall.activeMask()[0], 0);
+  const UpdateStats stats = inWall.update();
+  EXPECT_EQ(stats.paths, 0u);  // inactive probes get no rays
+  for (int i = 0; i < 27; ++i) EXPECT_EQ(inWall.probes()[i], 0.0f);
+}
+
+TEST_F(Updater, MovingLightIsFollowed) {
+  // builtin:cornell with the light moved half a turn: probes converge to the new lighting, and the
+  // probe nearer the new light position brightens.
+  Scene a, b;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, a, error));   // light at +x
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.5f, b, error));   // light at −x
+  ProbeGrid g;
+  g.min = {-0.7f, 1.5f, 0.5f};
+  g.max = {0.7f, 1.5f, 0.5f};
+  g.dims = {2, 1, 1};
+  UpdaterOptions o;
+  o.samplesPerProbe = 256;
+  o.minBlendWeight = 0.5f;
+  ProbeUpdater updater(*context_, a, g, o);
+  for (int u = 0; u < 4; ++u) updater.update();
+  const float leftBefore = updater.probes()[0], rightBefore = updater.probes()[27];
+  EXPECT_GT(rightBefore, leftBefore);
+  updater.setScene(b);
+  for (int u = 0; u < 6; ++u) updater.update();
+  const float leftAfter = updater.probes()[0], rightAfter = updater.probes()[27];
+  EXPECT_GT(leftAfter, rightAfter);
+  EXPECT_GT(leftAfter, leftBefore);
+}
+
+}  // namespace
+}  // namespace probecast::renderer
