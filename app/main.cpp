@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   int exitCode = 0;
   probecast::app::addDemoCommand(app, exitCode);
   probecast::app::addBenchCommands(app, exitCode);
+  probecast::app::addBakeCommand(app, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "codec_fuzz_common.h"
+#include "probecast/codec/probe_file.h"
 #include "probecast/codec/record.h"
 
 using namespace probecast;
@@ -27,6 +28,15 @@ bool finite(const float* v, size_t n) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const uint8_t control = data[0];
+  if (control & 0x40u) {  // probe volume files
+    ProbeVolume volume;
+    std::string error;
+    if (parseProbeVolume(data + 1, size - 1, volume, error))
+      require(volume.probes.size() == static_cast<size_t>(volume.count()) * 27 && volume.active.size() == volume.count());
+    else
+      require(!error.empty());
+    return 0;
+  }
   const Representation repr = kAllRepresentations[(control & 7u) % 5u];
   const uint8_t mode = (control >> 3) & 3u;
   std::vector<uint8_t> body(data + 1, data + size);

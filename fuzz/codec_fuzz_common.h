@@ -13,6 +13,7 @@ namespace probecast::fuzz {
 //   mode 0: a frame for a fresh decoder; mode 1: a frame for a decoder holding the base keyframe
 //   (checksums repaired first when bit 5 is set, so the payload parsers see the bytes);
 //   mode 2: record bytes; mode 3: floats for the encoder (round trip must be bit-exact).
+//   bit 6 set: the rest is a probe volume file (probe_file.h) instead.
 enum Mode : uint8_t { kFrameFresh = 0, kFrameOnBase = 1, kRecord = 2, kEncodeFloats = 3 };
 constexpr uint8_t kRepairFlag = 1u << 5;
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "codec_fuzz_common.h"
+#include "probecast/codec/probe_file.h"
 #include "probecast/codec/record.h"
 
 using namespace probecast;
@@ -52,5 +53,14 @@ int main(int argc, char** argv) {
     }
     write(dir, name + "-floats", control(fuzz::kEncodeFloats, false), raw);
   }
+  ProbeVolume volume;
+  volume.dims[0] = 2;
+  volume.dims[1] = 1;
+  volume.dims[2] = 2;
+  volume.probes.assign(4 * 27, 0.5f);
+  volume.active = {1, 0, 1, 1};
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(volume, bytes);
+  write(dir, "probe-volume", 0x40, bytes);
   return 0;
 }

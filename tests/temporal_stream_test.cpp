@@ -296,3 +296,48 @@ TEST(Stream, RejectsLayoutMismatchAndDuplicates) {
 
 }  // namespace
 }  // namespace probecast
+
+#include "probecast/codec/probe_file.h"
+
+namespace probecast {
+namespace {
+
+TEST(ProbeFile, RoundTripAndRejections) {
+  ProbeVolume v;
+  v.dims[0] = 3;
+  v.dims[1] = 2;
+  v.dims[2] = 1;
+  v.boundsMin[0] = -1;
+  v.boundsMax[0] = 1;
+  v.updates = 4;
+  v.samplesPerProbe = 128;
+  v.probes.resize(6 * 27);
+  for (size_t i = 0; i < v.probes.size(); ++i) v.probes[i] = 0.1f * static_cast<float>(i);
+  v.active = {1, 1, 0, 1, 1, 1};
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(v, bytes);
+  ProbeVolume back;
+  std::string error;
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_EQ(back.probes, v.probes);
+  EXPECT_EQ(back.active, v.active);
+  EXPECT_EQ(back.samplesPerProbe, 128u);
+  // Every truncation and every single-byte corruption is rejected with a reason.
+  for (size_t len = 0; len < bytes.size(); ++len) {
+    EXPECT_FALSE(parseProbeVolume(bytes.data(), len, back, error)) << len;
+    EXPECT_FALSE(error.empty());
+  }
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    std::vector<uint8_t> bad = bytes;
+    bad[i] ^= 0x20;
+    EXPECT_FALSE(parseProbeVolume(bad.data(), bad.size(), back, error)) << i;
+  }
+  // NaN radiance is refused even with a valid checksum.
+  v.probes[5] = std::nanf("");
+  serializeProbeVolume(v, bytes);
+  EXPECT_FALSE(parseProbeVolume(bytes.data(), bytes.size(), back, error));
+  EXPECT_NE(error.find("NaN"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace probecast

@@ -1,0 +1,58 @@
+// `probecast bake`: trace a probe grid with the Vulkan updater and write a probe volume file.
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "probecast/codec/probe_file.h"
+#include "probecast/renderer/probe_updater.h"
+#include "scene_options.h"
+
+namespace probecast::app {
+
+void addBakeCommand(CLI::App& app, int& exitCode) {
+  CLI::App* bake = app.add_subcommand("bake", "path-trace a probe grid and write it (float SH + active mask)");
+  auto scene = std::make_shared<SceneOptions>();
+  auto gpu = std::make_shared<GpuOptions>();
+  auto grid = std::make_shared<GridOptions>();
+  auto tracer = std::make_shared<TracerOptions>();
+  auto out = std::make_shared<std::string>();
+  auto updates = std::make_shared<uint32_t>(4);
+  scene->add(bake);
+  gpu->add(bake);
+  grid->add(bake);
+  tracer->add(bake);
+  bake->add_option("--updates", *updates, "updates to accumulate")->check(CLI::Range(1, 100000));
+  bake->add_option("--out", *out, "probe volume file to write")->required();
+  bake->callback([=, &exitCode] {
+    const scene::Scene s = scene->load();
+    renderer::VulkanContext context(gpu->context());
+    const renderer::ProbeGrid g = grid->resolve(s);
+    renderer::ProbeUpdater updater(context, s, g, tracer->options());
+    fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe\n", s.name, s.triangleCount(),
+               context.deviceName(), g.dims.x, g.dims.y, g.dims.z, tracer->spp);
+    uint32_t active = 0;
+    for (uint32_t p = 0; p < g.count(); ++p) active += updater.activeMask()[p];
+    fmt::print("bake: {} of {} probes active ({} inside geometry)\n", active, g.count(), g.count() - active);
+    for (uint32_t u = 0; u < *updates; ++u) {
+      const renderer::UpdateStats st = updater.update();
+      fmt::print("bake: update {}/{}: {:.1f} ms, {} paths\n", u + 1, *updates, st.milliseconds, st.paths);
+    }
+    ProbeVolume volume;
+    for (int a = 0; a < 3; ++a) {
+      volume.dims[a] = g.dims[a];
+      volume.boundsMin[a] = g.min[a];
+      volume.boundsMax[a] = g.max[a];
+    }
+    volume.updates = *updates;
+    volume.samplesPerProbe = tracer->spp;
+    volume.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
+    volume.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+    std::string error;
+    if (!writeProbeFile(*out, volume, error)) throw std::runtime_error(error);
+    if (context.validationMessages() > 0)
+      fmt::print(stderr, "bake: {} Vulkan validation messages\n", context.validationMessages());
+    fmt::print("wrote {}\n", *out);
+    exitCode = 0;
+  });
+}
+
+}  // namespace probecast::app

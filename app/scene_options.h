@@ -1,0 +1,98 @@
+// Options shared by the commands that load a scene, trace probes or use Vulkan.
+#pragma once
+
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "probecast/renderer/probe_updater.h"
+#include "probecast/scene/scene.h"
+
+namespace probecast::app {
+
+struct SceneOptions {
+  std::string scene = "builtin:cornell";
+  float t = 0.0f;
+  void add(CLI::App* cmd) {
+    cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box)");
+    cmd->add_option("--t", t, "animation parameter of built-in scenes")->check(CLI::Range(0.0f, 1.0f));
+  }
+  scene::Scene load() const {
+    scene::Scene s;
+    std::string error;
+    if (!scene::loadScene(scene, t, s, error)) throw std::runtime_error(error);
+    return s;
+  }
+};
+
+struct GpuOptions {
+  bool gpu = false;
+  bool validation = false;
+  void add(CLI::App* cmd) {
+    cmd->add_flag("--gpu", gpu, "prefer a GPU over lavapipe when one is present");
+    cmd->add_flag("--validation", validation, "enable the Vulkan validation layer");
+  }
+  renderer::ContextOptions context() const {
+    renderer::ContextOptions o;
+    o.preferGpu = gpu;
+    o.validation = validation;
+    return o;
+  }
+};
+
+struct GridOptions {
+  std::vector<uint32_t> dims{8, 8, 8};
+  std::vector<float> bounds;  // empty: cell-centred in the scene bounds
+  void add(CLI::App* cmd) {
+    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(1, 1024));
+    cmd->add_option("--bounds", bounds, "minX,minY,minZ,maxX,maxY,maxZ of the first and last probe (metres)")
+        ->delimiter(',')
+        ->expected(6);
+  }
+  renderer::ProbeGrid resolve(const scene::Scene& s) const {
+    renderer::ProbeGrid g;
+    g.dims = {dims[0], dims[1], dims[2]};
+    if (static_cast<uint64_t>(dims[0]) * dims[1] * dims[2] > (1u << 24)) throw std::runtime_error("grid too large");
+    if (bounds.size() == 6) {
+      g.min = {bounds[0], bounds[1], bounds[2]};
+      g.max = {bounds[3], bounds[4], bounds[5]};
+      for (float b : bounds)
+        if (!std::isfinite(b)) throw std::runtime_error("--bounds must be finite");
+    } else {  // probes at the centres of the grid's cells over the scene bounds
+      const glm::vec3 extent = s.boundsMax - s.boundsMin;
+      const glm::vec3 cell = extent / glm::vec3(g.dims);
+      g.min = s.boundsMin + 0.5f * cell;
+      g.max = s.boundsMax - 0.5f * cell;
+    }
+    return g;
+  }
+};
+
+struct TracerOptions {
+  uint32_t spp = 128;
+  uint32_t bounces = 4;
+  uint32_t seed = 1;
+  float wMin = 0.05f;
+  float clamp = 16.0f;
+  void add(CLI::App* cmd) {
+    cmd->add_option("--spp", spp, "samples (paths) per probe per update")->check(CLI::Range(1, 1 << 16));
+    cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
+    cmd->add_option("--seed", seed, "random seed (same seed, same result)");
+    cmd->add_option("--w-min", wMin, "minimum temporal blend weight")->check(CLI::Range(0.0f, 1.0f));
+    cmd->add_option("--clamp", clamp, "max luminance of an indirect contribution (0 = off)")->check(CLI::Range(0.0f, 1e9f));
+  }
+  renderer::UpdaterOptions options() const {
+    renderer::UpdaterOptions o;
+    o.samplesPerProbe = spp;
+    o.maxBounces = bounces;
+    o.seed = seed;
+    o.minBlendWeight = wMin;
+    o.indirectClamp = clamp;
+    return o;
+  }
+};
+
+}  // namespace probecast::app

@@ -1,0 +1,101 @@
+// Probe volume files (probe_file.h).
+#include "probecast/codec/probe_file.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "byte_io.h"
+#include "crc32c.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast {
+namespace {
+
+constexpr uint8_t kMagic[4] = {'P', 'C', 'P', 'V'};
+constexpr uint32_t kVersion = 1;
+constexpr size_t kHeaderBytes = 4 + 4 + 12 + 24 + 8;
+
+void putF32(std::vector<uint8_t>& out, float v) {
+  uint32_t bits;
+  std::memcpy(&bits, &v, 4);
+  putU32(out, bits);
+}
+float getF32(const uint8_t* p) {
+  const uint32_t bits = getU32(p);
+  float v;
+  std::memcpy(&v, &bits, 4);
+  return v;
+}
+
+}  // namespace
+
+void serializeProbeVolume(const ProbeVolume& v, std::vector<uint8_t>& out) {
+  out.assign(std::begin(kMagic), std::end(kMagic));
+  out.reserve(kHeaderBytes + v.probes.size() * 4 + v.active.size() + 4);
+  putU32(out, kVersion);
+  for (uint32_t d : v.dims) putU32(out, d);
+  for (float f : v.boundsMin) putF32(out, f);
+  for (float f : v.boundsMax) putF32(out, f);
+  putU32(out, v.updates);
+  putU32(out, v.samplesPerProbe);
+  for (float f : v.probes) putF32(out, f);
+  out.insert(out.end(), v.active.begin(), v.active.end());
+  putU32(out, crc32c(out.data(), out.size()));
+}
+
+bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::string& error) {
+  if (size < kHeaderBytes + 4) return error = "truncated probe file header", false;
+  if (std::memcmp(data, kMagic, 4) != 0) return error = "not a probecast probe file (bad magic)", false;
+  if (getU32(data + 4) != kVersion) return error = "unsupported probe file version " + std::to_string(getU32(data + 4)), false;
+  ProbeVolume out;
+  uint64_t count = 1;
+  for (int a = 0; a < 3; ++a) {
+    out.dims[a] = getU32(data + 8 + 4 * a);
+    if (out.dims[a] < 1 || out.dims[a] > kMaxGridDim) return error = "probe grid dimension out of range", false;
+    count *= out.dims[a];
+  }
+  if (count > kMaxProbes) return error = "probe grid too large", false;
+  for (int a = 0; a < 3; ++a) {
+    out.boundsMin[a] = getF32(data + 20 + 4 * a);
+    out.boundsMax[a] = getF32(data + 32 + 4 * a);
+    if (!std::isfinite(out.boundsMin[a]) || !std::isfinite(out.boundsMax[a])) return error = "non-finite bounds", false;
+  }
+  out.updates = getU32(data + 44);
+  out.samplesPerProbe = getU32(data + 48);
+  const uint64_t expected = kHeaderBytes + count * 27 * 4 + count + 4;
+  if (size != expected)
+    return error = "probe file is " + std::to_string(size) + " bytes, expected " + std::to_string(expected), false;
+  if (crc32c(data, size - 4) != getU32(data + size - 4)) return error = "probe file checksum mismatch", false;
+  out.probes.resize(count * 27);
+  const uint8_t* p = data + kHeaderBytes;
+  for (size_t i = 0; i < out.probes.size(); ++i) {
+    out.probes[i] = getF32(p + 4 * i);
+    if (!std::isfinite(out.probes[i])) return error = "probe " + std::to_string(i / 27) + " holds NaN or Inf", false;
+  }
+  out.active.assign(p + count * 27 * 4, p + count * 27 * 4 + count);
+  for (uint8_t a : out.active)
+    if (a > 1) return error = "active mask holds a value other than 0 or 1", false;
+  v = std::move(out);
+  return true;
+}
+
+bool writeProbeFile(const std::string& path, const ProbeVolume& volume, std::string& error) {
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(volume, bytes);
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  if (!out) return error = path + ": cannot write", false;
+  return true;
+}
+
+bool readProbeFile(const std::string& path, ProbeVolume& volume, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return error = path + ": cannot open", false;
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!parseProbeVolume(bytes.data(), bytes.size(), volume, error)) return error = path + ": " + error, false;
+  return true;
+}
+
+}  // namespace probecast
