@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   probecast::app::addDemoCommand(app, exitCode);
   probecast::app::addBenchCommands(app, exitCode);
   probecast::app::addBakeCommand(app, exitCode);
+  probecast::app::addReferenceCommand(app, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

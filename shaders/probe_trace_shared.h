@@ -61,7 +61,26 @@ struct PtPushConstants {
   float indirectClamp;      // max luminance of one indirect contribution; 0 = off
 };
 
+// The reference camera (reference_camera.rgen): a pinhole camera, one invocation per pixel,
+// adding samplesPerPixel path samples per dispatch into an RGBA float accumulation buffer bound
+// at PT_BINDING_PARTIALS.
+struct PtCameraPushConstants {
+  vec4 position;            // xyz camera position (metres)
+  vec4 forward;             // xyz unit view direction, w = tan(yfov / 2)
+  vec4 right;               // xyz unit, w = width / height
+  vec4 up;                  // xyz unit
+  uint width;
+  uint height;
+  uint samplesPerPixel;     // this dispatch
+  uint seed;
+  uint dispatchIndex;
+  uint lightCount;
+  uint maxBounces;
+  float indirectClamp;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(PtCameraPushConstants) == 96);
 static_assert(sizeof(PtMaterial) == 32);
 static_assert(sizeof(PtLight) == 64);
 static_assert(sizeof(PtPushConstants) == 96);

@@ -8,13 +8,13 @@
 #include <numeric>
 #include <random>
 
-#include "probe_trace_pass.h"
+#include "probe_trace.rgen.h"
+#include "gpu_scene.h"
+#include "vk_raytracing.h"
 
 namespace probecast::renderer {
 namespace {
 
-using shaders::PtLight;
-using shaders::PtMaterial;
 using shaders::PtPushConstants;
 
 constexpr uint32_t kLanes = PT_LANES_PER_PROBE;
@@ -108,32 +108,9 @@ struct ProbeUpdater::Impl {
   std::vector<glm::vec3> geometryPositions;
   std::vector<uint32_t> geometryIndices;
 
-  ProbeTracePass pass;
-  SceneAccel accel;
-  Buffer triangleMaterial, materials, lights, directions, classifyDirections, probeList, partials;
-  uint32_t lightCount = 0;
-
-  void uploadShading(const scene::Scene& s) {
-    destroyBuffer(*d, triangleMaterial);
-    destroyBuffer(*d, materials);
-    destroyBuffer(*d, lights);
-    triangleMaterial = createBufferWithData(*d, s.triangleMaterial.data(), s.triangleMaterial.size() * 4, kStorage);
-    std::vector<PtMaterial> mats;
-    for (const scene::Material& m : s.materials)
-      mats.push_back({{m.baseColor.r, m.baseColor.g, m.baseColor.b, m.metallic},
-                      {m.emission.r, m.emission.g, m.emission.b, m.roughness}});
-    materials = createBufferWithData(*d, mats.data(), mats.size() * sizeof(PtMaterial), kStorage);
-    std::vector<PtLight> ls;
-    for (const scene::Light& l : s.lights) {
-      const glm::vec3 dir = glm::length(l.direction) > 0 ? glm::normalize(l.direction) : glm::vec3(0, -1, 0);
-      ls.push_back({{l.position.x, l.position.y, l.position.z, static_cast<float>(static_cast<uint32_t>(l.type))},
-                    {dir.x, dir.y, dir.z, l.range},
-                    {l.color.r, l.color.g, l.color.b, l.intensity},
-                    {std::cos(l.outerConeAngle), std::cos(l.innerConeAngle), 0.0f, 0.0f}});
-    }
-    lights = createBufferWithData(*d, ls.data(), ls.size() * sizeof(PtLight), kStorage);
-    lightCount = static_cast<uint32_t>(ls.size());
-  }
+  RayTracingPass pass;
+  GpuScene gpu;
+  Buffer directions, classifyDirections, probeList, partials;
 
   void uploadProbeList(const std::vector<uint32_t>& list) {
     destroyBuffer(*d, probeList);
@@ -154,14 +131,15 @@ struct ProbeUpdater::Impl {
     push.rotation = rotation;
     push.sampleCount = sampleCount;
     push.probeCount = count;
-    push.lightCount = lightCount;
+    push.lightCount = gpu.lightCount;
     push.maxBounces = std::clamp<uint32_t>(options.maxBounces, 1, PT_MAX_BOUNCES_LIMIT);
     push.seed = options.seed;
     push.updateIndex = updates;
     push.mode = mode;
     push.indirectClamp = options.indirectClamp;
-    const ProbeTraceInputs in{&accel, &triangleMaterial, &materials, &lights, &dirs, &probeList, &partials};
-    runProbeTracePass(*d, pass, in, push);
+    const RayTracingInputs in{&gpu.accel, &gpu.triangleMaterial, &gpu.materials, &gpu.lights, &dirs, &probeList,
+                             &partials};
+    runRayTracingPass(*d, pass, in, &push, kLanes, count);
   }
 
   void classify() {
@@ -188,8 +166,7 @@ struct ProbeUpdater::Impl {
   }
 
   void setGeometry(const scene::Scene& s) {
-    if (accel.tlas.handle) destroySceneAccel(*d, accel);
-    buildSceneAccel(*d, s, accel);
+    uploadGpuScene(*d, s, gpu);
     geometryPositions = s.positions;
     geometryIndices = s.indices;
   }
@@ -208,32 +185,33 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   s.probes.assign(static_cast<size_t>(grid.count()) * 27, 0.0f);
   s.active.assign(grid.count(), 1);
   s.blendCount.assign(grid.count(), 0);
-  createProbeTracePass(*s.d, s.pass);
+  createRayTracingPass(*s.d, kProbeTraceRgen, sizeof kProbeTraceRgen, sizeof(PtPushConstants), s.pass);
   const auto dirs = coherentFibonacci(s.samples);
   s.directions = createBufferWithData(*s.d, dirs.data(), dirs.size() * sizeof(shaders::vec4), kStorage);
   const auto cdirs = coherentFibonacci(roundUpLanes(options.classifySamples));
   s.classifyDirections = createBufferWithData(*s.d, cdirs.data(), cdirs.size() * sizeof(shaders::vec4), kStorage);
   s.setGeometry(scene);
-  s.uploadShading(scene);
   s.classify();
 }
 
 ProbeUpdater::~ProbeUpdater() {
   Impl& s = *impl_;
-  destroySceneAccel(*s.d, s.accel);
-  for (Buffer* b : {&s.triangleMaterial, &s.materials, &s.lights, &s.directions, &s.classifyDirections, &s.probeList,
-                    &s.partials})
+  destroyGpuScene(*s.d, s.gpu);
+  for (Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials})
     destroyBuffer(*s.d, *b);
-  destroyProbeTracePass(*s.d, s.pass);
+  destroyRayTracingPass(*s.d, s.pass);
 }
 
 void ProbeUpdater::setScene(const scene::Scene& scene) {
   Impl& s = *impl_;
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   const bool geometryChanged = scene.positions != s.geometryPositions || scene.indices != s.geometryIndices;
-  if (geometryChanged) s.setGeometry(scene);
-  s.uploadShading(scene);
-  if (geometryChanged) s.classify();
+  if (geometryChanged) {
+    s.setGeometry(scene);
+    s.classify();
+  } else {
+    uploadGpuShading(*s.d, scene, s.gpu);
+  }
 }
 
 UpdateStats ProbeUpdater::update() {

@@ -1,11 +1,10 @@
-#include "probe_trace_pass.h"
+#include "vk_raytracing.h"
 
 #include <cstring>
 #include <vector>
 
 #include "probe_shadow.rmiss.h"
 #include "probe_trace.rchit.h"
-#include "probe_trace.rgen.h"
 #include "probe_trace.rmiss.h"
 
 namespace probecast::renderer {
@@ -24,7 +23,9 @@ VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * 
 
 }  // namespace
 
-void createProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
+void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygenBytes, uint32_t pushBytes,
+                         RayTracingPass& pass) {
+  pass.pushBytes = pushBytes;
   std::vector<VkDescriptorSetLayoutBinding> bindings;
   for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b) {
     VkDescriptorSetLayoutBinding binding{};
@@ -32,7 +33,7 @@ void createProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
     binding.descriptorType = b == PT_BINDING_TLAS ? VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR
                                                   : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     binding.descriptorCount = 1;
-    binding.stageFlags = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+    binding.stageFlags = VK_SHADER_STAGE_RAYGEN_BIT_KHR;  // only raygen reads the scene
     bindings.push_back(binding);
   }
   VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
@@ -40,7 +41,7 @@ void createProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
   lci.pBindings = bindings.data();
   VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &pass.setLayout));
 
-  VkPushConstantRange range{VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, sizeof(shaders::PtPushConstants)};
+  VkPushConstantRange range{VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, pushBytes};
   VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   pli.setLayoutCount = 1;
   pli.pSetLayouts = &pass.setLayout;
@@ -49,7 +50,7 @@ void createProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
   VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &pass.layout));
 
   const VkShaderModule modules[4] = {
-      createModule(d, kProbeTraceRgen, sizeof kProbeTraceRgen),
+      createModule(d, raygen, raygenBytes),
       createModule(d, kProbeTraceRmiss, sizeof kProbeTraceRmiss),
       createModule(d, kProbeShadowRmiss, sizeof kProbeShadowRmiss),
       createModule(d, kProbeTraceRchit, sizeof kProbeTraceRchit),
@@ -115,17 +116,17 @@ void createProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
   VK_CHECK(vkAllocateDescriptorSets(d.device, &dai, &pass.set));
 }
 
-void destroyProbeTracePass(VulkanDevice& d, ProbeTracePass& pass) {
+void destroyRayTracingPass(VulkanDevice& d, RayTracingPass& pass) {
   destroyBuffer(d, pass.sbt);
   if (pass.pool) vkDestroyDescriptorPool(d.device, pass.pool, nullptr);
   if (pass.pipeline) vkDestroyPipeline(d.device, pass.pipeline, nullptr);
   if (pass.layout) vkDestroyPipelineLayout(d.device, pass.layout, nullptr);
   if (pass.setLayout) vkDestroyDescriptorSetLayout(d.device, pass.setLayout, nullptr);
-  pass = ProbeTracePass{};
+  pass = RayTracingPass{};
 }
 
-void runProbeTracePass(VulkanDevice& d, ProbeTracePass& pass, const ProbeTraceInputs& in,
-                       const shaders::PtPushConstants& push) {
+void runRayTracingPass(VulkanDevice& d, RayTracingPass& pass, const RayTracingInputs& in, const void* push,
+                       uint32_t width, uint32_t height) {
   VkWriteDescriptorSetAccelerationStructureKHR asWrite{
       VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
   asWrite.accelerationStructureCount = 1;
@@ -153,9 +154,9 @@ void runProbeTracePass(VulkanDevice& d, ProbeTracePass& pass, const ProbeTraceIn
   submitAndWait(d, [&](VkCommandBuffer cmd) {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pass.pipeline);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pass.layout, 0, 1, &pass.set, 0, nullptr);
-    vkCmdPushConstants(cmd, pass.layout, VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, sizeof push, &push);
-    d.vkCmdTraceRaysKHR(cmd, &pass.raygen, &pass.miss, &pass.hit, &pass.callable, PT_LANES_PER_PROBE, push.probeCount, 1);
-    // Make the shader writes visible to the host reading the mapped partials.
+    vkCmdPushConstants(cmd, pass.layout, VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, pass.pushBytes, push);
+    d.vkCmdTraceRaysKHR(cmd, &pass.raygen, &pass.miss, &pass.hit, &pass.callable, width, height, 1);
+    // Make the shader writes visible to the host reading mapped buffers.
     VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
     barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;

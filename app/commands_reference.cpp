@@ -1,0 +1,72 @@
+// `probecast render-reference`: ground-truth camera path tracing to EXR.
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "image_io.h"
+#include "probecast/renderer/reference_camera.h"
+#include "scene_options.h"
+
+namespace probecast::app {
+
+void addReferenceCommand(CLI::App& app, int& exitCode) {
+  CLI::App* cmd = app.add_subcommand("render-reference", "ground-truth camera path tracer (EXR out)");
+  auto scene = std::make_shared<SceneOptions>();
+  auto gpu = std::make_shared<GpuOptions>();
+  struct Options {
+    std::vector<uint32_t> size{320, 240};
+    uint32_t spp = 256, bounces = 8, seed = 1;
+    std::vector<float> eye, target;
+    float yfovDeg = 0.0f;
+    std::string out, png;
+  };
+  auto o = std::make_shared<Options>();
+  scene->add(cmd);
+  gpu->add(cmd);
+  cmd->add_option("--size", o->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
+  cmd->add_option("--spp", o->spp, "samples per pixel")->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--bounces", o->bounces, "surface interactions per path")->check(CLI::Range(1, 16));
+  cmd->add_option("--seed", o->seed, "random seed");
+  cmd->add_option("--eye", o->eye, "camera position X,Y,Z (default: the scene's camera)")->delimiter(',')->expected(3);
+  cmd->add_option("--target", o->target, "point the camera looks at X,Y,Z")->delimiter(',')->expected(3);
+  cmd->add_option("--yfov", o->yfovDeg, "vertical field of view, degrees")->check(CLI::Range(1.0f, 179.0f));
+  cmd->add_option("--out", o->out, "EXR file to write (linear radiance)")->required();
+  cmd->add_option("--png", o->png, "also write a gamma-2.2 PNG preview");
+  cmd->callback([=, &exitCode] {
+    const scene::Scene s = scene->load();
+    renderer::CameraView camera = renderer::CameraView::fromScene(s);
+    if (o->eye.size() == 3) camera.position = {o->eye[0], o->eye[1], o->eye[2]};
+    if (o->target.size() == 3) {
+      const glm::vec3 dir = glm::vec3(o->target[0], o->target[1], o->target[2]) - camera.position;
+      if (glm::length(dir) <= 0.0f) throw std::runtime_error("--target equals the camera position");
+      camera.forward = glm::normalize(dir);
+      if (std::fabs(glm::dot(camera.forward, camera.up)) > 0.999f) camera.up = glm::vec3(0, 0, -1);
+    }
+    if (o->yfovDeg > 0) camera.yfov = glm::radians(o->yfovDeg);
+    renderer::VulkanContext context(gpu->context());
+    renderer::ReferenceOptions ro;
+    ro.width = o->size[0];
+    ro.height = o->size[1];
+    ro.samplesPerPixel = o->spp;
+    ro.maxBounces = o->bounces;
+    ro.seed = o->seed;
+    ro.progress = [](uint32_t done, uint32_t total) {
+      fmt::print(stderr, "\rrender-reference: {}/{} spp ({:.0f}%)", done, total, 100.0 * done / total);
+      if (done == total) fmt::print(stderr, "\n");
+    };
+    fmt::print("render-reference: {} on {}, {}x{}, {} spp\n", s.name, context.deviceName(), ro.width, ro.height, ro.samplesPerPixel);
+    const renderer::Image image = renderer::renderReference(context, s, camera, ro);
+    std::string error;
+    if (!bench::writeExr(o->out, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), error))
+      throw std::runtime_error(error);
+    fmt::print("wrote {}\n", o->out);
+    if (!o->png.empty()) {
+      if (!bench::writePngPreview(o->png, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), 1.0f,
+                                  error))
+        throw std::runtime_error(error);
+      fmt::print("wrote {}\n", o->png);
+    }
+    exitCode = 0;
+  });
+}
+
+}  // namespace probecast::app

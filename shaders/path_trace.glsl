@@ -1,0 +1,150 @@
+// The path loop shared by the probe tracer and the reference camera: emission, next-event
+// estimation to punctual lights, Lambert + GGX sampling, Russian roulette, bounce limit, clamp.
+// The including raygen declares the bindings, the payloads `hit` (location 0) and `visible`
+// (location 1), and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES and PATH_INDIRECT_CLAMP.
+const float PI = 3.14159265358979;
+const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+
+uint pcg(uint v) {
+  uint state = v * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+float rnd(inout uint s) {
+  s = pcg(s);
+  return float(s >> 8) * (1.0 / 16777216.0);
+}
+
+vec3 vertexPosition(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
+
+void onb(vec3 n, out vec3 t, out vec3 b) {
+  float s = n.z >= 0.0 ? 1.0 : -1.0;
+  float a = -1.0 / (s + n.z);
+  float c = n.x * n.y * a;
+  t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
+  b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+// Lambert + GGX (Cook-Torrance, Smith-Schlick G, Schlick F), metallic-roughness as glTF.
+vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) {
+  float nl = dot(n, wi), nv = dot(n, wo);
+  if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
+  vec3 h = normalize(wo + wi);
+  float nh = max(dot(n, h), 0.0), vh = max(dot(wo, h), 0.0);
+  float a2 = alpha * alpha;
+  float d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+  float k = alpha * 0.5;
+  float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
+  vec3 f0 = mix(vec3(0.04), base, metallic);
+  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
+  vec3 spec = d * g * f / max(4.0 * nl * nv, 1e-6);
+  vec3 diffuse = base * (1.0 - metallic) / PI;
+  return diffuse + spec;
+}
+
+float pdfBsdf(vec3 n, vec3 wo, vec3 wi, float alpha, float specProb) {
+  float nl = dot(n, wi);
+  if (nl <= 0.0) return 0.0;
+  vec3 h = normalize(wo + wi);
+  float nh = max(dot(n, h), 0.0), vh = max(dot(wo, h), 1e-6);
+  float a2 = alpha * alpha;
+  float d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+  return specProb * d * nh / (4.0 * vh) + (1.0 - specProb) * nl / PI;
+}
+
+// Samples the one-sample mixture of cosine-weighted diffuse and GGX half-vector lobes.
+vec3 sampleBsdf(vec3 n, vec3 wo, float alpha, float specProb, inout uint rng) {
+  vec3 t, b;
+  onb(n, t, b);
+  float u1 = rnd(rng), u2 = rnd(rng), u3 = rnd(rng);
+  if (u1 < specProb) {
+    float a2 = alpha * alpha;
+    float cosT = sqrt((1.0 - u2) / (1.0 + (a2 - 1.0) * u2));
+    float sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
+    float phi = 2.0 * PI * u3;
+    vec3 h = normalize(t * (sinT * cos(phi)) + b * (sinT * sin(phi)) + n * cosT);
+    return reflect(-wo, h);
+  }
+  float r = sqrt(u2), phi = 2.0 * PI * u3;
+  return normalize(t * (r * cos(phi)) + b * (r * sin(phi)) + n * sqrt(max(0.0, 1.0 - u2)));
+}
+
+bool unoccluded(vec3 origin, vec3 dir, float tmax) {
+  visible = 0u;
+  traceRayEXT(tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT,
+              0xFF, 0, 0, 1, origin, 0.0, dir, tmax, 1);
+  return visible != 0u;
+}
+
+// Radiance of punctual lights arriving at p along wi, times the cosine, via a shadow ray.
+vec3 directLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alpha) {
+  vec3 sum = vec3(0.0);
+  for (uint i = 0u; i < PATH_LIGHT_COUNT; ++i) {
+    PtLight l = lights[i];
+    uint type = uint(l.positionType.w);
+    vec3 wi;
+    float dist;
+    vec3 e = l.colorIntensity.rgb * l.colorIntensity.a;
+    if (type == PT_LIGHT_DIRECTIONAL) {
+      wi = -l.directionRange.xyz;
+      dist = 1e30;
+    } else {
+      vec3 toLight = l.positionType.xyz - p;
+      float d2 = max(dot(toLight, toLight), 1e-8);
+      dist = sqrt(d2);
+      wi = toLight / dist;
+      e /= d2;
+      float range = l.directionRange.w;
+      if (range > 0.0) e *= pow(clamp(1.0 - pow(dist / range, 4.0), 0.0, 1.0), 2.0);
+      if (type == PT_LIGHT_SPOT) e *= smoothstep(l.cone.x, l.cone.y, dot(-wi, l.directionRange.xyz));
+    }
+    float cosine = dot(n, wi);
+    if (cosine <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
+    vec3 origin = p + n * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+    if (unoccluded(origin, wi, dist * (1.0 - 1e-4))) sum += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e;
+  }
+  return sum;
+}
+
+vec3 clampIndirect(vec3 c, uint bounce) {
+  if (bounce == 0u || PATH_INDIRECT_CLAMP <= 0.0) return c;
+  float lum = dot(c, LUMA);
+  return lum > PATH_INDIRECT_CLAMP ? c * (PATH_INDIRECT_CLAMP / lum) : c;
+}
+
+vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
+  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  for (uint bounce = 0u; bounce < PATH_MAX_BOUNCES; ++bounce) {
+    traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, origin, 0.0, dir, 1e30, 0);
+    if (hit.t < 0.0) break;  // the environment is black
+    uint tri = hit.primitive;
+    vec3 p0 = vertexPosition(indices[3 * tri]), p1 = vertexPosition(indices[3 * tri + 1]),
+         p2 = vertexPosition(indices[3 * tri + 2]);
+    vec3 ng = normalize(cross(p1 - p0, p2 - p0));
+    PtMaterial m = materials[triangleMaterial[tri]];
+    vec3 p = origin + dir * hit.t;
+    if (hit.backFace == 0u) radiance += clampIndirect(throughput * m.emissionRoughness.rgb, bounce);
+    vec3 n = dot(ng, dir) < 0.0 ? ng : -ng;  // two-sided shading
+    vec3 wo = -dir;
+    vec3 base = m.baseColorMetallic.rgb;
+    float metallic = m.baseColorMetallic.a;
+    float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
+    radiance += clampIndirect(throughput * directLight(p, n, wo, base, metallic, alpha), bounce);
+    if (bounce + 1u >= PATH_MAX_BOUNCES) break;
+    float specProb = mix(0.2, 0.9, metallic);
+    vec3 wi = sampleBsdf(n, wo, alpha, specProb, rng);
+    float pdf = pdfBsdf(n, wo, wi, alpha, specProb);
+    if (pdf <= 1e-8) break;
+    throughput *= evalBsdf(n, wo, wi, base, metallic, alpha) * dot(n, wi) / pdf;
+    if (bounce >= 2u) {  // Russian roulette
+      float q = clamp(max(throughput.r, max(throughput.g, throughput.b)), 0.05, 0.95);
+      if (rnd(rng) > q) break;
+      throughput /= q;
+    }
+    origin = p + n * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+    dir = wi;
+  }
+  return radiance;
+}
+

@@ -1,0 +1,10 @@
+// Scene bindings shared by every ray-tracing raygen (numbers from probe_trace_shared.h).
+layout(binding = PT_BINDING_TLAS) uniform accelerationStructureEXT tlas;
+layout(std430, binding = PT_BINDING_POSITIONS) readonly buffer Positions { float positions[]; };
+layout(std430, binding = PT_BINDING_INDICES) readonly buffer Indices { uint indices[]; };
+layout(std430, binding = PT_BINDING_TRIANGLE_MATERIAL) readonly buffer TriangleMaterial { uint triangleMaterial[]; };
+layout(std430, binding = PT_BINDING_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
+layout(std430, binding = PT_BINDING_LIGHTS) readonly buffer Lights { PtLight lights[]; };
+
+layout(location = 0) rayPayloadEXT HitPayload hit;
+layout(location = 1) rayPayloadEXT uint visible;
