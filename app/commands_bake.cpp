@@ -34,7 +34,8 @@ void addBakeCommand(CLI::App& app, int& exitCode) {
     fmt::print("bake: {} of {} probes active ({} inside geometry)\n", active, g.count(), g.count() - active);
     for (uint32_t u = 0; u < *updates; ++u) {
       const renderer::UpdateStats st = updater.update();
-      fmt::print("bake: update {}/{}: {:.1f} ms, {} paths\n", u + 1, *updates, st.milliseconds, st.paths);
+      fmt::print("bake: update {}/{}: {:.1f} ms, {} paths, {:.2f} M rays/s\n", u + 1, *updates, st.milliseconds, st.paths,
+                 static_cast<double>(st.closestHitRays + st.shadowRays) / st.milliseconds / 1e3);
     }
     ProbeVolume volume;
     for (int a = 0; a < 3; ++a) {

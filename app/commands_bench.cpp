@@ -8,6 +8,8 @@
 
 #include "codec_bench.h"
 #include "commands.h"
+#include "scene_options.h"
+#include "update_bench.h"
 
 namespace probecast::app {
 namespace {
@@ -93,6 +95,49 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     if (!opt->chart.empty()) {
       writeTextFile(opt->chart, r.svg);
       fmt::print("wrote {}\n", opt->chart);
+    }
+    exitCode = 0;
+  });
+
+  CLI::App* update = bench->add_subcommand("update", "probe updater speed, convergence and flicker");
+  auto scene = std::make_shared<SceneOptions>();
+  auto gpu = std::make_shared<GpuOptions>();
+  auto grid = std::make_shared<GridOptions>();
+  auto tracer = std::make_shared<TracerOptions>();
+  struct UpdateOptions {
+    std::string json, chart;
+    uint32_t updates = 16, referenceSamples = 16384;
+    std::vector<float> wMins{0.02f, 0.05f, 0.1f, 0.25f};
+  };
+  auto uo = std::make_shared<UpdateOptions>();
+  scene->add(update);
+  gpu->add(update);
+  grid->add(update);
+  tracer->add(update);
+  update->add_option("--json", uo->json, "write the results as JSON here")->required();
+  update->add_option("--chart", uo->chart, "write an SVG chart of error against time here");
+  update->add_option("--updates", uo->updates, "updates per run")->check(CLI::Range(2, 10000));
+  update->add_option("--reference-samples", uo->referenceSamples, "samples per probe of the reference")
+      ->check(CLI::Range(1024u, 1u << 24));
+  update->add_option("--w-mins", uo->wMins, "w_min values for the flicker runs")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
+  update->callback([=, &exitCode] {
+    bench::UpdateBenchOptions o;
+    o.scene = scene->load();
+    o.grid = grid->resolve(o.scene);
+    o.updater = tracer->options();
+    o.context = gpu->context();
+    o.updates = uo->updates;
+    o.referenceSamples = uo->referenceSamples;
+    o.minBlendWeights = uo->wMins;
+    o.command = commandLine();
+    o.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    const bench::UpdateBenchResult r = bench::runUpdateBench(o);
+    fmt::print("{}", r.table);
+    writeTextFile(uo->json, r.json.dump(2) + "\n");
+    fmt::print("wrote {}\n", uo->json);
+    if (!uo->chart.empty()) {
+      writeTextFile(uo->chart, r.svg);
+      fmt::print("wrote {}\n", uo->chart);
     }
     exitCode = 0;
   });

@@ -3,6 +3,10 @@
 // The including raygen declares the bindings, the payloads `hit` (location 0) and `visible`
 // (location 1), and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES and PATH_INDIRECT_CLAMP.
 const float PI = 3.14159265358979;
+
+// Rays traced by this invocation (for rays-per-second figures).
+uint gClosestRays = 0u;
+uint gShadowRays = 0u;
 const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
 
 uint pcg(uint v) {
@@ -72,6 +76,7 @@ vec3 sampleBsdf(vec3 n, vec3 wo, float alpha, float specProb, inout uint rng) {
 
 bool unoccluded(vec3 origin, vec3 dir, float tmax) {
   visible = 0u;
+  ++gShadowRays;
   traceRayEXT(tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT,
               0xFF, 0, 0, 1, origin, 0.0, dir, tmax, 1);
   return visible != 0u;
@@ -117,6 +122,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
   for (uint bounce = 0u; bounce < PATH_MAX_BOUNCES; ++bounce) {
     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, origin, 0.0, dir, 1e30, 0);
+    ++gClosestRays;
     if (hit.t < 0.0) break;  // the environment is black
     uint tri = hit.primitive;
     vec3 p0 = vertexPosition(indices[3 * tri]), p1 = vertexPosition(indices[3 * tri + 1]),

@@ -3,7 +3,7 @@
 #define PROBECAST_PROBE_TRACE_SHARED_H
 
 #define PT_LANES_PER_PROBE 32   // invocations per probe; each sums its samples into one partial SH
-#define PT_PARTIAL_FLOATS 28    // 27 SH floats + 1 back-face counter per lane
+#define PT_PARTIAL_FLOATS 30    // 27 SH floats, back-face hits, closest-hit rays, shadow rays per lane
 #define PT_MAX_BOUNCES_LIMIT 16
 
 #define PT_MODE_TRACE 0u        // full paths, projected to SH

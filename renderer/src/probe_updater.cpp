@@ -231,6 +231,8 @@ UpdateStats ProbeUpdater::update() {
       for (uint32_t lane = 0; lane < kLanes; ++lane) {
         const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
         for (int k = 0; k < 27; ++k) sum[k] += src[k];
+        stats.closestHitRays += static_cast<uint64_t>(src[28]);
+        stats.shadowRays += static_cast<uint64_t>(src[29]);
       }
       const uint32_t n = ++s.blendCount[p];
       const float w = std::max(1.0f / static_cast<float>(n), s.options.minBlendWeight);
@@ -252,5 +254,15 @@ uint32_t ProbeUpdater::updates() const { return impl_->updates; }
 const float* ProbeUpdater::probes() const { return impl_->probes.data(); }
 const uint8_t* ProbeUpdater::activeMask() const { return impl_->active.data(); }
 const ProbeGrid& ProbeUpdater::grid() const { return impl_->grid; }
+
+uint64_t ProbeUpdater::deviceBytes() const {
+  const Impl& s = *impl_;
+  uint64_t total = 0;
+  for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.gpu.triangleMaterial,
+                          &s.gpu.materials, &s.gpu.lights, &s.gpu.accel.positions, &s.gpu.accel.indices,
+                          &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.tlas.storage, &s.pass.sbt})
+    total += b->size;
+  return total;
+}
 
 }  // namespace probecast::renderer

@@ -67,17 +67,57 @@ void makeClosedBox(float t, Scene& s) {
   s.lights.push_back(light);
 }
 
+// A closed 20 m × 6 m × 20 m hall: a finely tessellated floor and 4,600 blocks (≈100k triangles in
+// all), four point lights under the ceiling. For performance figures on a realistic triangle count.
+void makeHall(float t, Scene& s) {
+  const uint32_t floorMat = addMaterial(s, "floor", glm::vec3(0.6f, 0.58f, 0.55f));
+  const uint32_t wallMat = addMaterial(s, "wall", glm::vec3(0.75f));
+  const uint32_t blockMat = addMaterial(s, "block", glm::vec3(0.5f, 0.55f, 0.7f));
+  const uint32_t warmMat = addMaterial(s, "warm-block", glm::vec3(0.8f, 0.45f, 0.3f));
+  const float h = 10.0f, top = 6.0f;
+  const int tiles = 150;  // 150 × 150 floor quads = 45,000 triangles
+  for (int i = 0; i < tiles; ++i)
+    for (int k = 0; k < tiles; ++k) {
+      const float x0 = -h + 2 * h * static_cast<float>(i) / tiles, x1 = -h + 2 * h * static_cast<float>(i + 1) / tiles;
+      const float z0 = -h + 2 * h * static_cast<float>(k) / tiles, z1 = -h + 2 * h * static_cast<float>(k + 1) / tiles;
+      addQuad(s, {x0, 0, z1}, {x1, 0, z1}, {x1, 0, z0}, {x0, 0, z0}, floorMat);
+    }
+  addQuad(s, {-h, top, -h}, {h, top, -h}, {h, top, h}, {-h, top, h}, wallMat);
+  addQuad(s, {-h, 0, -h}, {h, 0, -h}, {h, top, -h}, {-h, top, -h}, wallMat);
+  addQuad(s, {h, 0, h}, {-h, 0, h}, {-h, top, h}, {h, top, h}, wallMat);
+  addQuad(s, {-h, 0, h}, {-h, 0, -h}, {-h, top, -h}, {-h, top, h}, wallMat);
+  addQuad(s, {h, 0, -h}, {h, 0, h}, {h, top, h}, {h, top, -h}, wallMat);
+  uint32_t state = 12345u;
+  auto next = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / 16777216.0f;
+  };
+  for (int b = 0; b < 4600; ++b) {
+    const glm::vec3 size(0.05f + 0.15f * next(), 0.1f + 0.9f * next(), 0.05f + 0.15f * next());
+    const glm::vec3 c(-h + 0.5f + (2 * h - 1) * next(), size.y, -h + 0.5f + (2 * h - 1) * next());
+    addBox(s, c, size, 6.2831853f * next(), b % 7 == 0 ? warmMat : blockMat);
+  }
+  for (int k = 0; k < 4; ++k) {
+    Light l;
+    const float a = glm::two_pi<float>() * (t + 0.25f * static_cast<float>(k));
+    l.position = {5.0f * std::cos(a), 5.0f, 5.0f * std::sin(a)};
+    l.intensity = 40.0f;
+    s.lights.push_back(l);
+  }
+}
+
 }  // namespace
 
-std::vector<std::string> builtinSceneNames() { return {"cornell", "closed-box"}; }
+std::vector<std::string> builtinSceneNames() { return {"cornell", "closed-box", "hall"}; }
 
 bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error) {
   scene = Scene{};
   scene.name = "builtin:" + name;
   if (name == "cornell") makeCornell(t, scene);
   else if (name == "closed-box") makeClosedBox(t, scene);
+  else if (name == "hall") makeHall(t, scene);
   else {
-    error = "unknown built-in scene '" + name + "' (have: cornell, closed-box)";
+    error = "unknown built-in scene '" + name + "' (have: cornell, closed-box, hall)";
     return false;
   }
   finalizeScene(scene);

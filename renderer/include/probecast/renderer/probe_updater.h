@@ -40,6 +40,8 @@ struct UpdaterOptions {
 struct UpdateStats {
   double milliseconds = 0.0;
   uint64_t paths = 0;        // primary samples traced
+  uint64_t closestHitRays = 0;  // path segments (rays that need the closest hit)
+  uint64_t shadowRays = 0;      // next-event rays (first hit ends them)
   uint32_t activeProbes = 0;
 };
 
@@ -61,6 +63,9 @@ class ProbeUpdater {
   const float* probes() const;        // 27 floats per probe
   const uint8_t* activeMask() const;  // 1 = active
   const ProbeGrid& grid() const;
+  // Device memory this updater holds (buffers and acceleration structures), bytes: it grows with
+  // the probe count, not with probes × samples.
+  uint64_t deviceBytes() const;
 
  private:
   struct Impl;

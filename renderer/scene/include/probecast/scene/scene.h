@@ -67,6 +67,7 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error);
 // Built-in scenes, generated in code. `t` in [0, 1) is the animation parameter.
 //   cornell     Cornell box (open front), ceiling panel + a point light circling under the ceiling
 //   closed-box  a closed 2 m box lit by a point light, for inside/outside tests
+//   hall        a closed 20 m hall with 4,600 blocks, ≈100k triangles, for performance figures
 std::vector<std::string> builtinSceneNames();
 bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error);
 
