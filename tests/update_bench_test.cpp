@@ -1,0 +1,55 @@
+// bench update on a tiny grid: the fields it promises, convergence, and memory that does not grow
+// with samples.
+#include <gtest/gtest.h>
+
+#include "update_bench.h"
+
+namespace probecast::bench {
+namespace {
+
+TEST(UpdateBench, ReportsConvergingErrorAndRays) {
+  UpdateBenchOptions o;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, o.scene, error));
+  o.grid.min = {-0.7f, 0.8f, -0.7f};
+  o.grid.max = {0.7f, 1.8f, 0.7f};
+  o.grid.dims = {3, 2, 3};
+  o.updater.samplesPerProbe = 128;
+  o.updates = 6;
+  o.referenceSamples = 4096;
+  o.minBlendWeights = {0.25f};
+  o.context.validation = true;
+  const UpdateBenchResult r = runUpdateBench(o);
+  const auto& j = r.json;
+  EXPECT_GT(j["rays_per_s"].get<double>(), 0.0);
+  EXPECT_GT(j["closest_hit_rays_per_s"].get<double>(), 0.0);
+  EXPECT_GT(j["shadow_rays_per_s"].get<double>(), 0.0);
+  EXPECT_GT(j["ms_per_update"].get<double>(), 0.0);
+  const auto errors = j["rmse_rel_after_updates"].get<std::vector<double>>();
+  ASSERT_EQ(errors.size(), 6u);
+  EXPECT_LT(errors.back(), errors.front());  // accumulating more samples approaches the reference
+  ASSERT_EQ(j["flicker_rel"].size(), 1u);
+  EXPECT_GT(j["flicker_rel"][0]["flicker_rel"].get<double>(), 0.0);
+  EXPECT_NE(r.svg.find("<svg"), std::string::npos);
+}
+
+TEST(UpdateBench, DeviceMemoryDoesNotGrowWithSamples) {
+  // Per-lane partial sums instead of a per-sample buffer: going from 64 to 2048 samples per probe
+  // adds only the direction table (16 bytes a sample).
+  renderer::VulkanContext context;
+  scene::Scene s;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  renderer::ProbeGrid g;
+  g.min = {-0.8f, 0.2f, -0.8f};
+  g.max = {0.8f, 1.8f, 0.8f};
+  g.dims = {8, 8, 8};
+  renderer::UpdaterOptions a, b;
+  a.samplesPerProbe = 64;
+  b.samplesPerProbe = 2048;
+  renderer::ProbeUpdater ua(context, s, g, a), ub(context, s, g, b);
+  EXPECT_EQ(ub.deviceBytes() - ua.deviceBytes(), (2048u - 64u) * 16u);
+}
+
+}  // namespace
+}  // namespace probecast::bench
