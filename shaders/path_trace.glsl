@@ -1,7 +1,9 @@
 // The path loop shared by the probe tracer and the reference camera: emission, next-event
-// estimation to punctual lights, Lambert + GGX sampling, Russian roulette, bounce limit, clamp.
+// estimation to punctual lights and to emissive triangles (multiple importance sampling with the
+// BSDF, power heuristic), Lambert + GGX sampling, Russian roulette, bounce limit, clamp.
 // The including raygen declares the bindings, the payloads `hit` (location 0) and `visible`
-// (location 1), and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES and PATH_INDIRECT_CLAMP.
+// (location 1), and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES, PATH_INDIRECT_CLAMP,
+// PATH_EMITTER_COUNT and PATH_EMITTER_POWER.
 const float PI = 3.14159265358979;
 
 // Rays traced by this invocation (for rays-per-second figures).
@@ -112,6 +114,48 @@ vec3 directLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alpha
   return sum;
 }
 
+float luminance(vec3 c) { return dot(c, LUMA); }
+
+// Solid-angle pdf with which emitter sampling picks a direction that reaches a point of triangle
+// `tri` (emission `le`, area `area`) at distance `dist`, seen at cosine `cosLight` from its front.
+float emitterPdf(vec3 le, float dist, float cosLight) {
+  if (PATH_EMITTER_COUNT == 0u || cosLight <= 0.0) return 0.0;
+  return luminance(le) / PATH_EMITTER_POWER * dist * dist / cosLight;  // (power/total) / area · d²/cos
+}
+
+// One emissive-triangle sample, chosen by power; MIS-weighted against BSDF sampling.
+vec3 emitterLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alpha, float specProb, inout uint rng) {
+  if (PATH_EMITTER_COUNT == 0u) return vec3(0.0);
+  float u = rnd(rng) * PATH_EMITTER_POWER;
+  uint lo = 0u, hi = PATH_EMITTER_COUNT - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi) / 2u;
+    if (emitters[mid].cdf < u) lo = mid + 1u; else hi = mid;
+  }
+  uint tri = emitters[lo].triangle;
+  vec3 p0 = vertexPosition(indices[3 * tri]), p1 = vertexPosition(indices[3 * tri + 1]),
+       p2 = vertexPosition(indices[3 * tri + 2]);
+  float su = sqrt(rnd(rng)), v = rnd(rng);
+  vec3 x = p0 * (1.0 - su) + p1 * (su * (1.0 - v)) + p2 * (su * v);
+  vec3 cr = cross(p1 - p0, p2 - p0);
+  vec3 nl = normalize(cr);
+  vec3 toLight = x - p;
+  float dist = length(toLight);
+  if (dist <= 1e-6) return vec3(0.0);
+  vec3 wi = toLight / dist;
+  float cosLight = dot(nl, -wi);
+  float cosSurface = dot(n, wi);
+  if (cosLight <= 0.0 || cosSurface <= 0.0) return vec3(0.0);
+  vec3 le = materials[triangleMaterial[tri]].emissionRoughness.rgb;
+  float pdfLight = emitterPdf(le, dist, cosLight);
+  if (pdfLight <= 0.0) return vec3(0.0);
+  vec3 origin = p + n * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+  if (!unoccluded(origin, wi, dist * (1.0 - 1e-3))) return vec3(0.0);
+  float pdfBsdfValue = pdfBsdf(n, wo, wi, alpha, specProb);
+  float weight = pdfLight * pdfLight / (pdfLight * pdfLight + pdfBsdfValue * pdfBsdfValue);
+  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * (weight / pdfLight);
+}
+
 vec3 clampIndirect(vec3 c, uint bounce) {
   if (bounce == 0u || PATH_INDIRECT_CLAMP <= 0.0) return c;
   float lum = dot(c, LUMA);
@@ -120,6 +164,7 @@ vec3 clampIndirect(vec3 c, uint bounce) {
 
 vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  float lastBsdfPdf = 0.0;  // pdf of the BSDF sample that started this segment (0: not sampled)
   for (uint bounce = 0u; bounce < PATH_MAX_BOUNCES; ++bounce) {
     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, origin, 0.0, dir, 1e30, 0);
     ++gClosestRays;
@@ -130,19 +175,31 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     vec3 ng = normalize(cross(p1 - p0, p2 - p0));
     PtMaterial m = materials[triangleMaterial[tri]];
     vec3 p = origin + dir * hit.t;
-    if (hit.backFace == 0u) radiance += clampIndirect(throughput * m.emissionRoughness.rgb, bounce);
+    vec3 le = m.emissionRoughness.rgb;
+    if (hit.backFace == 0u && max(le.r, max(le.g, le.b)) > 0.0) {
+      // Emission found by BSDF sampling, weighted against emitter sampling (not on the first
+      // segment: probe and camera rays are not BSDF samples).
+      float weight = 1.0;
+      if (lastBsdfPdf > 0.0) {
+        float pdfLight = emitterPdf(le, hit.t, abs(dot(ng, dir)));
+        weight = lastBsdfPdf * lastBsdfPdf / (lastBsdfPdf * lastBsdfPdf + pdfLight * pdfLight);
+      }
+      radiance += clampIndirect(throughput * le * weight, bounce);
+    }
     vec3 n = dot(ng, dir) < 0.0 ? ng : -ng;  // two-sided shading
     vec3 wo = -dir;
     vec3 base = m.baseColorMetallic.rgb;
     float metallic = m.baseColorMetallic.a;
     float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
+    float specProb = mix(0.2, 0.9, metallic);
     radiance += clampIndirect(throughput * directLight(p, n, wo, base, metallic, alpha), bounce);
     if (bounce + 1u >= PATH_MAX_BOUNCES) break;
-    float specProb = mix(0.2, 0.9, metallic);
+    radiance += clampIndirect(throughput * emitterLight(p, n, wo, base, metallic, alpha, specProb, rng), bounce);
     vec3 wi = sampleBsdf(n, wo, alpha, specProb, rng);
     float pdf = pdfBsdf(n, wo, wi, alpha, specProb);
     if (pdf <= 1e-8) break;
     throughput *= evalBsdf(n, wo, wi, base, metallic, alpha) * dot(n, wi) / pdf;
+    lastBsdfPdf = pdf;
     if (bounce >= 2u) {  // Russian roulette
       float q = clamp(max(throughput.r, max(throughput.g, throughput.b)), 0.05, 0.95);
       if (rnd(rng) > q) break;

@@ -18,7 +18,8 @@
 #define PT_BINDING_DIRECTIONS 6 // vec4[samples], unit directions in a coherent order
 #define PT_BINDING_PROBES 7     // vec4[active probes]: world position, w = grid index
 #define PT_BINDING_PARTIALS 8   // float[active probes * LANES * PARTIAL_FLOATS]
-#define PT_BINDING_COUNT 9
+#define PT_BINDING_EMITTERS 9   // PtEmitter[]: emissive triangles for next-event estimation
+#define PT_BINDING_COUNT 10
 
 #define PT_LIGHT_POINT 0u
 #define PT_LIGHT_SPOT 1u
@@ -49,6 +50,13 @@ struct PtLight {
   vec4 cone;                // x cos(outer), y cos(inner)
 };
 
+struct PtEmitter {
+  uint triangle;            // index into the index buffer / 3
+  float cdf;                // inclusive CDF of power (luminance of emission × area)
+  float power;              // luminance of emission × area
+  float pad;
+};
+
 struct PtPushConstants {
   mat4 rotation;            // random rotation of the sample set for this update
   uint sampleCount;         // samples per probe (multiple of LANES)
@@ -59,6 +67,10 @@ struct PtPushConstants {
   uint updateIndex;
   uint mode;                // PT_MODE_*
   float indirectClamp;      // max luminance of one indirect contribution; 0 = off
+  uint emitterCount;
+  float emitterPower;       // sum of PtEmitter.power
+  uint pad0;
+  uint pad1;
 };
 
 // The reference camera (reference_camera.rgen): a pinhole camera, one invocation per pixel,
@@ -77,13 +89,18 @@ struct PtCameraPushConstants {
   uint lightCount;
   uint maxBounces;
   float indirectClamp;
+  uint emitterCount;
+  float emitterPower;
+  uint pad0;
+  uint pad1;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(PtCameraPushConstants) == 96);
+static_assert(sizeof(PtCameraPushConstants) == 112);
+static_assert(sizeof(PtEmitter) == 16);
 static_assert(sizeof(PtMaterial) == 32);
 static_assert(sizeof(PtLight) == 64);
-static_assert(sizeof(PtPushConstants) == 96);
+static_assert(sizeof(PtPushConstants) == 112);
 }  // namespace probecast::shaders
 #endif
 

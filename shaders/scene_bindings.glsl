@@ -5,6 +5,7 @@ layout(std430, binding = PT_BINDING_INDICES) readonly buffer Indices { uint indi
 layout(std430, binding = PT_BINDING_TRIANGLE_MATERIAL) readonly buffer TriangleMaterial { uint triangleMaterial[]; };
 layout(std430, binding = PT_BINDING_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, binding = PT_BINDING_LIGHTS) readonly buffer Lights { PtLight lights[]; };
+layout(std430, binding = PT_BINDING_EMITTERS) readonly buffer Emitters { PtEmitter emitters[]; };
 
 layout(location = 0) rayPayloadEXT HitPayload hit;
 layout(location = 1) rayPayloadEXT uint visible;

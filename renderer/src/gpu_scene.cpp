@@ -28,6 +28,28 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   }
   g.lights = createBufferWithData(d, ls.data(), ls.size() * sizeof(shaders::PtLight), kStorage);
   g.lightCount = static_cast<uint32_t>(ls.size());
+
+  // Emissive triangles, chosen for next-event estimation in proportion to luminance × area.
+  destroyBuffer(d, g.emitters);
+  std::vector<shaders::PtEmitter> emitters;
+  double total = 0.0;
+  for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+    const glm::vec3 e = s.materials[s.triangleMaterial[t]].emission;
+    const float luma = 0.2126f * e.r + 0.7152f * e.g + 0.0722f * e.b;
+    const glm::vec3 p0 = s.positions[s.indices[3 * t]], p1 = s.positions[s.indices[3 * t + 1]],
+                    p2 = s.positions[s.indices[3 * t + 2]];
+    const float area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+    const float power = luma * area;
+    if (!(power > 0.0f) || !std::isfinite(power)) continue;
+    total += power;
+    emitters.push_back({t, static_cast<float>(total), power, 0.0f});
+  }
+  g.emitters = createBufferWithData(d, emitters.data(), emitters.size() * sizeof(shaders::PtEmitter), kStorage);
+  g.emitterCount = static_cast<uint32_t>(emitters.size());
+  g.emitterPower = static_cast<float>(total);
+  if (!emitters.empty()) {  // the last CDF entry equals the total exactly, so a draw never runs past it
+    static_cast<shaders::PtEmitter*>(g.emitters.mapped)[emitters.size() - 1].cdf = g.emitterPower;
+  }
 }
 
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
@@ -41,7 +63,9 @@ void destroyGpuScene(VulkanDevice& d, GpuScene& g) {
   destroyBuffer(d, g.triangleMaterial);
   destroyBuffer(d, g.materials);
   destroyBuffer(d, g.lights);
+  destroyBuffer(d, g.emitters);
   g.lightCount = 0;
+  g.emitterCount = 0;
 }
 
 }  // namespace probecast::renderer

@@ -11,7 +11,10 @@ struct GpuScene {
   Buffer triangleMaterial;  // uint per triangle
   Buffer materials;         // PtMaterial[]
   Buffer lights;            // PtLight[]
+  Buffer emitters;          // PtEmitter[]: emissive triangles with a power CDF
   uint32_t lightCount = 0;
+  uint32_t emitterCount = 0;
+  float emitterPower = 0.0f;
 };
 
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);  // geometry + shading

@@ -132,13 +132,15 @@ struct ProbeUpdater::Impl {
     push.sampleCount = sampleCount;
     push.probeCount = count;
     push.lightCount = gpu.lightCount;
+    push.emitterCount = gpu.emitterCount;
+    push.emitterPower = gpu.emitterPower;
     push.maxBounces = std::clamp<uint32_t>(options.maxBounces, 1, PT_MAX_BOUNCES_LIMIT);
     push.seed = options.seed;
     push.updateIndex = updates;
     push.mode = mode;
     push.indirectClamp = options.indirectClamp;
     const RayTracingInputs in{&gpu.accel, &gpu.triangleMaterial, &gpu.materials, &gpu.lights, &dirs, &probeList,
-                             &partials};
+                             &partials, &gpu.emitters};
     runRayTracingPass(*d, pass, in, &push, kLanes, count);
   }
 
@@ -259,7 +261,7 @@ uint64_t ProbeUpdater::deviceBytes() const {
   const Impl& s = *impl_;
   uint64_t total = 0;
   for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.gpu.triangleMaterial,
-                          &s.gpu.materials, &s.gpu.lights, &s.gpu.accel.positions, &s.gpu.accel.indices,
+                          &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.accel.positions, &s.gpu.accel.indices,
                           &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.tlas.storage, &s.pass.sbt})
     total += b->size;
   return total;

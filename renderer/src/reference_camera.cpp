@@ -54,6 +54,8 @@ Image renderReference(VulkanContext& context, const scene::Scene& scene, const C
     push.height = options.height;
     push.seed = options.seed;
     push.lightCount = gpu.lightCount;
+    push.emitterCount = gpu.emitterCount;
+    push.emitterPower = gpu.emitterPower;
     push.maxBounces = std::clamp<uint32_t>(options.maxBounces, 1, PT_MAX_BOUNCES_LIMIT);
     push.indirectClamp = options.indirectClamp;
     // Dispatches of bounded size keep each submission short (and a GPU watchdog happy).
@@ -63,7 +65,7 @@ Image renderReference(VulkanContext& context, const scene::Scene& scene, const C
       push.samplesPerPixel = std::min(perDispatch, options.samplesPerPixel - done);
       push.dispatchIndex = k;
       const RayTracingInputs in{&gpu.accel, &gpu.triangleMaterial, &gpu.materials, &gpu.lights, &unused, &unused,
-                                &accumulation};
+                                &accumulation, &gpu.emitters};
       runRayTracingPass(d, pass, in, &push, options.width, options.height);
       done += push.samplesPerPixel;
       if (options.progress) options.progress(done, options.samplesPerPixel);

@@ -133,7 +133,8 @@ void runRayTracingPass(VulkanDevice& d, RayTracingPass& pass, const RayTracingIn
   asWrite.pAccelerationStructures = &in.accel->tlas.handle;
   const Buffer* buffers[PT_BINDING_COUNT] = {nullptr,         &in.accel->positions, &in.accel->indices,
                                              in.triangleMaterial, in.materials,      in.lights,
-                                             in.directions,   in.probes,            in.partials};
+                                             in.directions,   in.probes,            in.partials,
+                                             in.emitters};
   VkDescriptorBufferInfo infos[PT_BINDING_COUNT];
   VkWriteDescriptorSet writes[PT_BINDING_COUNT];
   for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b) {

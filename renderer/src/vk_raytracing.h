@@ -27,6 +27,7 @@ struct RayTracingInputs {
   const Buffer* directions;
   const Buffer* probes;
   const Buffer* partials;
+  const Buffer* emitters;
 };
 
 void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygenBytes, uint32_t pushBytes,
