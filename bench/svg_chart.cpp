@@ -69,7 +69,8 @@ Axis makeAxis(std::vector<double> values, bool log) {
 std::string tickLabel(double v) {
   if (v == 0) return "0";
   const double a = std::fabs(v);
-  if (a >= 1000 || a < 0.001) return fmt::format("{:.0e}", v);
+  if (a >= 1e6 || a < 0.001) return fmt::format("{:.0e}", v);
+  if (a >= 1000) return fmt::format("{:.0f}", v);
   return fmt::format("{:g}", v);
 }
 
