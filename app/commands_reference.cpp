@@ -18,6 +18,7 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
     std::vector<float> eye, target;
     float yfovDeg = 0.0f;
     std::string out, png;
+    float exposure = 1.0f;
   };
   auto o = std::make_shared<Options>();
   scene->add(cmd);
@@ -31,6 +32,7 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--yfov", o->yfovDeg, "vertical field of view, degrees")->check(CLI::Range(1.0f, 179.0f));
   cmd->add_option("--out", o->out, "EXR file to write (linear radiance)")->required();
   cmd->add_option("--png", o->png, "also write a gamma-2.2 PNG preview");
+  cmd->add_option("--exposure", o->exposure, "scale applied to the PNG preview only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->callback([=, &exitCode] {
     const scene::Scene s = scene->load();
     renderer::CameraView camera = renderer::CameraView::fromScene(s);
@@ -60,7 +62,7 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
       throw std::runtime_error(error);
     fmt::print("wrote {}\n", o->out);
     if (!o->png.empty()) {
-      if (!bench::writePngPreview(o->png, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), 1.0f,
+      if (!bench::writePngPreview(o->png, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), o->exposure,
                                   error))
         throw std::runtime_error(error);
       fmt::print("wrote {}\n", o->png);

@@ -23,6 +23,30 @@ float rnd(inout uint s) {
 }
 
 vec3 vertexPosition(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
+vec3 vertexNormal(uint i) { return vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); }
+vec2 vertexTexcoord(uint i) { return vec2(texcoords[2 * i], texcoords[2 * i + 1]); }
+
+vec3 srgbToLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+vec3 texel(PtTexture t, int x, int y) {
+  x = ((x % int(t.width)) + int(t.width)) % int(t.width);  // repeat
+  y = ((y % int(t.height)) + int(t.height)) % int(t.height);
+  uint v = texels[t.offset + uint(y) * t.width + uint(x)];
+  return srgbToLinear(vec3(float(v & 255u), float((v >> 8) & 255u), float((v >> 16) & 255u)) / 255.0);
+}
+
+// Bilinear, repeat, sRGB decoded before filtering.
+vec3 sampleTexture(int index, vec2 uv) {
+  if (index < 0) return vec3(1.0);
+  PtTexture t = textures[index];
+  vec2 p = uv * vec2(t.width, t.height) - 0.5;
+  ivec2 i = ivec2(floor(p));
+  vec2 f = p - vec2(i);
+  return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x),
+             mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
+}
 
 void onb(vec3 n, out vec3 t, out vec3 b) {
   float s = n.z >= 0.0 ? 1.0 : -1.0;
@@ -85,7 +109,7 @@ bool unoccluded(vec3 origin, vec3 dir, float tmax) {
 }
 
 // Radiance of punctual lights arriving at p along wi, times the cosine, via a shadow ray.
-vec3 directLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alpha) {
+vec3 directLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha) {
   vec3 sum = vec3(0.0);
   for (uint i = 0u; i < PATH_LIGHT_COUNT; ++i) {
     PtLight l = lights[i];
@@ -107,8 +131,8 @@ vec3 directLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alpha
       if (type == PT_LIGHT_SPOT) e *= smoothstep(l.cone.x, l.cone.y, dot(-wi, l.directionRange.xyz));
     }
     float cosine = dot(n, wi);
-    if (cosine <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
-    vec3 origin = p + n * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+    if (cosine <= 0.0 || dot(ng, wi) <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
+    vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
     if (unoccluded(origin, wi, dist * (1.0 - 1e-4))) sum += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e;
   }
   return sum;
@@ -124,7 +148,8 @@ float emitterPdf(vec3 le, float dist, float cosLight) {
 }
 
 // One emissive-triangle sample, chosen by power; MIS-weighted against BSDF sampling.
-vec3 emitterLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alpha, float specProb, inout uint rng) {
+vec3 emitterLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha, float specProb,
+                  inout uint rng) {
   if (PATH_EMITTER_COUNT == 0u) return vec3(0.0);
   float u = rnd(rng) * PATH_EMITTER_POWER;
   uint lo = 0u, hi = PATH_EMITTER_COUNT - 1u;
@@ -145,11 +170,18 @@ vec3 emitterLight(vec3 p, vec3 n, vec3 wo, vec3 base, float metallic, float alph
   vec3 wi = toLight / dist;
   float cosLight = dot(nl, -wi);
   float cosSurface = dot(n, wi);
-  if (cosLight <= 0.0 || cosSurface <= 0.0) return vec3(0.0);
-  vec3 le = materials[triangleMaterial[tri]].emissionRoughness.rgb;
-  float pdfLight = emitterPdf(le, dist, cosLight);
+  if (cosLight <= 0.0 || cosSurface <= 0.0 || dot(ng, wi) <= 0.0) return vec3(0.0);
+  PtMaterial em = materials[triangleMaterial[tri]];
+  vec3 leFactor = em.emissionRoughness.rgb;
+  vec3 le = leFactor;
+  if (em.textures.y >= 0) {
+    uint i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
+    vec2 uv = vertexTexcoord(i0) * (1.0 - su) + vertexTexcoord(i1) * (su * (1.0 - v)) + vertexTexcoord(i2) * (su * v);
+    le *= sampleTexture(em.textures.y, uv);
+  }
+  float pdfLight = emitterPdf(leFactor, dist, cosLight);
   if (pdfLight <= 0.0) return vec3(0.0);
-  vec3 origin = p + n * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+  vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
   if (!unoccluded(origin, wi, dist * (1.0 - 1e-3))) return vec3(0.0);
   float pdfBsdfValue = pdfBsdf(n, wo, wi, alpha, specProb);
   float weight = pdfLight * pdfLight / (pdfLight * pdfLight + pdfBsdfValue * pdfBsdfValue);
@@ -175,26 +207,35 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     vec3 ng = normalize(cross(p1 - p0, p2 - p0));
     PtMaterial m = materials[triangleMaterial[tri]];
     vec3 p = origin + dir * hit.t;
-    vec3 le = m.emissionRoughness.rgb;
+    uint i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
+    vec3 bary = vec3(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics);
+    vec2 uv = vertexTexcoord(i0) * bary.x + vertexTexcoord(i1) * bary.y + vertexTexcoord(i2) * bary.z;
+    vec3 leFactor = m.emissionRoughness.rgb;
+    vec3 le = leFactor * sampleTexture(m.textures.y, uv);
     if (hit.backFace == 0u && max(le.r, max(le.g, le.b)) > 0.0) {
       // Emission found by BSDF sampling, weighted against emitter sampling (not on the first
       // segment: probe and camera rays are not BSDF samples).
       float weight = 1.0;
       if (lastBsdfPdf > 0.0) {
-        float pdfLight = emitterPdf(le, hit.t, abs(dot(ng, dir)));
+        float pdfLight = emitterPdf(leFactor, hit.t, abs(dot(ng, dir)));
         weight = lastBsdfPdf * lastBsdfPdf / (lastBsdfPdf * lastBsdfPdf + pdfLight * pdfLight);
       }
       radiance += clampIndirect(throughput * le * weight, bounce);
     }
-    vec3 n = dot(ng, dir) < 0.0 ? ng : -ng;  // two-sided shading
+    vec3 ngf = dot(ng, dir) < 0.0 ? ng : -ng;  // geometric normal facing the ray (two-sided)
+    vec3 ns = vertexNormal(i0) * bary.x + vertexNormal(i1) * bary.y + vertexNormal(i2) * bary.z;
+    float nsLen = length(ns);
+    vec3 n = nsLen > 1e-6 ? ns / nsLen : ngf;
+    if (dot(n, ngf) < 0.0) n = -n;                        // shading normal on the ray's side
+    if (dot(n, -dir) <= 1e-4) n = ngf;                     // grazing: fall back to the geometric normal
     vec3 wo = -dir;
-    vec3 base = m.baseColorMetallic.rgb;
+    vec3 base = m.baseColorMetallic.rgb * sampleTexture(m.textures.x, uv);
     float metallic = m.baseColorMetallic.a;
     float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
     float specProb = mix(0.2, 0.9, metallic);
-    radiance += clampIndirect(throughput * directLight(p, n, wo, base, metallic, alpha), bounce);
+    radiance += clampIndirect(throughput * directLight(p, n, ngf, wo, base, metallic, alpha), bounce);
     if (bounce + 1u >= PATH_MAX_BOUNCES) break;
-    radiance += clampIndirect(throughput * emitterLight(p, n, wo, base, metallic, alpha, specProb, rng), bounce);
+    radiance += clampIndirect(throughput * emitterLight(p, n, ngf, wo, base, metallic, alpha, specProb, rng), bounce);
     vec3 wi = sampleBsdf(n, wo, alpha, specProb, rng);
     float pdf = pdfBsdf(n, wo, wi, alpha, specProb);
     if (pdf <= 1e-8) break;
@@ -205,7 +246,8 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
       if (rnd(rng) > q) break;
       throughput /= q;
     }
-    origin = p + n * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+    if (dot(wi, ngf) <= 0.0) break;  // a shading-normal sample that goes below the surface
+    origin = p + ngf * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
     dir = wi;
   }
   return radiance;

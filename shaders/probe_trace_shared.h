@@ -19,7 +19,11 @@
 #define PT_BINDING_PROBES 7     // vec4[active probes]: world position, w = grid index
 #define PT_BINDING_PARTIALS 8   // float[active probes * LANES * PARTIAL_FLOATS]
 #define PT_BINDING_EMITTERS 9   // PtEmitter[]: emissive triangles for next-event estimation
-#define PT_BINDING_COUNT 10
+#define PT_BINDING_NORMALS 10   // float[3 * vertices], shading normals
+#define PT_BINDING_TEXCOORDS 11 // float[2 * vertices]
+#define PT_BINDING_TEXELS 12    // uint[]: every texture's sRGB RGBA8 texels, packed
+#define PT_BINDING_TEXTURES 13  // PtTexture[]
+#define PT_BINDING_COUNT 14
 
 #define PT_LIGHT_POINT 0u
 #define PT_LIGHT_SPOT 1u
@@ -32,6 +36,9 @@ using uint = uint32_t;
 struct vec4 {
   float x, y, z, w;
 };
+struct ivec4 {
+  int32_t x, y, z, w;
+};
 struct mat4 {
   vec4 c[4];
 };
@@ -41,6 +48,14 @@ struct mat4 {
 struct PtMaterial {
   vec4 baseColorMetallic;   // rgb base colour, a metallic
   vec4 emissionRoughness;   // rgb emitted radiance, a roughness
+  ivec4 textures;           // x base colour texture, y emissive texture (-1 = none)
+};
+
+struct PtTexture {
+  uint offset;              // first texel in PT_BINDING_TEXELS
+  uint width;
+  uint height;
+  uint pad;
 };
 
 struct PtLight {
@@ -98,7 +113,8 @@ struct PtCameraPushConstants {
 #ifdef __cplusplus
 static_assert(sizeof(PtCameraPushConstants) == 112);
 static_assert(sizeof(PtEmitter) == 16);
-static_assert(sizeof(PtMaterial) == 32);
+static_assert(sizeof(PtMaterial) == 48);
+static_assert(sizeof(PtTexture) == 16);
 static_assert(sizeof(PtLight) == 64);
 static_assert(sizeof(PtPushConstants) == 112);
 }  // namespace probecast::shaders

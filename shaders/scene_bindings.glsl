@@ -6,6 +6,10 @@ layout(std430, binding = PT_BINDING_TRIANGLE_MATERIAL) readonly buffer TriangleM
 layout(std430, binding = PT_BINDING_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, binding = PT_BINDING_LIGHTS) readonly buffer Lights { PtLight lights[]; };
 layout(std430, binding = PT_BINDING_EMITTERS) readonly buffer Emitters { PtEmitter emitters[]; };
+layout(std430, binding = PT_BINDING_NORMALS) readonly buffer Normals { float normals[]; };
+layout(std430, binding = PT_BINDING_TEXCOORDS) readonly buffer Texcoords { float texcoords[]; };
+layout(std430, binding = PT_BINDING_TEXELS) readonly buffer Texels { uint texels[]; };
+layout(std430, binding = PT_BINDING_TEXTURES) readonly buffer Textures { PtTexture textures[]; };
 
 layout(location = 0) rayPayloadEXT HitPayload hit;
 layout(location = 1) rayPayloadEXT uint visible;

@@ -83,6 +83,26 @@ TEST_F(Updater, ClosedEmissiveBoxGivesConstantRadiance) {
   }
 }
 
+TEST_F(Updater, EmissionTextureIsDecodedFromSrgb) {
+  // The constant box again, with emission factor 1 times a uniform sRGB 128 texture:
+  // linear ((128/255 + 0.055)/1.055)^2.4 = 0.2158605, so c00 = 2√π · 0.2158605.
+  Scene s = halfSplitBox([](int, bool) { return 0u; });
+  s.materials.clear();
+  const uint32_t m = addMaterial(s, glm::vec3(0.0f), glm::vec3(1.0f));
+  s.materials[m].emissiveTexture = 0;
+  scene::Texture t;
+  t.width = 3;
+  t.height = 2;
+  t.rgba.assign(3 * 2 * 4, 128);
+  s.textures.push_back(t);
+  UpdaterOptions o;
+  o.samplesPerProbe = 128;
+  o.maxBounces = 1;
+  ProbeUpdater updater(*context_, s, singleProbe({0.2f, 0.1f, -0.3f}), o);
+  updater.update();
+  EXPECT_NEAR(updater.probes()[0], 3.5449077f * 0.2158605f, 1e-4f);
+}
+
 TEST_F(Updater, HalfEmissiveBoxGivesHemisphereAnswer) {
   // Radiance 1 for z > 0, 0 below (CODEC.md §8.2): c00 = √π, c10 = √(3π)/2, c20 = 0, E(+z) = π.
   Scene s;

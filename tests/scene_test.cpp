@@ -134,3 +134,37 @@ TEST(Scene, NanPositionsAreRejected) {
 
 }  // namespace
 }  // namespace probecast::scene
+
+namespace probecast::scene {
+namespace {
+
+TEST(Scene, TexturedGltfLoadsTexturesUvsAndNormals) {
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(loadGltf(std::string(PROBECAST_SHARED_DATA) + "/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf", s,
+                       error))
+      << error;
+  EXPECT_EQ(s.textures.size(), 2u);  // checkerBJS.png and checker-meter.png
+  ASSERT_EQ(s.texcoords.size(), s.positions.size());
+  ASSERT_EQ(s.normals.size(), s.positions.size());
+  int textured = 0;
+  for (const Material& m : s.materials) textured += m.baseColorTexture >= 0 ? 1 : 0;
+  EXPECT_EQ(textured, 2);  // bloc and cornellBox.ground
+  for (const Texture& t : s.textures) {
+    EXPECT_GT(t.width, 0u);
+    EXPECT_EQ(t.rgba.size(), static_cast<size_t>(t.width) * t.height * 4);
+  }
+  for (const glm::vec3& n : s.normals) EXPECT_NEAR(glm::length(n), 1.0f, 1e-3f);
+  // Suzanne is smooth-shaded: some vertex normals differ from their triangle's face normal.
+  int smooth = 0;
+  for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+    const glm::vec3 a = s.positions[s.indices[3 * t]], b = s.positions[s.indices[3 * t + 1]],
+                    c = s.positions[s.indices[3 * t + 2]];
+    const glm::vec3 fn = glm::normalize(glm::cross(b - a, c - a));
+    if (glm::dot(fn, s.normals[s.indices[3 * t]]) < 0.99f) ++smooth;
+  }
+  EXPECT_GT(smooth, 100);
+}
+
+}  // namespace
+}  // namespace probecast::scene

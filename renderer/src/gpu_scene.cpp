@@ -14,9 +14,11 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   destroyBuffer(d, g.lights);
   g.triangleMaterial = createBufferWithData(d, s.triangleMaterial.data(), s.triangleMaterial.size() * 4, kStorage);
   std::vector<shaders::PtMaterial> mats;
+  const auto textureIndex = [&](int32_t t) { return t >= 0 && t < static_cast<int32_t>(s.textures.size()) ? t : -1; };
   for (const scene::Material& m : s.materials)
     mats.push_back({{m.baseColor.r, m.baseColor.g, m.baseColor.b, m.metallic},
-                    {m.emission.r, m.emission.g, m.emission.b, m.roughness}});
+                    {m.emission.r, m.emission.g, m.emission.b, m.roughness},
+                    {textureIndex(m.baseColorTexture), textureIndex(m.emissiveTexture), -1, -1}});
   g.materials = createBufferWithData(d, mats.data(), mats.size() * sizeof(shaders::PtMaterial), kStorage);
   std::vector<shaders::PtLight> ls;
   for (const scene::Light& l : s.lights) {
@@ -53,8 +55,26 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
 }
 
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
+  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   if (g.accel.tlas.handle) destroySceneAccel(d, g.accel);
   buildSceneAccel(d, s, g.accel);
+  for (Buffer* b : {&g.normals, &g.texcoords, &g.texels, &g.textures}) destroyBuffer(d, *b);
+  std::vector<glm::vec3> normals = s.normals;
+  normals.resize(s.positions.size(), glm::vec3(0.0f));  // 0: the shader uses the geometric normal
+  g.normals = createBufferWithData(d, normals.data(), normals.size() * sizeof(glm::vec3), kStorage);
+  std::vector<glm::vec2> uvs = s.texcoords;
+  uvs.resize(s.positions.size(), glm::vec2(0.0f));
+  g.texcoords = createBufferWithData(d, uvs.data(), uvs.size() * sizeof(glm::vec2), kStorage);
+  std::vector<uint32_t> texels;
+  std::vector<shaders::PtTexture> infos;
+  for (const scene::Texture& t : s.textures) {
+    infos.push_back({static_cast<uint32_t>(texels.size()), t.width, t.height, 0});
+    for (size_t i = 0; i < static_cast<size_t>(t.width) * t.height; ++i)
+      texels.push_back(static_cast<uint32_t>(t.rgba[i * 4]) | (static_cast<uint32_t>(t.rgba[i * 4 + 1]) << 8) |
+                       (static_cast<uint32_t>(t.rgba[i * 4 + 2]) << 16) | (static_cast<uint32_t>(t.rgba[i * 4 + 3]) << 24));
+  }
+  g.texels = createBufferWithData(d, texels.data(), texels.size() * 4, kStorage);
+  g.textures = createBufferWithData(d, infos.data(), infos.size() * sizeof(shaders::PtTexture), kStorage);
   uploadGpuShading(d, s, g);
 }
 
@@ -64,6 +84,7 @@ void destroyGpuScene(VulkanDevice& d, GpuScene& g) {
   destroyBuffer(d, g.materials);
   destroyBuffer(d, g.lights);
   destroyBuffer(d, g.emitters);
+  for (Buffer* b : {&g.normals, &g.texcoords, &g.texels, &g.textures}) destroyBuffer(d, *b);
   g.lightCount = 0;
   g.emitterCount = 0;
 }

@@ -12,6 +12,10 @@ struct GpuScene {
   Buffer materials;         // PtMaterial[]
   Buffer lights;            // PtLight[]
   Buffer emitters;          // PtEmitter[]: emissive triangles with a power CDF
+  Buffer normals;           // float3 per vertex
+  Buffer texcoords;         // float2 per vertex
+  Buffer texels;            // packed sRGB RGBA8 of every texture
+  Buffer textures;          // PtTexture[]
   uint32_t lightCount = 0;
   uint32_t emitterCount = 0;
   float emitterPower = 0.0f;

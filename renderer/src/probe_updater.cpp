@@ -139,8 +139,7 @@ struct ProbeUpdater::Impl {
     push.updateIndex = updates;
     push.mode = mode;
     push.indirectClamp = options.indirectClamp;
-    const RayTracingInputs in{&gpu.accel, &gpu.triangleMaterial, &gpu.materials, &gpu.lights, &dirs, &probeList,
-                             &partials, &gpu.emitters};
+    const RayTracingInputs in{&gpu, &dirs, &probeList, &partials};
     runRayTracingPass(*d, pass, in, &push, kLanes, count);
   }
 
@@ -261,7 +260,8 @@ uint64_t ProbeUpdater::deviceBytes() const {
   const Impl& s = *impl_;
   uint64_t total = 0;
   for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.gpu.triangleMaterial,
-                          &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.accel.positions, &s.gpu.accel.indices,
+                          &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.normals, &s.gpu.texcoords, &s.gpu.texels,
+                          &s.gpu.textures, &s.gpu.accel.positions, &s.gpu.accel.indices,
                           &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.tlas.storage, &s.pass.sbt})
     total += b->size;
   return total;

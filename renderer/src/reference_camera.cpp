@@ -64,8 +64,7 @@ Image renderReference(VulkanContext& context, const scene::Scene& scene, const C
     for (uint32_t k = 0; done < options.samplesPerPixel; ++k) {
       push.samplesPerPixel = std::min(perDispatch, options.samplesPerPixel - done);
       push.dispatchIndex = k;
-      const RayTracingInputs in{&gpu.accel, &gpu.triangleMaterial, &gpu.materials, &gpu.lights, &unused, &unused,
-                                &accumulation, &gpu.emitters};
+      const RayTracingInputs in{&gpu, &unused, &unused, &accumulation};
       runRayTracingPass(d, pass, in, &push, options.width, options.height);
       done += push.samplesPerPixel;
       if (options.progress) options.progress(done, options.samplesPerPixel);

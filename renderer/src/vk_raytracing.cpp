@@ -130,11 +130,22 @@ void runRayTracingPass(VulkanDevice& d, RayTracingPass& pass, const RayTracingIn
   VkWriteDescriptorSetAccelerationStructureKHR asWrite{
       VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
   asWrite.accelerationStructureCount = 1;
-  asWrite.pAccelerationStructures = &in.accel->tlas.handle;
-  const Buffer* buffers[PT_BINDING_COUNT] = {nullptr,         &in.accel->positions, &in.accel->indices,
-                                             in.triangleMaterial, in.materials,      in.lights,
-                                             in.directions,   in.probes,            in.partials,
-                                             in.emitters};
+  asWrite.pAccelerationStructures = &in.scene->accel.tlas.handle;
+  const GpuScene& g = *in.scene;
+  const Buffer* buffers[PT_BINDING_COUNT] = {};
+  buffers[PT_BINDING_POSITIONS] = &g.accel.positions;
+  buffers[PT_BINDING_INDICES] = &g.accel.indices;
+  buffers[PT_BINDING_TRIANGLE_MATERIAL] = &g.triangleMaterial;
+  buffers[PT_BINDING_MATERIALS] = &g.materials;
+  buffers[PT_BINDING_LIGHTS] = &g.lights;
+  buffers[PT_BINDING_DIRECTIONS] = in.directions;
+  buffers[PT_BINDING_PROBES] = in.probes;
+  buffers[PT_BINDING_PARTIALS] = in.partials;
+  buffers[PT_BINDING_EMITTERS] = &g.emitters;
+  buffers[PT_BINDING_NORMALS] = &g.normals;
+  buffers[PT_BINDING_TEXCOORDS] = &g.texcoords;
+  buffers[PT_BINDING_TEXELS] = &g.texels;
+  buffers[PT_BINDING_TEXTURES] = &g.textures;
   VkDescriptorBufferInfo infos[PT_BINDING_COUNT];
   VkWriteDescriptorSet writes[PT_BINDING_COUNT];
   for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b) {

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "probe_trace_shared.h"
-#include "vk_acceleration.h"
+#include "gpu_scene.h"
 
 namespace probecast::renderer {
 
@@ -18,16 +18,12 @@ struct RayTracingPass {
   uint32_t pushBytes = 0;
 };
 
-// Buffers bound at PT_BINDING_* (the TLAS comes from the scene).
+// What is bound at PT_BINDING_*: the scene, and the pass's own buffers.
 struct RayTracingInputs {
-  const SceneAccel* accel;
-  const Buffer* triangleMaterial;
-  const Buffer* materials;
-  const Buffer* lights;
+  const GpuScene* scene;
   const Buffer* directions;
   const Buffer* probes;
   const Buffer* partials;
-  const Buffer* emitters;
 };
 
 void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygenBytes, uint32_t pushBytes,

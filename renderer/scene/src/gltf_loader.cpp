@@ -14,8 +14,8 @@
 namespace probecast::scene {
 namespace {
 
-const std::set<std::string> kSupportedRequired = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                                  "KHR_materials_ior", "KHR_texture_transform"};
+// Extensions a file may require: ones we implement, or that cannot change what we render.
+const std::set<std::string> kSupportedRequired = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
 
 glm::mat4 nodeMatrix(const tinygltf::Node& node) {
   if (node.matrix.size() == 16) {
@@ -128,7 +128,36 @@ glm::vec3 vec3Of(const std::vector<double>& v, glm::vec3 fallback) {
   return v.size() >= 3 ? glm::vec3(v[0], v[1], v[2]) : fallback;
 }
 
+// glTF texture index → Scene::textures index (images converted to RGBA8 once each).
+int32_t convertTexture(const tinygltf::Model& model, int textureIndex, std::vector<int32_t>& imageToTexture,
+                       Scene& scene) {
+  if (textureIndex < 0 || textureIndex >= static_cast<int>(model.textures.size())) return -1;
+  const int source = model.textures[textureIndex].source;
+  if (source < 0 || source >= static_cast<int>(model.images.size())) return -1;
+  if (imageToTexture[source] >= 0) return imageToTexture[source];
+  const tinygltf::Image& img = model.images[source];
+  const int comps = img.component;
+  if (img.width <= 0 || img.height <= 0 || img.bits != 8 || comps < 1 || comps > 4 ||
+      img.image.size() < static_cast<size_t>(img.width) * img.height * comps)
+    return -1;  // undecodable or 16-bit images: the factor alone is used
+  Texture t;
+  t.width = static_cast<uint32_t>(img.width);
+  t.height = static_cast<uint32_t>(img.height);
+  t.rgba.resize(static_cast<size_t>(t.width) * t.height * 4);
+  for (size_t i = 0; i < static_cast<size_t>(t.width) * t.height; ++i) {
+    const unsigned char* src = &img.image[i * comps];
+    t.rgba[i * 4 + 0] = src[0];
+    t.rgba[i * 4 + 1] = comps >= 3 ? src[1] : src[0];
+    t.rgba[i * 4 + 2] = comps >= 3 ? src[2] : src[0];
+    t.rgba[i * 4 + 3] = comps == 4 ? src[3] : (comps == 2 ? src[1] : 255);
+  }
+  scene.textures.push_back(std::move(t));
+  imageToTexture[source] = static_cast<int32_t>(scene.textures.size() - 1);
+  return imageToTexture[source];
+}
+
 void convertMaterials(const tinygltf::Model& model, Scene& scene) {
+  std::vector<int32_t> imageToTexture(model.images.size(), -1);
   for (const tinygltf::Material& m : model.materials) {
     Material out;
     out.name = m.name;
@@ -141,6 +170,8 @@ void convertMaterials(const tinygltf::Model& model, Scene& scene) {
     if (it != m.extensions.end() && it->second.Has("emissiveStrength"))
       strength = static_cast<float>(it->second.Get("emissiveStrength").GetNumberAsDouble());
     out.emission = vec3Of(m.emissiveFactor, glm::vec3(0.0f)) * strength;
+    out.baseColorTexture = convertTexture(model, pbr.baseColorTexture.index, imageToTexture, scene);
+    out.emissiveTexture = convertTexture(model, m.emissiveTexture.index, imageToTexture, scene);
     scene.materials.push_back(out);
   }
   // Primitives without a material use glTF's default (white, metallic 1 roughness 1 per spec;
@@ -220,6 +251,18 @@ bool addPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim,
     }
   }
   scene.normals.insert(scene.normals.end(), normals.begin(), normals.end());
+  std::vector<glm::vec2> uvs(positions.count(), glm::vec2(0.0f));
+  auto uv = prim.attributes.find("TEXCOORD_0");
+  if (uv != prim.attributes.end()) {
+    AccessorReader t(model, uv->second, error);
+    if (!t.ok()) return false;
+    if (t.count() == positions.count() && t.components() == 2)
+      for (size_t i = 0; i < t.count(); ++i) {
+        const glm::vec2 v(t.component(i, 0), t.component(i, 1));
+        uvs[i] = std::isfinite(v.x) && std::isfinite(v.y) ? v : glm::vec2(0.0f);
+      }
+  }
+  scene.texcoords.insert(scene.texcoords.end(), uvs.begin(), uvs.end());
   const uint32_t material =
       prim.material >= 0 && prim.material < static_cast<int>(model.materials.size())
           ? static_cast<uint32_t>(prim.material)

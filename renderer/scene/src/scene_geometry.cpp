@@ -26,9 +26,12 @@ void addQuad(Scene& s, const glm::vec3& a, const glm::vec3& b, const glm::vec3& 
              uint32_t material) {
   const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
   const uint32_t base = static_cast<uint32_t>(s.positions.size());
+  const glm::vec2 uv[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+  int k = 0;
   for (const glm::vec3& p : {a, b, c, d}) {
     s.positions.push_back(p);
     s.normals.push_back(n);
+    s.texcoords.push_back(uv[k++]);
   }
   for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) s.indices.push_back(base + i);
   s.triangleMaterial.push_back(material);

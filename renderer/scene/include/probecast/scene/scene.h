@@ -20,6 +20,16 @@ struct Material {
   float metallic = 0.0f;
   float roughness = 1.0f;
   glm::vec3 emission{0.0f};
+  int32_t baseColorTexture = -1;  // index into Scene::textures, multiplies baseColor
+  int32_t emissiveTexture = -1;   // index into Scene::textures, multiplies emission
+};
+
+// An sRGB-encoded RGBA8 image (glTF base colour and emissive textures are sRGB), sampled with
+// repeat wrapping and bilinear filtering.
+struct Texture {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<uint8_t> rgba;
 };
 
 enum class LightType : uint32_t { Point = 0, Spot = 1, Directional = 2 };
@@ -49,10 +59,12 @@ struct Camera {
 struct Scene {
   std::string name;
   std::vector<glm::vec3> positions;  // world space
-  std::vector<glm::vec3> normals;    // per vertex, unit length
+  std::vector<glm::vec3> normals;    // per vertex, unit length (shading normals)
+  std::vector<glm::vec2> texcoords;  // per vertex, TEXCOORD_0 (0 when absent)
   std::vector<uint32_t> indices;     // 3 per triangle
   std::vector<uint32_t> triangleMaterial;
   std::vector<Material> materials;
+  std::vector<Texture> textures;
   std::vector<Light> lights;
   std::vector<Camera> cameras;
   glm::vec3 boundsMin{0.0f};
