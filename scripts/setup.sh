@@ -9,7 +9,7 @@ PACKAGES=(
   nlohmann-json3-dev libstb-dev libtinyexr-dev libglm-dev libtinygltf-dev
   libvulkan-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev openssl
 )
 # Mesa >= 24 from bookworm-backports: lavapipe with ray tracing (see LAVAPIPE.md).
 MESA_MIN=24

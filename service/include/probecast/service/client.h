@@ -1,0 +1,69 @@
+// The client library (no Vulkan): subscribes, sends views, decodes into a local probe volume, keeps
+// the last volume when the network drops, reconnects with back-off and resumes by telling the
+// server what it holds.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "probecast/codec/priority.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast::service {
+
+struct ClientConfig {
+  std::string address;                  // host:port
+  std::string token;                    // bearer token
+  bool tls = false;
+  std::string rootCertPem;              // trusted root for TLS (empty: system roots)
+  std::string tlsServerName;            // override of the name checked against the certificate
+  uint64_t budgetBytesPerSecond = 0;    // 0 = unlimited
+  std::string name = "probecast-client";
+  int reconnectMinMs = 50;
+  int reconnectMaxMs = 2000;
+};
+
+struct VolumeSnapshot {
+  StreamLayout layout;
+  GridBounds bounds;
+  std::vector<float> probes;    // 27 floats per probe (sh.h layout), last good volume
+  std::vector<uint8_t> active;
+  uint32_t framesApplied = 0;
+  uint64_t newestServerTimeUs = 0;
+};
+
+struct ClientStats {
+  bool connected = false;
+  uint32_t connects = 0;          // successful subscriptions (1 + resumes)
+  uint32_t framesApplied = 0;
+  uint32_t framesRejected = 0;    // frames the decoder refused (state kept)
+  uint64_t bytesReceived = 0;     // payload bytes
+  std::string lastError;          // last status or decode error
+  bool fatal = false;             // the server refused us (auth, bad request): no more retries
+};
+
+class ProbeClient {
+ public:
+  explicit ProbeClient(const ClientConfig& config);
+  ~ProbeClient();  // stops
+  ProbeClient(const ProbeClient&) = delete;
+  ProbeClient& operator=(const ProbeClient&) = delete;
+
+  void start();
+  void stop();
+  // Replaces the views sent to the server (now, and again after every reconnect).
+  void setViews(std::vector<View> views);
+  // Copies the current volume; false until a volume description has arrived.
+  bool snapshot(VolumeSnapshot& out) const;
+  ClientStats stats() const;
+  // Cuts the current connection (as a network fault would); the client reconnects and resumes.
+  void dropConnection();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace probecast::service

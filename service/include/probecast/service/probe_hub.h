@@ -1,0 +1,112 @@
+// The transport-free core of the service: one encoder for the volume, and per subscriber what it
+// holds, what it sees and what it may be sent. Frames are built from brick sections encoded once
+// (the same bytes for every subscriber); a subscriber that falls behind gets the newest version
+// (a keyframe when it skipped some), never a queue of stale ones.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "probecast/codec/priority.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast::service {
+
+using Clock = std::chrono::steady_clock;
+
+struct HubConfig {
+  StreamLayout layout;
+  GridBounds bounds;
+  EncoderOptions encoder;
+  PriorityParams priority;
+  double burstSeconds = 1.0;  // a subscriber's budget bucket holds this many seconds of bytes
+};
+
+struct HeldBrick {
+  uint32_t brick = 0;
+  uint32_t version = 0;
+};
+
+struct OutgoingFrame {
+  uint32_t sequence = 0;
+  uint64_t serverTimeUs = 0;  // when the newest lighting in it was published
+  std::vector<uint8_t> payload;  // codec frame
+  uint32_t keyframes = 0;
+  uint32_t deltas = 0;
+};
+
+struct SubscriberStats {
+  uint64_t bytesSent = 0;
+  uint32_t bricksBehind = 0;
+  uint32_t framesSent = 0;
+};
+
+class ProbeHub {
+ public:
+  explicit ProbeHub(const HubConfig& config);
+
+  const StreamLayout& layout() const { return config_.layout; }
+  const GridBounds& bounds() const { return config_.bounds; }
+  uint64_t epoch() const { return epoch_; }
+
+  // A new lighting frame (27 floats per probe, sh.h layout; active mask or null). Each changed
+  // brick gets a new version, encoded once. Wakes subscribers that wait for data.
+  void publish(const float* probes, const uint8_t* active);
+  // Wakes subscribers whose budget has refilled (call at the producer's rate when nothing changes).
+  void tick();
+  uint32_t serverFrame() const;
+
+  // `wake` is called (never under the hub's lock) when the subscriber may have a frame to take.
+  // `held` is honoured when `epoch` equals this hub's epoch (resume), ignored otherwise.
+  uint64_t addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
+                         std::function<void()> wake);
+  void removeSubscriber(uint64_t id);
+  void setViews(uint64_t id, std::vector<View> views);
+  size_t subscriberCount() const;
+
+  // The next frame for this subscriber: the bricks it lacks, best first, within its budget.
+  // nullopt when it holds everything or its budget is spent (it is woken later).
+  std::optional<OutgoingFrame> nextFrame(uint64_t id);
+  SubscriberStats stats(uint64_t id) const;
+
+  // The volume every subscriber converges to (the encoder's reconstruction), for tests and tools.
+  void reconstruction(std::vector<float>& probes, std::vector<uint8_t>& active) const;
+
+ private:
+  struct Subscriber {
+    uint64_t budget = 0;  // bytes per second, 0 = unlimited
+    double tokens = 0;
+    Clock::time_point refilled;
+    std::vector<uint32_t> held;       // version per brick
+    std::vector<uint32_t> staleSince;  // server frame when the held version became stale
+    std::vector<View> views;
+    std::function<void()> wake;
+    bool waiting = false;
+    uint32_t sequence = 0;
+    SubscriberStats stats;
+  };
+
+  void refill(Subscriber& s, Clock::time_point now) const;
+  std::vector<std::function<void()>> collectWakes();
+
+  HubConfig config_;
+  uint64_t epoch_;
+  mutable std::mutex mutex_;
+  StreamEncoder encoder_;
+  uint32_t frame_ = 0;
+  uint64_t publishedUs_ = 0;
+  uint64_t nextId_ = 1;
+  std::map<uint64_t, Subscriber> subscribers_;
+  std::vector<BrickCandidate> candidates_;
+  std::vector<float> scores_;
+  std::vector<uint32_t> chosen_;
+};
+
+}  // namespace probecast::service

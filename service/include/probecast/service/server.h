@@ -1,0 +1,40 @@
+// The gRPC ProbeStream server: a thin adapter from the ProbeHub to the wire. One reactor per
+// subscriber with one write in flight, so gRPC's flow control paces each stream.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "probecast/service/probe_hub.h"
+
+namespace probecast::service {
+
+struct ServerConfig {
+  std::string listen = "127.0.0.1:0";  // host:port; port 0 picks a free one
+  std::string token;                    // bearer token required on every call; empty = none
+  std::string tlsCertPem;               // PEM contents; with tlsKeyPem enables TLS
+  std::string tlsKeyPem;
+  bool plaintext = false;               // must be set to serve without TLS
+  uint32_t maxSubscribers = 1024;
+  uint32_t maxViews = 64;               // per view update
+  uint32_t maxMessageBytes = 64 * 1024; // largest client message accepted
+};
+
+class ProbeServer {
+ public:
+  // Throws std::runtime_error when the configuration is unsafe or the port cannot be bound.
+  ProbeServer(const ServerConfig& config, ProbeHub& hub);
+  ~ProbeServer();
+  ProbeServer(const ProbeServer&) = delete;
+  ProbeServer& operator=(const ProbeServer&) = delete;
+
+  int port() const;
+  void shutdown();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace probecast::service

@@ -1,0 +1,239 @@
+// The subscriber side: one worker thread per client holding a synchronous bidirectional stream.
+#include "probecast/service/client.h"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <thread>
+
+#include <grpcpp/grpcpp.h>
+
+#include "probecast.grpc.pb.h"
+#include "wire_convert.h"
+
+namespace probecast::service {
+
+namespace pb = probecast::v1;
+using Stream = grpc::ClientReaderWriter<pb::ClientMessage, pb::ServerMessage>;
+
+struct ProbeClient::Impl {
+  ClientConfig config;
+  std::thread worker;
+  std::atomic<bool> stopping{false};
+  mutable std::mutex mutex;  // everything below
+  std::condition_variable wakeup;
+  std::unique_ptr<StreamDecoder> decoder;
+  StreamLayout layout;
+  GridBounds bounds;
+  uint64_t epoch = 0;
+  uint64_t newestServerTimeUs = 0;
+  std::vector<View> views;
+  ClientStats stats;
+  grpc::ClientContext* context = nullptr;
+  Stream* stream = nullptr;
+  std::mutex writeMutex;  // one writer at a time on the stream
+
+  bool write(const pb::ClientMessage& m) {
+    std::lock_guard<std::mutex> w(writeMutex);
+    Stream* s;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      s = stream;
+    }
+    return s && s->Write(m);
+  }
+
+  std::shared_ptr<grpc::Channel> channel() const {
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(256 << 20);
+    std::shared_ptr<grpc::ChannelCredentials> creds;
+    if (config.tls) {
+      grpc::SslCredentialsOptions options;
+      options.pem_root_certs = config.rootCertPem;
+      creds = grpc::SslCredentials(options);
+      if (!config.tlsServerName.empty()) args.SetSslTargetNameOverride(config.tlsServerName);
+    } else {
+      creds = grpc::InsecureChannelCredentials();
+    }
+    return grpc::CreateCustomChannel(config.address, creds, args);
+  }
+
+  void onVolume(const pb::VolumeDescription& v) {
+    StreamLayout l;
+    GridBounds b;
+    std::string why;
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!volumeFromWire(v, l, b, why)) {
+      stats.lastError = "bad volume description: " + why;
+      return;
+    }
+    const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
+                      l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
+    if (!same || v.stream_epoch() != epoch) decoder = std::make_unique<StreamDecoder>(l);  // nothing held is valid
+    layout = l;
+    bounds = b;
+    epoch = v.stream_epoch();
+    stats.connected = true;
+    stats.connects += 1;
+  }
+
+  // Returns false when the connection should be dropped (the server and we disagree on state).
+  bool onFrame(const pb::Frame& f) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!decoder) {
+      stats.lastError = "frame before volume description";
+      return false;
+    }
+    const auto* data = reinterpret_cast<const uint8_t*>(f.payload().data());
+    const CodecStatus st = decoder->apply(data, f.payload().size());
+    if (st != CodecStatus::Ok) {
+      stats.framesRejected += 1;
+      stats.lastError = std::string("frame rejected: ") + codecStatusName(st);
+      return st != CodecStatus::BaseVersionMismatch;  // resubscribe to tell the server what we hold
+    }
+    stats.framesApplied += 1;
+    stats.bytesReceived += f.payload().size();
+    newestServerTimeUs = std::max(newestServerTimeUs, f.server_time_us());
+    return true;
+  }
+
+  pb::ClientMessage hello() {
+    pb::ClientMessage m;
+    pb::Hello* h = m.mutable_hello();
+    h->set_protocol_version(kProtocolVersion);
+    h->set_budget_bytes_per_second(config.budgetBytesPerSecond);
+    h->set_client_name(config.name);
+    std::lock_guard<std::mutex> lock(mutex);
+    if (decoder) {
+      h->set_stream_epoch(epoch);
+      for (uint32_t b = 0; b < brickCount(layout); ++b)
+        if (decoder->brickVersion(b) != 0) {
+          pb::BrickVersion* v = h->add_held();
+          v->set_brick(b);
+          v->set_version(decoder->brickVersion(b));
+        }
+    }
+    return m;
+  }
+
+  void run() {
+    int backoff = config.reconnectMinMs;
+    while (!stopping) {
+      grpc::ClientContext ctx;
+      if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel());
+      std::unique_ptr<Stream> rw = stub->Subscribe(&ctx);
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        context = &ctx;
+        stream = rw.get();
+      }
+      if (stopping) ctx.TryCancel();
+      write(hello());
+      {
+        pb::ClientMessage vm;
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          viewsToWire(views, *vm.mutable_views());
+        }
+        write(vm);
+      }
+      pb::ServerMessage msg;
+      bool gotVolume = false;
+      while (rw->Read(&msg)) {
+        if (msg.has_volume()) {
+          onVolume(msg.volume());
+          gotVolume = true;
+          backoff = config.reconnectMinMs;
+        } else if (msg.has_frame()) {
+          if (!onFrame(msg.frame())) {
+            ctx.TryCancel();
+            break;
+          }
+          pb::ClientMessage ack;
+          ack.mutable_ack()->set_frame_sequence(msg.frame().sequence());
+          write(ack);
+        }
+      }
+      {
+        std::lock_guard<std::mutex> w(writeMutex);  // no writer may hold the stream past this point
+        std::lock_guard<std::mutex> lock(mutex);
+        stream = nullptr;
+        context = nullptr;
+      }
+      const grpc::Status status = rw->Finish();
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        stats.connected = false;
+        if (!status.ok()) stats.lastError = status.error_message();
+        const auto code = status.error_code();
+        if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
+            code == grpc::StatusCode::PERMISSION_DENIED) {
+          stats.fatal = true;
+          return;  // retrying would be refused the same way
+        }
+      }
+      (void)gotVolume;
+      if (stopping) return;
+      std::unique_lock<std::mutex> lock(mutex);
+      wakeup.wait_for(lock, std::chrono::milliseconds(backoff), [&] { return stopping.load(); });
+      backoff = std::min(backoff * 2, config.reconnectMaxMs);
+    }
+  }
+};
+
+ProbeClient::ProbeClient(const ClientConfig& config) : impl_(std::make_unique<Impl>()) { impl_->config = config; }
+
+ProbeClient::~ProbeClient() { stop(); }
+
+void ProbeClient::start() {
+  if (impl_->worker.joinable()) return;
+  impl_->stopping = false;
+  impl_->worker = std::thread([this] { impl_->run(); });
+}
+
+void ProbeClient::stop() {
+  Impl& s = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.stopping = true;
+    if (s.context) s.context->TryCancel();
+  }
+  s.wakeup.notify_all();
+  if (s.worker.joinable()) s.worker.join();
+}
+
+void ProbeClient::setViews(std::vector<View> views) {
+  pb::ClientMessage m;
+  viewsToWire(views, *m.mutable_views());
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->views = std::move(views);
+  }
+  impl_->write(m);
+}
+
+bool ProbeClient::snapshot(VolumeSnapshot& out) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (!impl_->decoder) return false;
+  const uint32_t n = probeCount(impl_->layout);
+  out.layout = impl_->layout;
+  out.bounds = impl_->bounds;
+  out.probes.assign(impl_->decoder->probes(), impl_->decoder->probes() + static_cast<size_t>(n) * kProbeFloats);
+  out.active.assign(impl_->decoder->activeMask(), impl_->decoder->activeMask() + n);
+  out.framesApplied = impl_->stats.framesApplied;
+  out.newestServerTimeUs = impl_->newestServerTimeUs;
+  return true;
+}
+
+ClientStats ProbeClient::stats() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->stats;
+}
+
+void ProbeClient::dropConnection() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (impl_->context) impl_->context->TryCancel();
+}
+
+}  // namespace probecast::service

@@ -1,0 +1,195 @@
+#include "probecast/service/probe_hub.h"
+
+#include <algorithm>
+#include <random>
+
+namespace probecast::service {
+namespace {
+
+uint64_t nowUs() {
+  return static_cast<uint64_t>(
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+
+uint64_t randomEpoch() {
+  std::random_device rd;
+  return (static_cast<uint64_t>(rd()) << 32 | rd()) | 1u;  // never 0 ("no epoch")
+}
+
+}  // namespace
+
+ProbeHub::ProbeHub(const HubConfig& config)
+    : config_(config), epoch_(randomEpoch()), encoder_(config.layout, config.encoder) {}
+
+void ProbeHub::publish(const float* probes, const uint8_t* active) {
+  std::vector<std::function<void()>> wakes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    encoder_.update(probes, active);
+    ++frame_;
+    publishedUs_ = nowUs();
+    const uint32_t bricks = brickCount(config_.layout);
+    for (auto& [id, s] : subscribers_)
+      for (uint32_t b = 0; b < bricks; ++b)
+        if (s.held[b] != encoder_.brickVersion(b) && s.staleSince[b] == UINT32_MAX) s.staleSince[b] = frame_;
+    wakes = collectWakes();
+  }
+  for (auto& w : wakes) w();
+}
+
+void ProbeHub::tick() {
+  std::vector<std::function<void()>> wakes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    wakes = collectWakes();
+  }
+  for (auto& w : wakes) w();
+}
+
+std::vector<std::function<void()>> ProbeHub::collectWakes() {
+  std::vector<std::function<void()>> wakes;
+  for (auto& [id, s] : subscribers_)
+    if (s.waiting && s.wake) {
+      s.waiting = false;
+      wakes.push_back(s.wake);
+    }
+  return wakes;
+}
+
+uint32_t ProbeHub::serverFrame() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return frame_;
+}
+
+uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
+                                 std::function<void()> wake) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const uint32_t bricks = brickCount(config_.layout);
+  Subscriber s;
+  s.budget = budgetBytesPerSecond;
+  s.tokens = static_cast<double>(budgetBytesPerSecond) * config_.burstSeconds;
+  s.refilled = Clock::now();
+  s.held.assign(bricks, 0);
+  s.staleSince.assign(bricks, UINT32_MAX);
+  if (epoch == epoch_)
+    for (const HeldBrick& h : held)
+      if (h.brick < bricks && h.version <= encoder_.brickVersion(h.brick)) s.held[h.brick] = h.version;
+  for (uint32_t b = 0; b < bricks; ++b)
+    if (s.held[b] != encoder_.brickVersion(b)) s.staleSince[b] = frame_;
+  s.wake = std::move(wake);
+  const uint64_t id = nextId_++;
+  subscribers_.emplace(id, std::move(s));
+  return id;
+}
+
+void ProbeHub::removeSubscriber(uint64_t id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  subscribers_.erase(id);
+}
+
+void ProbeHub::setViews(uint64_t id, std::vector<View> views) {
+  std::function<void()> wake;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = subscribers_.find(id);
+    if (it == subscribers_.end()) return;
+    it->second.views = std::move(views);
+    if (it->second.waiting) {  // priorities changed: it may now want something else first
+      it->second.waiting = false;
+      wake = it->second.wake;
+    }
+  }
+  if (wake) wake();
+}
+
+size_t ProbeHub::subscriberCount() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return subscribers_.size();
+}
+
+void ProbeHub::refill(Subscriber& s, Clock::time_point now) const {
+  if (s.budget == 0) return;
+  const double dt = std::chrono::duration<double>(now - s.refilled).count();
+  s.refilled = now;
+  const double cap = static_cast<double>(s.budget) * config_.burstSeconds;
+  s.tokens = std::min(cap, s.tokens + dt * static_cast<double>(s.budget));
+}
+
+std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = subscribers_.find(id);
+  if (it == subscribers_.end()) return std::nullopt;
+  Subscriber& s = it->second;
+  const uint32_t bricks = brickCount(config_.layout);
+  candidates_.assign(bricks, BrickCandidate{});
+  uint32_t behind = 0;
+  for (uint32_t b = 0; b < bricks; ++b) {
+    const uint32_t current = encoder_.brickVersion(b);
+    if (s.held[b] == current) continue;
+    ++behind;
+    BrickCandidate& c = candidates_[b];
+    c.change = std::max(encoder_.changeSince(b, s.held[b]), 1e-3f);
+    c.ageFrames = frame_ - std::min(frame_, s.staleSince[b]);
+    c.bytes = static_cast<uint32_t>(encoder_.sectionFor(b, s.held[b]).size());
+  }
+  s.stats.bricksBehind = behind;
+  if (behind == 0) {
+    s.waiting = true;
+    return std::nullopt;
+  }
+  refill(s, Clock::now());
+  scores_.resize(bricks);
+  scoreBricks(config_.layout, config_.bounds, s.views, candidates_, config_.priority, scores_.data());
+  const double cap = static_cast<double>(s.budget) * config_.burstSeconds;
+  // A full bucket may always send the best brick, so one larger than the bucket still goes out.
+  uint64_t allowance = s.budget == 0 ? UINT64_MAX : static_cast<uint64_t>(std::max(0.0, s.tokens));
+  chosen_.resize(bricks);
+  size_t n = selectBricks(scores_, candidates_, allowance, chosen_.data());
+  if (n == 0 && s.budget != 0 && s.tokens >= cap) {
+    uint32_t best = 0;
+    for (uint32_t b = 1; b < bricks; ++b)
+      if (scores_[b] > scores_[best]) best = b;
+    if (scores_[best] > 0) {
+      chosen_[0] = best;
+      n = 1;
+    }
+  }
+  if (n == 0) {
+    s.waiting = true;  // the producer's tick refills and wakes it
+    return std::nullopt;
+  }
+  OutgoingFrame frame;
+  std::vector<std::span<const uint8_t>> sections;
+  sections.reserve(n);
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t b = chosen_[k];
+    const bool delta = s.held[b] + 1 == encoder_.brickVersion(b);
+    sections.push_back(encoder_.sectionFor(b, s.held[b]));
+    (delta ? frame.deltas : frame.keyframes) += 1;
+    s.held[b] = encoder_.brickVersion(b);
+    s.staleSince[b] = UINT32_MAX;
+  }
+  frame.sequence = ++s.sequence;
+  frame.serverTimeUs = publishedUs_;
+  writeFrame(config_.layout, frame.sequence, sections, frame.payload);
+  if (s.budget != 0) s.tokens -= static_cast<double>(frame.payload.size());
+  s.stats.bytesSent += frame.payload.size();
+  s.stats.framesSent += 1;
+  s.stats.bricksBehind = behind - static_cast<uint32_t>(n);
+  return frame;
+}
+
+SubscriberStats ProbeHub::stats(uint64_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = subscribers_.find(id);
+  return it == subscribers_.end() ? SubscriberStats{} : it->second.stats;
+}
+
+void ProbeHub::reconstruction(std::vector<float>& probes, std::vector<uint8_t>& active) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const uint32_t n = probeCount(config_.layout);
+  probes.assign(encoder_.reconstruction(), encoder_.reconstruction() + static_cast<size_t>(n) * kProbeFloats);
+  active.assign(encoder_.activeMask(), encoder_.activeMask() + n);
+}
+
+}  // namespace probecast::service

@@ -1,0 +1,84 @@
+#include "wire_convert.h"
+
+#include <cmath>
+
+namespace probecast::service {
+
+const char* const kShConvention =
+    "real SH L0-L2 without the Condon-Shortley phase, index l(l+1)+m, 27 floats per probe coefficient-major "
+    "(RGB per coefficient), incident radiance";
+
+void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t epoch, v1::VolumeDescription& out) {
+  out.set_protocol_version(kProtocolVersion);
+  out.set_codec_format_version(kFormatVersion);
+  out.set_grid_x(layout.grid[0]);
+  out.set_grid_y(layout.grid[1]);
+  out.set_grid_z(layout.grid[2]);
+  out.set_brick_size(layout.brickDim);
+  out.set_representation(static_cast<v1::Representation>(layout.repr));
+  out.clear_bounds_min();
+  out.clear_bounds_max();
+  for (int a = 0; a < 3; ++a) {
+    out.add_bounds_min(bounds.min[a]);
+    out.add_bounds_max(bounds.max[a]);
+  }
+  out.set_sh_convention(kShConvention);
+  out.set_stream_epoch(epoch);
+}
+
+bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds, std::string& why) {
+  if (in.protocol_version() != kProtocolVersion) return why = "server speaks another protocol version", false;
+  if (in.codec_format_version() != kFormatVersion) return why = "server sends another codec format version", false;
+  if (in.grid_x() > kMaxGridDim || in.grid_y() > kMaxGridDim || in.grid_z() > kMaxGridDim || in.brick_size() > 255)
+    return why = "volume grid out of range", false;
+  StreamLayout l;
+  l.grid[0] = static_cast<uint16_t>(in.grid_x());
+  l.grid[1] = static_cast<uint16_t>(in.grid_y());
+  l.grid[2] = static_cast<uint16_t>(in.grid_z());
+  l.brickDim = static_cast<uint8_t>(in.brick_size());
+  l.repr = static_cast<Representation>(in.representation());
+  if (!isValidRepresentation(static_cast<uint8_t>(in.representation())) || !isValidLayout(l))
+    return why = "volume layout not valid", false;
+  if (in.bounds_min_size() != 3 || in.bounds_max_size() != 3) return why = "volume bounds need 3 values each", false;
+  for (int a = 0; a < 3; ++a) {
+    bounds.min[a] = in.bounds_min(a);
+    bounds.max[a] = in.bounds_max(a);
+    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a])) return why = "volume bounds not finite", false;
+  }
+  layout = l;
+  return true;
+}
+
+bool viewsFromWire(const v1::ViewUpdate& in, uint32_t maxViews, std::vector<View>& out, std::string& why) {
+  if (static_cast<uint32_t>(in.views_size()) > maxViews)
+    return why = std::to_string(in.views_size()) + " views exceed the limit of " + std::to_string(maxViews), false;
+  out.clear();
+  for (const v1::View& v : in.views()) {
+    if (v.view_projection_size() != 16) return why = "a view_projection must have 16 floats", false;
+    View view{};
+    for (int i = 0; i < 16; ++i) {
+      view.viewProj[i] = v.view_projection(i);
+      if (!std::isfinite(view.viewProj[i])) return why = "a view_projection holds NaN or Inf", false;
+    }
+    view.eye[0] = v.eye_x();
+    view.eye[1] = v.eye_y();
+    view.eye[2] = v.eye_z();
+    for (float e : view.eye)
+      if (!std::isfinite(e)) return why = "an eye position holds NaN or Inf", false;
+    out.push_back(view);
+  }
+  return true;
+}
+
+void viewsToWire(const std::vector<View>& views, v1::ViewUpdate& out) {
+  out.clear_views();
+  for (const View& v : views) {
+    v1::View* w = out.add_views();
+    for (float f : v.viewProj) w->add_view_projection(f);
+    w->set_eye_x(v.eye[0]);
+    w->set_eye_y(v.eye[1]);
+    w->set_eye_z(v.eye[2]);
+  }
+}
+
+}  // namespace probecast::service

@@ -1,0 +1,415 @@
+// ProbeStream over real gRPC on 127.0.0.1: convergence of many subscribers, late join, network
+// faults and resume, a stalled subscriber, authentication, malformed input, TLS. Every wait is
+// bounded and every test stops its own threads.
+#include <gtest/gtest.h>
+
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "probecast.grpc.pb.h"
+#include "probecast/service/client.h"
+#include "probecast/service/server.h"
+#include "test_probes.h"
+
+namespace probecast::service {
+namespace {
+
+namespace pb = probecast::v1;
+using namespace std::chrono_literals;
+
+constexpr char kToken[] = "test-token";
+
+HubConfig volumeConfig() {
+  // 16 × 4 × 16 probes (the moving-light generator's layout), bricks of 4: 16 bricks.
+  HubConfig c;
+  c.layout.grid[0] = 16;
+  c.layout.grid[1] = 4;
+  c.layout.grid[2] = 16;
+  c.layout.brickDim = 4;
+  c.layout.repr = Representation::Zh3;
+  c.bounds.min[0] = -2.0f;
+  c.bounds.max[0] = 1.5f;
+  c.bounds.max[1] = 1.5f;
+  c.bounds.min[2] = -2.0f;
+  c.bounds.max[2] = 5.5f;
+  return c;
+}
+
+// Publishes `frames` moving-light frames, then keeps ticking until stopped.
+class Producer {
+ public:
+  Producer(ProbeHub& hub, int frames, std::chrono::milliseconds interval) : hub_(hub) {
+    thread_ = std::thread([this, frames, interval] {
+      std::mt19937 rng(5);
+      for (int f = 0; !stop_; ++f) {
+        if (f < frames) hub_.publish(test::movingLightFrame(1024, f, 0.01f, rng).data(), nullptr);
+        else hub_.tick();
+        published_ = std::min(f + 1, frames);
+        std::this_thread::sleep_for(f < frames ? interval : 10ms);
+      }
+    });
+  }
+  ~Producer() { stop(); }
+  void stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  int published() const { return published_; }
+
+ private:
+  ProbeHub& hub_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> published_{0};
+  std::thread thread_;
+};
+
+ServerConfig plaintextConfig() {
+  ServerConfig c;
+  c.listen = "127.0.0.1:0";
+  c.token = kToken;
+  c.plaintext = true;
+  return c;
+}
+
+ClientConfig clientFor(int port, uint64_t budget = 0) {
+  ClientConfig c;
+  c.address = "127.0.0.1:" + std::to_string(port);
+  c.token = kToken;
+  c.budgetBytesPerSecond = budget;
+  return c;
+}
+
+bool matchesServer(const ProbeClient& client, const ProbeHub& hub) {
+  VolumeSnapshot snap;
+  if (!client.snapshot(snap)) return false;
+  std::vector<float> probes;
+  std::vector<uint8_t> active;
+  hub.reconstruction(probes, active);
+  return snap.probes.size() == probes.size() &&
+         std::memcmp(snap.probes.data(), probes.data(), probes.size() * sizeof(float)) == 0 && snap.active == active;
+}
+
+template <typename Pred>
+bool waitFor(Pred pred, std::chrono::milliseconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < end) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return pred();
+}
+
+View viewAt(float x, float z) {
+  // A narrow orthographic view down −z around (x, 0.75), depth 0..40 m from an eye at z + 20.
+  View v{};
+  v.viewProj[0] = 1.0f;
+  v.viewProj[5] = 1.0f;
+  v.viewProj[10] = -1.0f / 40.0f;
+  v.viewProj[12] = -x;
+  v.viewProj[13] = -0.75f;
+  v.viewProj[14] = (z + 20.0f) / 40.0f;
+  v.viewProj[15] = 1.0f;
+  v.eye[0] = x;
+  v.eye[1] = 0.75f;
+  v.eye[2] = z + 20.0f;
+  return v;
+}
+
+TEST(Service, TwentySubscribersConvergeBitIdentical) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 30, 20ms);
+  std::vector<std::unique_ptr<ProbeClient>> clients;
+  for (int i = 0; i < 20; ++i) {
+    const uint64_t budget = i % 3 == 0 ? 0 : 40000u + 10000u * static_cast<uint64_t>(i);
+    clients.push_back(std::make_unique<ProbeClient>(clientFor(server.port(), budget)));
+    clients.back()->setViews({viewAt(-2.0f + 0.2f * static_cast<float>(i), 0.0f)});
+    clients.back()->start();
+  }
+  ASSERT_TRUE(waitFor([&] { return producer.published() == 30; }, 10s));
+  for (size_t i = 0; i < clients.size(); ++i)
+    EXPECT_TRUE(waitFor([&] { return matchesServer(*clients[i], hub); }, 20s)) << "client " << i;
+  for (auto& c : clients) {
+    EXPECT_EQ(c->stats().framesRejected, 0u);
+    EXPECT_EQ(c->stats().connects, 1u);
+  }
+}
+
+TEST(Service, LateJoinerGetsKeyframesAndConverges) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 40, 15ms);
+  ASSERT_TRUE(waitFor([&] { return producer.published() >= 20; }, 10s));
+  ProbeClient late(clientFor(server.port()));
+  late.start();
+  ASSERT_TRUE(waitFor([&] { return producer.published() == 40; }, 10s));
+  EXPECT_TRUE(waitFor([&] { return matchesServer(late, hub); }, 10s));
+}
+
+TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {
+  ProbeHub hub(volumeConfig());
+  auto server = std::make_unique<ProbeServer>(plaintextConfig(), hub);
+  const int port = server->port();
+  Producer producer(hub, 1000000, 20ms);  // lighting keeps changing throughout
+  ClientConfig cc = clientFor(port);
+  cc.reconnectMaxMs = 200;
+  ProbeClient client(cc);
+  client.start();
+  ASSERT_TRUE(waitFor([&] { return client.stats().framesApplied >= 10; }, 10s));
+
+  // The server goes away: lighting stays the last volume, it never goes black.
+  server.reset();
+  ASSERT_TRUE(waitFor([&] { return !client.stats().connected; }, 5s));
+  VolumeSnapshot during;
+  ASSERT_TRUE(client.snapshot(during));
+  double energy = 0;
+  for (float v : during.probes) energy += std::fabs(v);
+  EXPECT_GT(energy, 0.0);
+  std::this_thread::sleep_for(300ms);  // a few reconnect attempts fail meanwhile
+  VolumeSnapshot later;
+  ASSERT_TRUE(client.snapshot(later));
+  EXPECT_EQ(later.probes, during.probes);
+
+  // It comes back on the same port with the same hub (epoch): the client resumes.
+  ServerConfig again = plaintextConfig();
+  again.listen = "127.0.0.1:" + std::to_string(port);
+  server = std::make_unique<ProbeServer>(again, hub);
+  ASSERT_TRUE(waitFor([&] { return client.stats().connects >= 2; }, 10s));
+  const uint64_t bytesAtResume = client.stats().bytesReceived;
+  ProbeClient fresh(clientFor(port));  // joins at the same moment, holding nothing
+  fresh.start();
+  producer.stop();  // freeze the lighting so both can finish
+  hub.tick();
+  ASSERT_TRUE(waitFor([&] { return matchesServer(client, hub); }, 10s));
+  ASSERT_TRUE(waitFor([&] { return matchesServer(fresh, hub); }, 10s));
+  // The resumed client sent its held versions: it needed no more than a newcomer (who got every
+  // brick as a keyframe) and usually much less.
+  EXPECT_LE(client.stats().bytesReceived - bytesAtResume, fresh.stats().bytesReceived);
+  EXPECT_EQ(client.stats().framesRejected, 0u);
+}
+
+TEST(Service, StalledSubscriberDoesNotDelayOthers) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  // A subscriber that says hello and then never reads: flow control stops its stream only.
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials());
+  auto stub = pb::ProbeStream::NewStub(channel);
+  grpc::ClientContext stalledCtx;
+  stalledCtx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  auto stalled = stub->Subscribe(&stalledCtx);
+  pb::ClientMessage hello;
+  hello.mutable_hello()->set_protocol_version(1);
+  ASSERT_TRUE(stalled->Write(hello));
+
+  Producer producer(hub, 60, 10ms);
+  std::vector<std::unique_ptr<ProbeClient>> clients;
+  for (int i = 0; i < 4; ++i) {
+    clients.push_back(std::make_unique<ProbeClient>(clientFor(server.port())));
+    clients.back()->start();
+  }
+  ASSERT_TRUE(waitFor([&] { return producer.published() == 60; }, 10s));
+  for (auto& c : clients) EXPECT_TRUE(waitFor([&] { return matchesServer(*c, hub); }, 10s));
+  // Frame age of the others: their newest lighting is the last published frame.
+  std::this_thread::sleep_for(100ms);
+  for (auto& c : clients) EXPECT_EQ(c->stats().framesRejected, 0u);
+  stalledCtx.TryCancel();
+  stalled->Finish();
+}
+
+TEST(Service, WrongTokenIsUnauthenticatedAndGetsNoPayload) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 5, 10ms);
+  auto stub = pb::ProbeStream::NewStub(
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", "Bearer nope");
+  auto stream = stub->Subscribe(&ctx);
+  pb::ClientMessage hello;
+  hello.mutable_hello()->set_protocol_version(1);
+  stream->Write(hello);
+  pb::ServerMessage msg;
+  EXPECT_FALSE(stream->Read(&msg));
+  EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  grpc::ClientContext unary;
+  pb::VolumeDescription volume;
+  EXPECT_EQ(stub->GetVolume(&unary, pb::GetVolumeRequest(), &volume).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  ClientConfig bad = clientFor(server.port());
+  bad.token = "wrong";
+  ProbeClient client(bad);
+  client.start();
+  EXPECT_TRUE(waitFor([&] { return client.stats().fatal; }, 5s));
+  VolumeSnapshot snap;
+  EXPECT_FALSE(client.snapshot(snap));
+}
+
+// Sends `first` (and `second` if given) and returns the stream's final status.
+grpc::Status statusAfter(pb::ProbeStream::Stub& stub, const pb::ClientMessage& first,
+                         const pb::ClientMessage* second = nullptr) {
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  ctx.set_deadline(std::chrono::system_clock::now() + 5s);
+  auto stream = stub.Subscribe(&ctx);
+  stream->Write(first);
+  if (second) stream->Write(*second);
+  stream->WritesDone();
+  pb::ServerMessage msg;
+  while (stream->Read(&msg)) {
+  }
+  return stream->Finish();
+}
+
+TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {
+  ProbeHub hub(volumeConfig());
+  ServerConfig sc = plaintextConfig();
+  sc.maxViews = 8;
+  ProbeServer server(sc, hub);
+  Producer producer(hub, 30, 15ms);
+  ProbeClient good(clientFor(server.port()));
+  good.start();
+  auto stub = pb::ProbeStream::NewStub(
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
+
+  pb::ClientMessage hello;
+  hello.mutable_hello()->set_protocol_version(1);
+  pb::ClientMessage views;  // a first message that is not hello
+  views.mutable_views()->add_views()->add_view_projection(1.0f);
+  EXPECT_EQ(statusAfter(*stub, views).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  pb::ClientMessage v2 = hello;
+  v2.mutable_hello()->set_protocol_version(2);
+  const grpc::Status wrongVersion = statusAfter(*stub, v2);
+  EXPECT_EQ(wrongVersion.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(wrongVersion.error_message().find("protocol version"), std::string::npos);
+
+  pb::ClientMessage shortMatrix;  // 15 floats
+  for (int i = 0; i < 15; ++i) shortMatrix.mutable_views()->mutable_views()->Add()->add_view_projection(0.0f);
+  shortMatrix.mutable_views()->clear_views();
+  pb::View* v = shortMatrix.mutable_views()->add_views();
+  for (int i = 0; i < 15; ++i) v->add_view_projection(1.0f);
+  EXPECT_EQ(statusAfter(*stub, hello, &shortMatrix).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  pb::ClientMessage nan;
+  pb::View* w = nan.mutable_views()->add_views();
+  for (int i = 0; i < 16; ++i) w->add_view_projection(i == 5 ? std::nanf("") : 1.0f);
+  EXPECT_EQ(statusAfter(*stub, hello, &nan).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  pb::ClientMessage many;
+  for (int k = 0; k < 9; ++k) {
+    pb::View* m = many.mutable_views()->add_views();
+    for (int i = 0; i < 16; ++i) m->add_view_projection(1.0f);
+  }
+  EXPECT_EQ(statusAfter(*stub, hello, &many).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  pb::ClientMessage oversized = hello;
+  oversized.mutable_hello()->set_client_name(std::string(100 * 1024, 'x'));
+  EXPECT_EQ(statusAfter(*stub, oversized).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  pb::ClientMessage wrongRepr = hello;
+  wrongRepr.mutable_hello()->set_representation(pb::REPRESENTATION_L1);
+  EXPECT_EQ(statusAfter(*stub, wrongRepr).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  ASSERT_TRUE(waitFor([&] { return producer.published() == 30; }, 10s));
+  EXPECT_TRUE(waitFor([&] { return matchesServer(good, hub); }, 10s));
+  EXPECT_EQ(good.stats().connects, 1u);
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(Service, TlsRoundTripAndNoAccidentalPlaintext) {
+  const std::string dir = PROBECAST_TEST_TMP;
+  const std::string key = dir + "/tls-key.pem", cert = dir + "/tls-cert.pem";
+  const std::string cmd = "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
+                          "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " + key + " -out " + cert +
+                          " >/dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << "openssl could not make a test certificate";
+  ProbeHub hub(volumeConfig());
+  ServerConfig unsafe;
+  unsafe.token = kToken;  // neither TLS nor plaintext asked for
+  EXPECT_THROW(ProbeServer(unsafe, hub), std::runtime_error);
+
+  ServerConfig sc;
+  sc.token = kToken;
+  sc.tlsCertPem = readFile(cert);
+  sc.tlsKeyPem = readFile(key);
+  ProbeServer server(sc, hub);
+  Producer producer(hub, 10, 10ms);
+  ClientConfig cc = clientFor(server.port());
+  cc.tls = true;
+  cc.rootCertPem = sc.tlsCertPem;
+  cc.tlsServerName = "localhost";
+  ProbeClient client(cc);
+  client.start();
+  ASSERT_TRUE(waitFor([&] { return producer.published() == 10; }, 10s));
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, hub); }, 10s));
+  // A plaintext client cannot talk to the TLS port.
+  ProbeClient plain(clientFor(server.port()));
+  plain.start();
+  std::this_thread::sleep_for(300ms);
+  VolumeSnapshot snap;
+  EXPECT_FALSE(plain.snapshot(snap));
+}
+
+TEST(Service, GetVolumeAndHealth) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials());
+  auto stub = pb::ProbeStream::NewStub(channel);
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  pb::VolumeDescription v;
+  ASSERT_TRUE(stub->GetVolume(&ctx, pb::GetVolumeRequest(), &v).ok());
+  EXPECT_EQ(v.grid_x(), 16u);
+  EXPECT_EQ(v.grid_z(), 16u);
+  EXPECT_EQ(v.representation(), pb::REPRESENTATION_ZH3);
+  EXPECT_EQ(v.stream_epoch(), hub.epoch());
+  EXPECT_NE(v.sh_convention().find("Condon-Shortley"), std::string::npos);
+  // The standard health service answers for the ProbeStream service.
+  grpc::ByteBuffer response;
+  grpc::ClientContext hctx;
+  grpc::GenericStub generic(channel);
+  // grpc.health.v1.HealthCheckRequest { service = "probecast.v1.ProbeStream" } encoded by hand:
+  const std::string svc = "probecast.v1.ProbeStream";
+  std::string req = std::string(1, '\x0a') + static_cast<char>(svc.size()) + svc;
+  grpc::Slice slice(req);
+  grpc::ByteBuffer request(&slice, 1);
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  grpc::Status status;
+  generic.UnaryCall(&hctx, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request, &response,
+                    [&](grpc::Status s) {
+                      std::lock_guard<std::mutex> lock(m);
+                      status = s;
+                      done = true;
+                      cv.notify_all();
+                    });
+  std::unique_lock<std::mutex> lock(m);
+  ASSERT_TRUE(cv.wait_for(lock, 5s, [&] { return done; }));
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  std::vector<grpc::Slice> slices;
+  ASSERT_TRUE(response.Dump(&slices).ok());
+  std::string body;
+  for (auto& s : slices) body.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  EXPECT_EQ(body, std::string("\x08\x01", 2));  // status: SERVING
+}
+
+}  // namespace
+}  // namespace probecast::service
