@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   probecast::app::addBenchCommands(app, exitCode);
   probecast::app::addBakeCommand(app, exitCode);
   probecast::app::addReferenceCommand(app, exitCode);
+  probecast::app::addServeCommands(app, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

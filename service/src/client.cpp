@@ -165,7 +165,7 @@ struct ProbeClient::Impl {
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
-        if (!status.ok()) stats.lastError = status.error_message();
+        if (!status.ok() && !stopping) stats.lastError = status.error_message();
         const auto code = status.error_code();
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# serve a baked volume over loopback, subscribe, and compare what arrived with what was served.
+# Bounded: the server stops itself after 20 s; the script kills it when done.
+set -euo pipefail
+probecast=$1
+work=$2
+mkdir -p "$work"
+port=$((20000 + RANDOM % 20000))
+"$probecast" bake --scene builtin:cornell --grid 6,6,6 --spp 32 --updates 1 --out "$work/served.pcpv" >/dev/null
+"$probecast" serve --probes "$work/served.pcpv" --repr l2 --deadzone 0 --listen "127.0.0.1:$port" --plaintext \
+  --token s3cret --seconds 20 >"$work/serve.log" 2>&1 &
+server=$!
+trap 'kill $server 2>/dev/null || true' EXIT
+for _ in $(seq 50); do grep -q "on port" "$work/serve.log" && break; sleep 0.1; done
+"$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1 --out "$work/received.pcpv"
+if "$probecast" subscribe --connect "127.0.0.1:$port" --token wrong --seconds 1 2>"$work/refused.log"; then
+  echo "a wrong token was accepted"; exit 1
+fi
+grep -q "wrong bearer token" "$work/refused.log"
+# The received volume is the l2 decoding of the served one: same size, within quantisation error.
+python3 - "$work/served.pcpv" "$work/received.pcpv" <<'PY'
+import struct, sys
+def load(p):
+    b = open(p, 'rb').read()
+    n = struct.unpack_from('<3I', b, 8)
+    count = n[0] * n[1] * n[2]
+    f = struct.unpack_from('<%df' % (count * 27), b, 52)
+    return count, f, b[52 + count * 108: 52 + count * 109]
+ca, fa, ma = load(sys.argv[1]); cb, fb, mb = load(sys.argv[2])
+assert ca == cb and ma == mb, "grid or active mask differ"
+num = sum((x - y) ** 2 for x, y in zip(fa, fb)); den = sum(x * x for x in fa)
+rel = (num / den) ** 0.5
+print("relative coefficient error %.4f" % rel)
+assert rel < 0.02, rel
+PY
+echo "serve/subscribe round trip ok"
