@@ -9,6 +9,7 @@
 #include "codec_bench.h"
 #include "commands.h"
 #include "scene_options.h"
+#include "stream_bench.h"
 #include "update_bench.h"
 
 namespace probecast::app {
@@ -138,6 +139,45 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     if (!uo->chart.empty()) {
       writeTextFile(uo->chart, r.svg);
       fmt::print("wrote {}\n", uo->chart);
+    }
+    exitCode = 0;
+  });
+
+  CLI::App* stream = bench->add_subcommand("stream", "the service under N subscribers on loopback");
+  struct StreamOptions {
+    std::string json, chart;
+    bench::StreamBenchOptions bench;
+  };
+  auto so = std::make_shared<StreamOptions>();
+  stream->add_option("--subscribers", so->bench.subscribers, "subscriber counts to run, e.g. 1,10,100,1000")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 5000));
+  stream->add_option("--hz", so->bench.hz, "lighting updates per second")->check(CLI::Range(0.5, 240.0));
+  stream->add_option("--seconds", so->bench.seconds, "measured time per subscriber count")->check(CLI::Range(2.0, 3600.0));
+  stream->add_option("--budget", so->bench.budgetBytesPerSecond, "bytes per second per subscriber (0 = unlimited)");
+  stream->add_option("--repr", so->bench.repr, "l1, zh3h, zh3, l2 or fp16")
+      ->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
+  stream->add_option("--json", so->json, "write the results as JSON here")->required();
+  stream->add_option("--chart", so->chart, "write an SVG chart here");
+  CLI::App* streamServer = bench->add_subcommand("stream-server", "");  // internal: bench stream's server process
+  streamServer->group("");
+  auto ss = std::make_shared<std::tuple<double, double, std::string>>(10.0, 5.0, "zh3");
+  streamServer->add_option("--hz", std::get<0>(*ss))->check(CLI::Range(0.5, 240.0));
+  streamServer->add_option("--seconds", std::get<1>(*ss))->check(CLI::Range(1.0, 3600.0));
+  streamServer->add_option("--repr", std::get<2>(*ss));
+  streamServer->callback([ss, &exitCode] {
+    exitCode = bench::runStreamBenchServer(std::get<0>(*ss), std::get<1>(*ss), std::get<2>(*ss));
+  });
+  stream->callback([so, &exitCode] {
+    so->bench.command = commandLine();
+    so->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
+    fmt::print("{}", r.table);
+    writeTextFile(so->json, r.json.dump(2) + "\n");
+    fmt::print("wrote {}\n", so->json);
+    if (!so->chart.empty()) {
+      writeTextFile(so->chart, r.svg);
+      fmt::print("wrote {}\n", so->chart);
     }
     exitCode = 0;
   });

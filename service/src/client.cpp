@@ -27,6 +27,8 @@ struct ProbeClient::Impl {
   GridBounds bounds;
   uint64_t epoch = 0;
   uint64_t newestServerTimeUs = 0;
+  std::vector<uint32_t> latencies;  // ring of the most recent 4096
+  size_t latencyNext = 0;
   std::vector<View> views;
   ClientStats stats;
   grpc::ClientContext* context = nullptr;
@@ -93,6 +95,12 @@ struct ProbeClient::Impl {
     }
     stats.framesApplied += 1;
     stats.bytesReceived += f.payload().size();
+    const uint64_t now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                                   std::chrono::system_clock::now().time_since_epoch())
+                                                   .count());
+    const uint32_t latency = static_cast<uint32_t>(std::min<uint64_t>(now - std::min(now, f.server_time_us()), UINT32_MAX));
+    if (latencies.size() < 4096) latencies.push_back(latency);
+    else latencies[latencyNext++ % 4096] = latency;
     newestServerTimeUs = std::max(newestServerTimeUs, f.server_time_us());
     return true;
   }
@@ -229,6 +237,11 @@ bool ProbeClient::snapshot(VolumeSnapshot& out) const {
 ClientStats ProbeClient::stats() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   return impl_->stats;
+}
+
+std::vector<uint32_t> ProbeClient::latenciesUs() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->latencies;
 }
 
 void ProbeClient::dropConnection() {

@@ -67,13 +67,13 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   void OnWriteDone(bool ok) override {
     std::lock_guard<std::mutex> lock(link_->mutex);
     writing_ = false;
-    if (!ok) {
-      finishLocked(grpc::Status(grpc::StatusCode::UNAVAILABLE, "write failed"));
-      return;
-    }
-    if (pendingFinish_) {
+    if (pendingFinish_) {  // a finish waited for this write, whether it went through or not
       finished_ = true;
       Finish(*pendingFinish_);
+      return;
+    }
+    if (!ok) {
+      finishLocked(grpc::Status(grpc::StatusCode::UNAVAILABLE, "write failed"));
       return;
     }
     tryWriteLocked();

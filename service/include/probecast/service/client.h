@@ -60,6 +60,9 @@ class ProbeClient {
   ClientStats stats() const;
   // Cuts the current connection (as a network fault would); the client reconnects and resumes.
   void dropConnection();
+  // Produce→decoded latencies of the frames applied so far (microseconds, server and client
+  // clocks: meaningful on one machine or with synchronised clocks), the most recent 4096.
+  std::vector<uint32_t> latenciesUs() const;
 
  private:
   struct Impl;

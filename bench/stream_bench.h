@@ -1,0 +1,34 @@
+// `probecast bench stream`: the service under N subscribers on loopback, with a moving light.
+// The server (hub, encoder, gRPC) runs in a child process so its CPU time is its own.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace probecast::bench {
+
+struct StreamBenchOptions {
+  std::vector<int> subscribers = {1, 10, 100};
+  double hz = 10.0;
+  double seconds = 5.0;
+  uint64_t budgetBytesPerSecond = 0;  // per subscriber; 0 = unlimited
+  std::string repr = "zh3";
+  std::string command;
+  std::function<void(const std::string&)> progress;
+};
+
+struct StreamBenchResult {
+  nlohmann::json json;
+  std::string table;
+  std::string svg;
+};
+
+StreamBenchResult runStreamBench(const StreamBenchOptions& options);
+// The server process of the benchmark (`probecast bench stream-server`): prints "port N", serves
+// for `seconds`, prints "report CPU_SECONDS ENCODE_MS_PER_FRAME FRAMES".
+int runStreamBenchServer(double hz, double seconds, const std::string& repr);
+
+}  // namespace probecast::bench
