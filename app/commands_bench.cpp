@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "codec_bench.h"
+#include "probecast/codec/probe_file.h"
 #include "commands.h"
 #include "scene_options.h"
 #include "stream_bench.h"
@@ -64,15 +65,18 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   CLI::App* codec = bench->add_subcommand("codec", "codec size against irradiance accuracy, speed, and temporal coding");
 
   struct Options {
-    std::string envmaps, json, chart;
+    std::string envmaps, probes, json, chart;
     std::vector<int> deadzones{0, 1, 2, 4, 8};
     int frames = 60;
     int normals = 2048;
   };
   auto opt = std::make_shared<Options>();
-  codec->add_option("--envmaps", opt->envmaps, "folder of equirect .hdr/.exr maps (top row +Y)")
-      ->required()
-      ->check(CLI::ExistingDirectory);
+  auto* envmaps = codec->add_option("--envmaps", opt->envmaps, "folder of equirect .hdr/.exr maps (top row +Y)")
+                      ->check(CLI::ExistingDirectory);
+  auto* probes = codec->add_option("--probes", opt->probes, "a baked probe volume file (probecast bake) to measure too")
+                     ->check(CLI::ExistingFile);
+  (void)envmaps;
+  (void)probes;
   codec->add_option("--json", opt->json, "write the results as JSON here")->required();
   codec->add_option("--chart", opt->chart, "write an SVG chart of error against bytes here");
   codec->add_option("--deadzones", opt->deadzones, "dead-zones (quantisation steps) for the temporal part")
@@ -82,8 +86,18 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   codec->add_option("--normals", opt->normals, "directions for the brute-force irradiance")->check(CLI::Range(16, 1 << 20));
 
   codec->callback([opt, &exitCode] {
+    if (opt->envmaps.empty() && opt->probes.empty())
+      throw std::runtime_error("give --envmaps DIR and/or --probes FILE");
     bench::CodecBenchOptions options;
-    options.maps = loadEnvMapDir(opt->envmaps);
+    if (!opt->envmaps.empty()) options.maps = loadEnvMapDir(opt->envmaps);
+    if (!opt->probes.empty()) {
+      ProbeVolume volume;
+      std::string error;
+      if (!readProbeFile(opt->probes, volume, error)) throw std::runtime_error(error);
+      options.volumeName = opt->probes;
+      options.volumeProbes = std::move(volume.probes);
+      options.volumeActive = std::move(volume.active);
+    }
     options.deadzones = opt->deadzones;
     options.frames = opt->frames;
     options.normals = opt->normals;

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 #include <random>
+#include <algorithm>
 
 #include <fmt/format.h>
 
@@ -119,9 +120,17 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   std::vector<Probe> many(static_cast<size_t>(opt.throughputProbes));
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> scale(0.05f, 20.0f);
-  for (size_t i = 0; i < many.size() && !mapProbes.empty(); ++i) {
+  std::vector<Probe> sources = mapProbes;
+  for (size_t p = 0; p < opt.volumeActive.size(); ++p)
+    if (opt.volumeActive[p]) {
+      Probe q;
+      std::copy_n(opt.volumeProbes.begin() + static_cast<std::ptrdiff_t>(p * kProbeFloats), kProbeFloats, q.begin());
+      sources.push_back(q);
+    }
+  if (sources.empty()) many.clear();
+  for (size_t i = 0; i < many.size(); ++i) {
     const float s = scale(rng);
-    for (int k = 0; k < kProbeFloats; ++k) many[i][k] = mapProbes[i % mapProbes.size()][k] * s;
+    for (int k = 0; k < kProbeFloats; ++k) many[i][k] = sources[i % sources.size()][k] * s;
   }
 
   // 2. Every representation: size, error, speed.
@@ -172,6 +181,36 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
     results[name] = r;
   }
   json["representations"] = reprJson;
+
+  // Baked probes: each representation against the float L2 it was made from (exact over the sphere).
+  std::string volumeTable;
+  if (!opt.volumeProbes.empty()) {
+    nlohmann::json vol;
+    vol["name"] = opt.volumeName;
+    uint32_t active = 0;
+    for (uint8_t a : opt.volumeActive) active += a ? 1 : 0;
+    vol["probes"] = opt.volumeActive.size();
+    vol["active"] = active;
+    volumeTable = fmt::format("\nbaked volume {} ({} active probes), irradiance error vs its float L2:", opt.volumeName, active);
+    for (Representation repr : kAllRepresentations) {
+      double err = 0, energy = 0;
+      for (size_t p = 0; p < opt.volumeActive.size(); ++p) {
+        if (!opt.volumeActive[p]) continue;
+        const float* src = opt.volumeProbes.data() + p * kProbeFloats;
+        uint8_t rec[kMaxRecordBytes];
+        encodeProbeRecord(repr, src, rec);
+        Probe q{};
+        decodeProbeRecord(repr, rec, q.data());
+        irradianceEnergy(q.data(), src, err, energy);
+      }
+      const double rmse = energy > 0 ? std::sqrt(err / energy) : 0.0;
+      vol["representations"][representationName(repr)] = {{"bytes_per_probe", recordSize(repr)},
+                                                           {"irradiance_rmse_rel_vs_float_l2", rmse}};
+      volumeTable += fmt::format(" {} {:.2f}%", representationName(repr), 100 * rmse);
+    }
+    volumeTable += "\n";
+    json["probe_volume"] = vol;
+  }
   json["timing"] = fmt::format("median of {} repeats, one thread", opt.repeats);
 
   // 3. Temporal: the first map rotating about +Y, 0.5°/frame, on a 16×4×16 grid with per-probe
@@ -266,7 +305,8 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   json["temporal_results_note"] = "bytes include frame and section headers; zstd level 3";
 
   // Table.
-  std::string table = fmt::format("{:<6} {:>8} {:>14} {:>14} {:>14} {:>14}\n", "repr", "B/probe", "E rmse (true)",
+  std::string table = mapProbes.empty() ? "(no environment maps: the error columns below are empty)\n" : "";
+  table += fmt::format("{:<6} {:>8} {:>14} {:>14} {:>14} {:>14}\n", "repr", "B/probe", "E rmse (true)",
                                   "vs float L2", "encode Mpr/s", "decode Mpr/s");
   for (Representation repr : kAllRepresentations) {
     const StaticResult& r = results[representationName(repr)];
@@ -277,6 +317,7 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   table += fmt::format("float baselines (E rmse vs true): l1 {:.2f}%  zh3h {:.2f}%  zh3 {:.2f}%  l2 {:.2f}%\n",
                        100 * baselines["l1"].get<double>(), 100 * baselines["zh3h"].get<double>(),
                        100 * baselines["zh3"].get<double>(), 100 * baselines["l2"].get<double>());
+  table += volumeTable;
   if (!temporal.empty()) {
     table += fmt::format("\ntemporal ({} frames, 1024 probes, 1% noise): {:<6} {:>4} {:>14} {:>14}\n", opt.frames,
                          "repr", "dz", "B/probe/frame", "E rmse (clean)");

@@ -14,6 +14,10 @@ namespace probecast::bench {
 
 struct CodecBenchOptions {
   std::vector<EnvMap> maps;
+  // Optional baked probes (probecast bake): measured against their own float L2, active ones only.
+  std::string volumeName;
+  std::vector<float> volumeProbes;   // 27 floats per probe
+  std::vector<uint8_t> volumeActive;
   std::vector<int> deadzones = {0, 1, 2, 4, 8};
   int frames = 60;         // temporal sequence length
   int normals = 2048;      // equal-area directions for the brute-force irradiance
