@@ -165,7 +165,11 @@ TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {
   cc.reconnectMaxMs = 200;
   ProbeClient client(cc);
   client.start();
-  ASSERT_TRUE(waitFor([&] { return client.stats().framesApplied >= 10; }, 10s));
+  ASSERT_TRUE(waitFor([&] { return client.stats().framesApplied >= 20; }, 10s));
+  // Every 16 frames the server reports what it sent; it matches what arrived.
+  ASSERT_TRUE(waitFor([&] { return client.stats().statsReceived >= 1; }, 5s));
+  EXPECT_GT(client.stats().serverBytesSent, 0u);
+  EXPECT_LE(client.stats().serverBytesSent, client.stats().bytesReceived);
 
   // The server goes away: lighting stays the last volume, it never goes black.
   server.reset();

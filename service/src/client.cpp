@@ -153,6 +153,11 @@ struct ProbeClient::Impl {
           onVolume(msg.volume());
           gotVolume = true;
           backoff = config.reconnectMinMs;
+        } else if (msg.has_stats()) {
+          std::lock_guard<std::mutex> lock(mutex);
+          stats.statsReceived += 1;
+          stats.serverBytesSent = msg.stats().bytes_sent();
+          stats.serverBricksBehind = msg.stats().bricks_behind();
         } else if (msg.has_frame()) {
           if (!onFrame(msg.frame())) {
             ctx.TryCancel();

@@ -94,6 +94,18 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   // Called by the hub's wake-up with the link locked.
   void tryWriteLocked() {
     if (writing_ || finished_ || pendingFinish_ || !id_) return;
+    if (framesSinceStats_ >= kFramesPerStats) {  // a Stats message every kFramesPerStats frames
+      framesSinceStats_ = 0;
+      const SubscriberStats st = hub_.stats(id_);
+      out_.Clear();
+      pb::Stats* s = out_.mutable_stats();
+      s->set_bytes_sent(st.bytesSent);
+      s->set_bricks_behind(st.bricksBehind);
+      s->set_server_frame(hub_.serverFrame());
+      writing_ = true;
+      StartWrite(&out_);
+      return;
+    }
     std::optional<OutgoingFrame> frame = hub_.nextFrame(id_);
     if (!frame) return;
     out_.Clear();
@@ -103,6 +115,7 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     f->set_payload(reinterpret_cast<const char*>(frame->payload.data()), frame->payload.size());
     f->set_keyframes(frame->keyframes);
     f->set_deltas(frame->deltas);
+    ++framesSinceStats_;
     writing_ = true;
     StartWrite(&out_);
   }
@@ -188,6 +201,8 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   std::shared_ptr<ReactorLink> link_;
   pb::ClientMessage in_;
   pb::ServerMessage out_;
+  static constexpr uint32_t kFramesPerStats = 16;
+  uint32_t framesSinceStats_ = 0;
   uint64_t id_ = 0;
   bool counted_ = false;
   bool writing_ = false;

@@ -42,6 +42,9 @@ struct ClientStats {
   uint64_t bytesReceived = 0;     // payload bytes
   std::string lastError;          // last status or decode error
   bool fatal = false;             // the server refused us (auth, bad request): no more retries
+  uint32_t statsReceived = 0;     // Stats messages from the server
+  uint64_t serverBytesSent = 0;   // as the server counted them (latest Stats)
+  uint32_t serverBricksBehind = 0;
 };
 
 class ProbeClient {
