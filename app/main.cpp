@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   probecast::app::addBakeCommand(app, exitCode);
   probecast::app::addReferenceCommand(app, exitCode);
   probecast::app::addServeCommands(app, exitCode);
+  probecast::app::addCompareCommand(app, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
