@@ -61,10 +61,11 @@ void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   for (Buffer* b : {&g.normals, &g.texcoords, &g.texels, &g.textures}) destroyBuffer(d, *b);
   std::vector<glm::vec3> normals = s.normals;
   normals.resize(s.positions.size(), glm::vec3(0.0f));  // 0: the shader uses the geometric normal
-  g.normals = createBufferWithData(d, normals.data(), normals.size() * sizeof(glm::vec3), kStorage);
+  constexpr VkBufferUsageFlags kVertex = kStorage | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+  g.normals = createBufferWithData(d, normals.data(), normals.size() * sizeof(glm::vec3), kVertex);
   std::vector<glm::vec2> uvs = s.texcoords;
   uvs.resize(s.positions.size(), glm::vec2(0.0f));
-  g.texcoords = createBufferWithData(d, uvs.data(), uvs.size() * sizeof(glm::vec2), kStorage);
+  g.texcoords = createBufferWithData(d, uvs.data(), uvs.size() * sizeof(glm::vec2), kVertex);
   std::vector<uint32_t> texels;
   std::vector<shaders::PtTexture> infos;
   for (const scene::Texture& t : s.textures) {

@@ -5,7 +5,8 @@ namespace {
 
 constexpr VkBufferUsageFlags kInputUsage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
                                            VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
-                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT;  // the raster client draws them too
 
 void build(VulkanDevice& d, VkAccelerationStructureTypeKHR type, const VkAccelerationStructureGeometryKHR& geometry,
            uint32_t primitives, AccelerationStructure& out) {

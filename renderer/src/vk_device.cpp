@@ -132,6 +132,11 @@ void createDevice(VulkanDevice& d, bool validation, bool preferGpu) {
   v13.pNext = &v12;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   features.pNext = &v13;
+  VkPhysicalDeviceFeatures available{};
+  vkGetPhysicalDeviceFeatures(d.physical, &available);
+  if (!available.geometryShader)
+    throw std::runtime_error("the Vulkan device lacks geometryShader (gl_PrimitiveID in the raster client)");
+  features.features.geometryShader = VK_TRUE;
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -53,6 +53,69 @@ Buffer createBufferWithData(VulkanDevice& d, const void* data, size_t bytes, VkB
   return b;
 }
 
+GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImageUsageFlags usage, bool type3d) {
+  GpuImage img;
+  img.format = format;
+  img.extent = extent;
+  VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  ici.imageType = type3d ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
+  ici.format = format;
+  ici.extent = extent;
+  ici.mipLevels = 1;
+  ici.arrayLayers = 1;
+  ici.samples = VK_SAMPLE_COUNT_1_BIT;
+  ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ici.usage = usage;
+  ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VK_CHECK(vkCreateImage(d.device, &ici, nullptr, &img.image));
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(d.device, img.image, &req);
+  uint32_t type = UINT32_MAX;
+  for (uint32_t i = 0; i < d.memory.memoryTypeCount && type == UINT32_MAX; ++i)
+    if ((req.memoryTypeBits & (1u << i)) && (d.memory.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+      type = i;
+  for (uint32_t i = 0; i < d.memory.memoryTypeCount && type == UINT32_MAX; ++i)
+    if (req.memoryTypeBits & (1u << i)) type = i;
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = type;
+  VK_CHECK(vkAllocateMemory(d.device, &mai, nullptr, &img.memory));
+  VK_CHECK(vkBindImageMemory(d.device, img.image, img.memory, 0));
+  const bool depth = format == VK_FORMAT_D32_SFLOAT;
+  VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  vci.image = img.image;
+  vci.viewType = type3d ? VK_IMAGE_VIEW_TYPE_3D : VK_IMAGE_VIEW_TYPE_2D;
+  vci.format = format;
+  vci.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0, 1};
+  VK_CHECK(vkCreateImageView(d.device, &vci, nullptr, &img.view));
+  return img;
+}
+
+void destroyImage(VulkanDevice& d, GpuImage& img) {
+  if (img.view) vkDestroyImageView(d.device, img.view, nullptr);
+  if (img.image) vkDestroyImage(d.device, img.image, nullptr);
+  if (img.memory) vkFreeMemory(d.device, img.memory, nullptr);
+  img = GpuImage{};
+}
+
+void transitionImage(VkCommandBuffer cmd, const GpuImage& img, VkImageLayout from, VkImageLayout to) {
+  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  b.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
+  b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = img.image;
+  const bool depth = img.format == VK_FORMAT_D32_SFLOAT;
+  b.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0, 1};
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = 1;
+  dep.pImageMemoryBarriers = &b;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
 void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record) {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = d.commandPool;

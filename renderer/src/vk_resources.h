@@ -22,6 +22,20 @@ void destroyBuffer(VulkanDevice& d, Buffer& b);
 // Creates a buffer holding `bytes` (at least 4 bytes are allocated so empty arrays stay valid).
 Buffer createBufferWithData(VulkanDevice& d, const void* data, size_t bytes, VkBufferUsageFlags usage);
 
+struct GpuImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent3D extent{};
+};
+
+// A 2D or 3D image (depth > 1 or `type3d`) with one mip level and a view of all of it.
+GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImageUsageFlags usage, bool type3d = false);
+void destroyImage(VulkanDevice& d, GpuImage& image);
+// A whole-image layout transition (synchronisation2, all commands): simple and correct, not fast.
+void transitionImage(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to);
+
 // Records commands into a fresh command buffer, submits it and waits.
 void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record);
 

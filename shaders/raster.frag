@@ -1,0 +1,110 @@
+#version 460
+// Raster client shading: surface emission + direct light from punctual lights + diffuse indirect
+// albedo/π · E(n) from the probe volume (trilinear in 3D textures), linear radiance out.
+#extension GL_GOOGLE_include_directive : require
+#include "raster_shared.h"
+
+layout(location = 0) in vec3 worldPosition;
+layout(location = 1) in vec3 worldNormal;
+layout(location = 2) in vec2 texcoord;
+layout(location = 0) out vec4 outColor;
+layout(push_constant) uniform Push { RsPushConstants pc; };
+
+layout(std430, binding = RS_BINDING_TRIANGLE_MATERIAL) readonly buffer TriangleMaterial { uint triangleMaterial[]; };
+layout(std430, binding = RS_BINDING_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
+layout(std430, binding = RS_BINDING_LIGHTS) readonly buffer Lights { PtLight lights[]; };
+layout(std430, binding = RS_BINDING_TEXELS) readonly buffer Texels { uint texels[]; };
+layout(std430, binding = RS_BINDING_TEXTURES) readonly buffer Textures { PtTexture textures[]; };
+layout(binding = RS_BINDING_PROBES) uniform sampler3D probeVolume[RS_PROBE_TEXTURES];
+
+const float PI = 3.14159265358979;
+
+vec3 srgbToLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045))); }
+
+vec3 texel(PtTexture t, int x, int y) {
+  x = ((x % int(t.width)) + int(t.width)) % int(t.width);
+  y = ((y % int(t.height)) + int(t.height)) % int(t.height);
+  uint v = texels[t.offset + uint(y) * t.width + uint(x)];
+  return srgbToLinear(vec3(float(v & 255u), float((v >> 8) & 255u), float((v >> 16) & 255u)) / 255.0);
+}
+
+vec3 sampleTexture(int index, vec2 uv) {
+  if (index < 0) return vec3(1.0);
+  PtTexture t = textures[index];
+  vec2 p = uv * vec2(t.width, t.height) - 0.5;
+  ivec2 i = ivec2(floor(p));
+  vec2 f = p - vec2(i);
+  return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x), mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
+}
+
+vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) {
+  float nl = dot(n, wi), nv = dot(n, wo);
+  if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
+  vec3 h = normalize(wo + wi);
+  float nh = max(dot(n, h), 0.0), vh = max(dot(wo, h), 0.0);
+  float a2 = alpha * alpha;
+  float d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+  float k = alpha * 0.5;
+  float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
+  vec3 f0 = mix(vec3(0.04), base, metallic);
+  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
+  return base * (1.0 - metallic) / PI + d * g * f / max(4.0 * nl * nv, 1e-6);
+}
+
+// L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) of the probe volume at p (CODEC.md §1), clamped ≥ 0.
+vec3 probeIrradiance(vec3 p, vec3 n) {
+  if (pc.volumeMin.w == 0.0) return vec3(0.0);
+  vec3 extent = max(pc.volumeMax.xyz - pc.volumeMin.xyz, vec3(1e-6));
+  vec3 dims = pc.volumeDims.xyz;
+  vec3 uvw = ((p - pc.volumeMin.xyz) / extent * (dims - 1.0) + 0.5) / dims;
+  float c[28];
+  for (int t = 0; t < RS_PROBE_TEXTURES; ++t) {
+    vec4 v = texture(probeVolume[t], uvw);
+    c[4 * t] = v.x;
+    c[4 * t + 1] = v.y;
+    c[4 * t + 2] = v.z;
+    c[4 * t + 3] = v.w;
+  }
+  float x = n.x, y = n.y, z = n.z;
+  float basis[9] = float[9](0.282094792 * PI, 0.488602512 * y * (2.0 * PI / 3.0), 0.488602512 * z * (2.0 * PI / 3.0),
+                            0.488602512 * x * (2.0 * PI / 3.0), 1.092548431 * x * y * (PI / 4.0),
+                            1.092548431 * y * z * (PI / 4.0), 0.315391565 * (3.0 * z * z - 1.0) * (PI / 4.0),
+                            1.092548431 * x * z * (PI / 4.0), 0.546274215 * (x * x - y * y) * (PI / 4.0));
+  vec3 e = vec3(0.0);
+  for (int i = 0; i < 9; ++i) e += basis[i] * vec3(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
+  return max(e, vec3(0.0));
+}
+
+void main() {
+  PtMaterial m = materials[triangleMaterial[gl_PrimitiveID]];
+  vec3 base = m.baseColorMetallic.rgb * sampleTexture(m.textures.x, texcoord);
+  float metallic = m.baseColorMetallic.a;
+  float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
+  vec3 emission = m.emissionRoughness.rgb * sampleTexture(m.textures.y, texcoord);
+  vec3 wo = normalize(pc.eye.xyz - worldPosition);
+  vec3 n = normalize(worldNormal);
+  if (dot(n, wo) < 0.0) n = -n;  // two-sided, as in the path tracer
+  vec3 direct = vec3(0.0);
+  for (uint i = 0u; i < pc.lightCount; ++i) {
+    PtLight l = lights[i];
+    uint type = uint(l.positionType.w);
+    vec3 wi;
+    vec3 e = l.colorIntensity.rgb * l.colorIntensity.a;
+    if (type == PT_LIGHT_DIRECTIONAL) {
+      wi = -l.directionRange.xyz;
+    } else {
+      vec3 toLight = l.positionType.xyz - worldPosition;
+      float d2 = max(dot(toLight, toLight), 1e-8);
+      float dist = sqrt(d2);
+      wi = toLight / dist;
+      e /= d2;
+      float range = l.directionRange.w;
+      if (range > 0.0) e *= pow(clamp(1.0 - pow(dist / range, 4.0), 0.0, 1.0), 2.0);
+      if (type == PT_LIGHT_SPOT) e *= smoothstep(l.cone.x, l.cone.y, dot(-wi, l.directionRange.xyz));
+    }
+    float cosine = dot(n, wi);
+    if (cosine > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e;
+  }
+  vec3 diffuseIndirect = base * (1.0 - metallic) / PI * probeIrradiance(worldPosition, n);
+  outColor = vec4(emission + direct + diffuseIndirect, 1.0);
+}

@@ -1,0 +1,99 @@
+// The raster client: analytic diffuse indirect light, inactive-probe filling, a Cornell render.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "probecast/renderer/probe_updater.h"
+#include "probecast/renderer/raster_client.h"
+
+namespace probecast::renderer {
+namespace {
+
+TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
+  // Radiance L from every direction: E = π L (CODEC.md §8.1), so a white Lambertian plane
+  // reflects albedo/π · E = L. No lights, no emission.
+  ContextOptions co;
+  co.validation = true;
+  VulkanContext context(co);
+  scene::Scene s;
+  scene::Material white;
+  white.baseColor = glm::vec3(1.0f);
+  s.materials.push_back(white);
+  scene::addQuad(s, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, {-5, 0, -5}, 0);
+  scene::finalizeScene(s);
+  RasterRenderer raster(context, s, 32, 24);
+  const glm::vec3 L(0.5f, 0.25f, 0.125f);
+  ProbeVolumeData v;
+  v.dims = {3, 2, 3};
+  v.min = {-4, -1, -4};
+  v.max = {4, 1, 4};
+  v.probes.assign(18 * 27, 0.0f);
+  for (int p = 0; p < 18; ++p)
+    for (int c = 0; c < 3; ++c) v.probes[p * 27 + c] = 3.5449077f * L[c];  // c00 = 2√π L
+  raster.setProbes(v);
+  CameraView cam;
+  cam.position = {0, 3, 0.01f};
+  cam.forward = glm::normalize(glm::vec3(0, -1, -0.01f));
+  cam.up = {0, 0, -1};
+  cam.yfov = 0.5f;
+  const Image img = raster.render(raster.viewProjection(cam), cam.position);
+  for (uint32_t y = 4; y < 20; y += 5)
+    for (uint32_t x = 4; x < 28; x += 7)
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.rgb[(y * 32 + x) * 3 + c], L[c], 1e-4f) << x << "," << y;
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+TEST(RasterClient, InactiveProbesAreFilledFromActiveNeighbours) {
+  ProbeVolumeData v;
+  v.dims = {3, 1, 1};
+  v.probes.assign(3 * 27, 0.0f);
+  v.probes[0] = 2.0f;   // probe 0 active, c00 R = 2
+  v.probes[54] = 4.0f;  // probe 2 active, c00 R = 4
+  v.active = {1, 0, 1};
+  fillInactiveProbes(v);
+  EXPECT_FLOAT_EQ(v.probes[27], 3.0f);  // the inactive middle probe takes the mean, not black
+  v.active = {0, 0, 1};
+  v.probes.assign(3 * 27, 0.0f);
+  v.probes[54] = 4.0f;
+  fillInactiveProbes(v);
+  EXPECT_FLOAT_EQ(v.probes[0], 4.0f);  // filled across two steps
+}
+
+TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
+  ContextOptions co;
+  co.validation = true;
+  VulkanContext context(co);
+  scene::Scene s;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  ProbeGrid g;
+  g.dims = {4, 4, 4};
+  g.min = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
+  g.max = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
+  UpdaterOptions uo;
+  uo.samplesPerProbe = 64;
+  ProbeUpdater updater(context, s, g, uo);
+  updater.update();
+  ProbeVolumeData v;
+  v.dims = g.dims;
+  v.min = g.min;
+  v.max = g.max;
+  v.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
+  v.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+  RasterRenderer raster(context, s, 48, 36);
+  raster.setProbes(v);
+  const CameraView cam = CameraView::fromScene(s);
+  const Image a = raster.render(raster.viewProjection(cam), cam.position);
+  const Image b = raster.render(raster.viewProjection(cam), cam.position);
+  EXPECT_EQ(a.rgb, b.rgb);
+  double mean = 0;
+  for (float x : a.rgb) {
+    ASSERT_TRUE(std::isfinite(x));
+    mean += x;
+  }
+  EXPECT_GT(mean / static_cast<double>(a.rgb.size()), 0.05);
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+}  // namespace
+}  // namespace probecast::renderer
