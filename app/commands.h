@@ -11,6 +11,7 @@ void addBakeCommand(CLI::App& app, int& exitCode);
 void addReferenceCommand(CLI::App& app, int& exitCode);
 void addServeCommands(CLI::App& app, int& exitCode);
 void addCompareCommand(CLI::App& app, int& exitCode);
+void addViewCommand(CLI::App& app, int& exitCode);
 
 // Writes text to a file, creating parent folders; throws std::runtime_error with the path on failure.
 void writeTextFile(const std::string& path, const std::string& text);

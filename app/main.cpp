@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   probecast::app::addReferenceCommand(app, exitCode);
   probecast::app::addServeCommands(app, exitCode);
   probecast::app::addCompareCommand(app, exitCode);
+  probecast::app::addViewCommand(app, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

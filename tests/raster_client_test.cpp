@@ -97,3 +97,52 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
 
 }  // namespace
 }  // namespace probecast::renderer
+
+#include "probecast/renderer/view_sets.h"
+
+namespace probecast::renderer {
+namespace {
+
+TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
+  ContextOptions co;
+  co.validation = true;
+  VulkanContext context(co);
+  scene::Scene s;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  RasterRenderer raster(context, s, 20, 16);
+  ViewSetSpec spec;
+  ASSERT_TRUE(parseViewSet("lf:3x2", spec, error));
+  ViewSetOptions vo;
+  vo.aspect = 20.0f / 16.0f;
+  const CameraView cam = CameraView::fromScene(s);
+  const auto views = makeViewSet(cam, spec, vo);
+  ASSERT_EQ(views.size(), 6u);
+  std::vector<Image> images;
+  for (const auto& v : views) images.push_back(raster.render(v.viewProj, v.eye));
+  const Image quilt = composeQuilt(images, views, 3, 2);
+  ASSERT_EQ(quilt.width, 60u);
+  ASSERT_EQ(quilt.height, 32u);
+  // View 4 is column 1 of row 1 (the top row): quilt tile x = 1, y = 0. Render it alone, as mono.
+  const Image mono = raster.render(views[4].viewProj, views[4].eye);
+  for (uint32_t y = 0; y < 16; ++y)
+    for (uint32_t x = 0; x < 20; ++x)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(quilt.rgb[((y + 0) * 60 + 20 + x) * 3 + c], mono.rgb[(y * 20 + x) * 3 + c]) << x << "," << y;
+  // Neighbouring views differ (parallax), and the centre view of an odd array is the mono camera.
+  EXPECT_NE(images[3].rgb, images[4].rgb);
+  ViewSetSpec odd;
+  ASSERT_TRUE(parseViewSet("lf:3x3", odd, error));
+  const auto oddViews = makeViewSet(cam, odd, vo);
+  ViewSetSpec monoSpec;
+  ASSERT_TRUE(parseViewSet("mono", monoSpec, error));
+  const auto monoViews = makeViewSet(cam, monoSpec, vo);
+  EXPECT_EQ(raster.render(oddViews[4].viewProj, oddViews[4].eye).rgb,
+            raster.render(monoViews[0].viewProj, monoViews[0].eye).rgb);
+  EXPECT_FALSE(parseViewSet("lf:0x3", spec, error));
+  EXPECT_FALSE(parseViewSet("quad", spec, error));
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+}  // namespace
+}  // namespace probecast::renderer

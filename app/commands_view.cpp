@@ -1,0 +1,98 @@
+// `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
+#include <chrono>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "image_io.h"
+#include "probecast/codec/probe_file.h"
+#include "probecast/renderer/raster_client.h"
+#include "probecast/renderer/view_sets.h"
+#include "scene_options.h"
+
+namespace probecast::app {
+
+void addViewCommand(CLI::App& app, int& exitCode) {
+  CLI::App* cmd = app.add_subcommand("view", "render views (mono, stereo, lf:NxM quilt) lit by probes");
+  auto scene = std::make_shared<SceneOptions>();
+  auto gpu = std::make_shared<GpuOptions>();
+  auto grid = std::make_shared<GridOptions>();
+  auto tracer = std::make_shared<TracerOptions>();
+  struct Options {
+    std::string probes = "live", views = "lf:5x5", out = "out/view";
+    std::vector<uint32_t> size{320, 200};
+    uint32_t updates = 4;
+    float exposure = 1.0f;
+    bool exr = false;
+  };
+  auto o = std::make_shared<Options>();
+  scene->add(cmd);
+  gpu->add(cmd);
+  grid->add(cmd);
+  tracer->add(cmd);
+  cmd->add_option("--probes", o->probes, "probe volume file, or 'live' to trace it now");
+  cmd->add_option("--updates", o->updates, "live: updates to accumulate")->check(CLI::Range(1, 100000));
+  cmd->add_option("--views", o->views, "mono, stereo or lf:NxM");
+  cmd->add_option("--size", o->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
+  cmd->add_option("--out", o->out, "output folder");
+  cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
+  cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
+  cmd->callback([=, &exitCode] {
+    renderer::ViewSetSpec spec;
+    std::string error;
+    if (!renderer::parseViewSet(o->views, spec, error)) throw std::runtime_error(error);
+    const scene::Scene s = scene->load();
+    renderer::VulkanContext context(gpu->context());
+    renderer::ProbeVolumeData volume;
+    if (o->probes == "live") {
+      const renderer::ProbeGrid g = grid->resolve(s);
+      renderer::ProbeUpdater updater(context, s, g, tracer->options());
+      for (uint32_t u = 0; u < o->updates; ++u) {
+        updater.update();
+        fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);
+      }
+      fmt::print(stderr, "\n");
+      volume.dims = g.dims;
+      volume.min = g.min;
+      volume.max = g.max;
+      volume.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
+      volume.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+    } else {
+      ProbeVolume file;
+      if (!readProbeFile(o->probes, file, error)) throw std::runtime_error(error);
+      volume.dims = {file.dims[0], file.dims[1], file.dims[2]};
+      volume.min = {file.boundsMin[0], file.boundsMin[1], file.boundsMin[2]};
+      volume.max = {file.boundsMax[0], file.boundsMax[1], file.boundsMax[2]};
+      volume.probes = std::move(file.probes);
+      volume.active = std::move(file.active);
+    }
+    renderer::RasterRenderer raster(context, s, o->size[0], o->size[1]);
+    raster.setProbes(volume);
+    const renderer::CameraView camera = renderer::CameraView::fromScene(s);
+    renderer::ViewSetOptions vo;
+    vo.aspect = static_cast<float>(o->size[0]) / static_cast<float>(o->size[1]);
+    vo.displayDistance = std::max(0.1f, glm::length(0.5f * (s.boundsMin + s.boundsMax) - camera.position));
+    const auto views = renderer::makeViewSet(camera, spec, vo);
+    std::vector<renderer::Image> images;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& v : views) images.push_back(raster.render(v.viewProj, v.eye));
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::filesystem::create_directories(o->out);
+    const renderer::Image quilt = renderer::composeQuilt(images, views, spec.columns, spec.rows);
+    const auto w = static_cast<int>(quilt.width), h = static_cast<int>(quilt.height);
+    if (!bench::writePngPreview(o->out + "/quilt.png", quilt.rgb, w, h, o->exposure, error) ||
+        !bench::writeExr(o->out + "/quilt.exr", quilt.rgb, w, h, error))
+      throw std::runtime_error(error);
+    if (o->exr)
+      for (size_t k = 0; k < images.size(); ++k)
+        if (!bench::writeExr(fmt::format("{}/view_{:02}.exr", o->out, k), images[k].rgb, static_cast<int>(o->size[0]),
+                             static_cast<int>(o->size[1]), error))
+          throw std::runtime_error(error);
+    fmt::print("view: {} {} views of {}x{} on {}: {:.1f} ms per view; wrote {}/quilt.png and quilt.exr\n", o->views,
+               views.size(), o->size[0], o->size[1], context.deviceName(), ms / static_cast<double>(views.size()), o->out);
+    exitCode = 0;
+  });
+}
+
+}  // namespace probecast::app
