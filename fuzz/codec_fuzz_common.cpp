@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "crc32c.h"
+#include "brick_section.h"
 #include "probecast/codec/sh.h"
 
 namespace probecast::fuzz {
@@ -34,25 +34,6 @@ void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector
   enc.writeChangedFrame(delta);
 }
 
-void repairChecksums(std::vector<uint8_t>& f) {
-  if (f.size() < kFrameHeaderSize) return;
-  auto put = [&](size_t at, uint32_t v) {
-    for (int b = 0; b < 4; ++b) f[at + b] = static_cast<uint8_t>(v >> (8 * b));
-  };
-  auto get = [&](size_t at) {
-    return static_cast<uint32_t>(f[at]) | (static_cast<uint32_t>(f[at + 1]) << 8) |
-           (static_cast<uint32_t>(f[at + 2]) << 16) | (static_cast<uint32_t>(f[at + 3]) << 24);
-  };
-  put(28, crc32c(f.data(), 28));
-  size_t at = kFrameHeaderSize;
-  while (at + kSectionHeaderSize <= f.size()) {
-    const uint32_t stored = get(at + 14);
-    if (stored > f.size() - at - kSectionHeaderSize) break;
-    uint32_t crc = crc32c(f.data() + at, 18);
-    crc = crc32c(f.data() + at + kSectionHeaderSize, stored, crc);
-    put(at + 18, crc);
-    at += kSectionHeaderSize + stored;
-  }
-}
+void repairChecksums(std::vector<uint8_t>& f) { rewriteFrameChecksums(f); }
 
 }  // namespace probecast::fuzz

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "../codec/src/crc32c.h"
+#include "../codec/src/brick_section.h"
 #include "probecast/codec/stream.h"
 #include "test_probes.h"
 
@@ -53,26 +53,7 @@ bool allFinite(const StreamDecoder& d) {
 }
 
 // Recomputes the header and section CRCs so corruption reaches the payload parsers.
-void repairChecksums(std::vector<uint8_t>& f) {
-  if (f.size() < kFrameHeaderSize) return;
-  auto put = [&](size_t at, uint32_t v) {
-    for (int b = 0; b < 4; ++b) f[at + b] = static_cast<uint8_t>(v >> (8 * b));
-  };
-  auto get = [&](size_t at) {
-    return static_cast<uint32_t>(f[at]) | (static_cast<uint32_t>(f[at + 1]) << 8) |
-           (static_cast<uint32_t>(f[at + 2]) << 16) | (static_cast<uint32_t>(f[at + 3]) << 24);
-  };
-  put(28, crc32c(f.data(), 28));
-  size_t at = kFrameHeaderSize;
-  while (at + kSectionHeaderSize <= f.size()) {
-    const uint32_t stored = get(at + 14);
-    if (stored > f.size() - at - kSectionHeaderSize) break;
-    uint32_t crc = crc32c(f.data() + at, 18);
-    crc = crc32c(f.data() + at + kSectionHeaderSize, stored, crc);
-    put(at + 18, crc);
-    at += kSectionHeaderSize + stored;
-  }
-}
+void repairChecksums(std::vector<uint8_t>& f) { rewriteFrameChecksums(f); }
 
 class MemorySafety : public ::testing::TestWithParam<Representation> {};
 

@@ -54,6 +54,10 @@ struct SectionView {
 CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
                          size_t* consumed);
 
+// Recomputes the header CRC and every section CRC of a (possibly corrupted) frame in place, so
+// tests and the fuzzer can reach the parsers behind the checksums. Not for production use.
+void rewriteFrameChecksums(std::vector<uint8_t>& frame);
+
 // Applies a decompressed payload to a brick's symbols. `active`/`symbols` hold the brick's state
 // on entry (the base) and the new state on success. `scratch` avoids allocation.
 CodecStatus applyPayload(Representation repr, uint32_t probes, SectionKind kind, const uint8_t* raw, size_t rawSize,

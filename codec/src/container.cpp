@@ -151,6 +151,20 @@ void BrickTable::build(const StreamLayout& layout) {
   first[bricks] = at;
 }
 
+void rewriteFrameChecksums(std::vector<uint8_t>& f) {
+  if (f.size() < kFrameHeaderSize) return;
+  setU32(f.data() + 28, crc32c(f.data(), 28));
+  size_t at = kFrameHeaderSize;
+  while (at + kSectionHeaderSize <= f.size()) {
+    const uint32_t stored = getU32(f.data() + at + 14);
+    if (stored > f.size() - at - kSectionHeaderSize) break;
+    uint32_t crc = crc32c(f.data() + at, 18);
+    crc = crc32c(f.data() + at + kSectionHeaderSize, stored, crc);
+    setU32(f.data() + at + 18, crc);
+    at += kSectionHeaderSize + stored;
+  }
+}
+
 size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick) {
   const uint32_t probes = brickProbeCount(layout, brick);
   const SymbolShape shape = symbolShape(layout.repr);

@@ -12,19 +12,6 @@
 #include "raster_shared.h"
 
 namespace probecast::renderer {
-namespace {
-
-VkShaderModule module(VulkanDevice& d, const uint32_t* code, size_t bytes) {
-  VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  ci.codeSize = bytes;
-  ci.pCode = code;
-  VkShaderModule m;
-  VK_CHECK(vkCreateShaderModule(d.device, &ci, nullptr, &m));
-  return m;
-}
-
-}  // namespace
-
 void fillInactiveProbes(ProbeVolumeData& v) {
   const glm::uvec3 n = v.dims;
   const size_t count = static_cast<size_t>(n.x) * n.y * n.z;
@@ -178,7 +165,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   pli.pPushConstantRanges = &range;
   VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.layout));
 
-  const VkShaderModule vs = module(d, kRasterVert, sizeof kRasterVert), fs = module(d, kRasterFrag, sizeof kRasterFrag);
+  const VkShaderModule vs = createShaderModule(d, kRasterVert, sizeof kRasterVert),
+                       fs = createShaderModule(d, kRasterFrag, sizeof kRasterFrag);
   VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
                                                {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
   stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;

@@ -10,15 +10,6 @@
 namespace probecast::renderer {
 namespace {
 
-VkShaderModule createModule(VulkanDevice& d, const uint32_t* code, size_t bytes) {
-  VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  ci.codeSize = bytes;
-  ci.pCode = code;
-  VkShaderModule m;
-  VK_CHECK(vkCreateShaderModule(d.device, &ci, nullptr, &m));
-  return m;
-}
-
 VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
 }  // namespace
@@ -50,10 +41,10 @@ void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygen
   VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &pass.layout));
 
   const VkShaderModule modules[4] = {
-      createModule(d, raygen, raygenBytes),
-      createModule(d, kProbeTraceRmiss, sizeof kProbeTraceRmiss),
-      createModule(d, kProbeShadowRmiss, sizeof kProbeShadowRmiss),
-      createModule(d, kProbeTraceRchit, sizeof kProbeTraceRchit),
+      createShaderModule(d, raygen, raygenBytes),
+      createShaderModule(d, kProbeTraceRmiss, sizeof kProbeTraceRmiss),
+      createShaderModule(d, kProbeShadowRmiss, sizeof kProbeShadowRmiss),
+      createShaderModule(d, kProbeTraceRchit, sizeof kProbeTraceRchit),
   };
   const VkShaderStageFlagBits stageBits[4] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
                                               VK_SHADER_STAGE_MISS_BIT_KHR, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR};

@@ -116,6 +116,15 @@ void transitionImage(VkCommandBuffer cmd, const GpuImage& img, VkImageLayout fro
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+VkShaderModule createShaderModule(VulkanDevice& d, const uint32_t* code, size_t bytes) {
+  VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  ci.codeSize = bytes;
+  ci.pCode = code;
+  VkShaderModule m;
+  VK_CHECK(vkCreateShaderModule(d.device, &ci, nullptr, &m));
+  return m;
+}
+
 void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record) {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = d.commandPool;

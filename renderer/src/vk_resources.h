@@ -36,6 +36,9 @@ void destroyImage(VulkanDevice& d, GpuImage& image);
 // A whole-image layout transition (synchronisation2, all commands): simple and correct, not fast.
 void transitionImage(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to);
 
+// A shader module from embedded SPIR-V.
+VkShaderModule createShaderModule(VulkanDevice& d, const uint32_t* code, size_t bytes);
+
 // Records commands into a fresh command buffer, submits it and waits.
 void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record);
 
