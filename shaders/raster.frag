@@ -16,6 +16,7 @@ layout(std430, binding = RS_BINDING_LIGHTS) readonly buffer Lights { PtLight lig
 layout(std430, binding = RS_BINDING_TEXELS) readonly buffer Texels { uint texels[]; };
 layout(std430, binding = RS_BINDING_TEXTURES) readonly buffer Textures { PtTexture textures[]; };
 layout(binding = RS_BINDING_PROBES) uniform sampler3D probeVolume[RS_PROBE_TEXTURES];
+layout(binding = RS_BINDING_ENV_BRDF) uniform sampler2D envBrdf;
 
 const float PI = 3.14159265358979;
 
@@ -51,13 +52,13 @@ vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) 
   return base * (1.0 - metallic) / PI + d * g * f / max(4.0 * nl * nv, 1e-6);
 }
 
-// L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) of the probe volume at p (CODEC.md §1), clamped ≥ 0.
-vec3 probeIrradiance(vec3 p, vec3 n) {
-  if (pc.volumeMin.w == 0.0) return vec3(0.0);
+// The probe volume's 27 SH coefficients at p (trilinear).
+bool probeCoefficients(vec3 p, out float c[28]) {
+  for (int i = 0; i < 28; ++i) c[i] = 0.0;
+  if (pc.volumeMin.w == 0.0) return false;
   vec3 extent = max(pc.volumeMax.xyz - pc.volumeMin.xyz, vec3(1e-6));
   vec3 dims = pc.volumeDims.xyz;
   vec3 uvw = ((p - pc.volumeMin.xyz) / extent * (dims - 1.0) + 0.5) / dims;
-  float c[28];
   for (int t = 0; t < RS_PROBE_TEXTURES; ++t) {
     vec4 v = texture(probeVolume[t], uvw);
     c[4 * t] = v.x;
@@ -65,6 +66,11 @@ vec3 probeIrradiance(vec3 p, vec3 n) {
     c[4 * t + 2] = v.z;
     c[4 * t + 3] = v.w;
   }
+  return true;
+}
+
+// L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) (CODEC.md §1), clamped ≥ 0.
+vec3 probeIrradiance(float c[28], vec3 n) {
   float x = n.x, y = n.y, z = n.z;
   float basis[9] = float[9](0.282094792 * PI, 0.488602512 * y * (2.0 * PI / 3.0), 0.488602512 * z * (2.0 * PI / 3.0),
                             0.488602512 * x * (2.0 * PI / 3.0), 1.092548431 * x * y * (PI / 4.0),
@@ -73,6 +79,24 @@ vec3 probeIrradiance(vec3 p, vec3 n) {
   vec3 e = vec3(0.0);
   for (int i = 0; i < 9; ++i) e += basis[i] * vec3(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
   return max(e, vec3(0.0));
+}
+
+float lobeScale(vec4 fit, float roughness) {
+  float a = roughness * roughness;
+  return (1.0 + fit.x * a + fit.y * a * a) / (1.0 + fit.z * a + fit.w * a * a);
+}
+
+// Split-sum glossy: Σ_l g_l(roughness) Σ_m c_lm Y_lm(R) times (F0·A + B) (glossy_sh.h).
+vec3 probeGlossy(float c[28], vec3 r, float roughness, float nv, vec3 f0) {
+  float g1 = lobeScale(pc.lobeBand1, roughness), g2 = lobeScale(pc.lobeBand2, roughness);
+  float x = r.x, y = r.y, z = r.z;
+  float basis[9] = float[9](0.282094792, 0.488602512 * y * g1, 0.488602512 * z * g1, 0.488602512 * x * g1,
+                            1.092548431 * x * y * g2, 1.092548431 * y * z * g2, 0.315391565 * (3.0 * z * z - 1.0) * g2,
+                            1.092548431 * x * z * g2, 0.546274215 * (x * x - y * y) * g2);
+  vec3 prefiltered = vec3(0.0);
+  for (int i = 0; i < 9; ++i) prefiltered += basis[i] * vec3(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
+  vec2 ab = texture(envBrdf, vec2(nv, roughness)).xy;
+  return max(prefiltered, vec3(0.0)) * (f0 * ab.x + ab.y);
 }
 
 void main() {
@@ -105,6 +129,13 @@ void main() {
     float cosine = dot(n, wi);
     if (cosine > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e;
   }
-  vec3 diffuseIndirect = base * (1.0 - metallic) / PI * probeIrradiance(worldPosition, n);
-  outColor = vec4(emission + direct + diffuseIndirect, 1.0);
+  float c[28];
+  vec3 indirect = vec3(0.0);
+  if (probeCoefficients(worldPosition, c)) {
+    float roughness = m.emissionRoughness.a;
+    vec3 f0 = mix(vec3(0.04), base, metallic);
+    indirect = base * (1.0 - metallic) / PI * probeIrradiance(c, n) +
+               probeGlossy(c, reflect(-wo, n), roughness, clamp(dot(n, wo), 0.0, 1.0), f0);
+  }
+  outColor = vec4(emission + direct + indirect, 1.0);
 }

@@ -11,7 +11,8 @@
 #define RS_BINDING_TEXELS 3
 #define RS_BINDING_TEXTURES 4
 #define RS_BINDING_PROBES 5            // sampler3D[RS_PROBE_TEXTURES], trilinear, clamp
-#define RS_BINDING_COUNT 6
+#define RS_BINDING_ENV_BRDF 6          // sampler2D: (A, B) over (n·v, roughness), glossy_sh.h
+#define RS_BINDING_COUNT 7
 
 #ifdef __cplusplus
 namespace probecast::shaders {
@@ -23,6 +24,8 @@ struct RsPushConstants {
   vec4 volumeMin;      // xyz position of probe (0,0,0); w = 1 if a probe volume is bound
   vec4 volumeMax;      // xyz position of the last probe
   vec4 volumeDims;     // xyz probes per axis (as floats)
+  vec4 lobeBand1;      // GGX zonal lobe fit of band 1: p1, p2, q1, q2 (glossy_sh.h)
+  vec4 lobeBand2;      // band 2
   uint lightCount;
   uint pad0;
   uint pad1;
@@ -30,7 +33,7 @@ struct RsPushConstants {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RsPushConstants) == 144);
+static_assert(sizeof(RsPushConstants) == 176);
 }  // namespace probecast::shaders
 #endif
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "probecast/renderer/glossy_sh.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/raster_client.h"
 
@@ -11,7 +12,9 @@ namespace {
 
 TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
   // Radiance L from every direction: E = π L (CODEC.md §8.1), so a white Lambertian plane
-  // reflects albedo/π · E = L. No lights, no emission.
+  // reflects albedo/π · E = L; the glossy split sum adds L · (F0·A + B) (the prefiltered constant
+  // radiance is L whatever the lobe), F0 = 0.04, (A, B) from the environment-BRDF table at
+  // roughness 1 and n·v ≈ 1 (its last texel; the sampler clamps there). No lights, no emission.
   ContextOptions co;
   co.validation = true;
   VulkanContext context(co);
@@ -37,9 +40,15 @@ TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
   cam.up = {0, 0, -1};
   cam.yfov = 0.5f;
   const Image img = raster.render(raster.viewProjection(cam), cam.position);
+  const std::vector<float> table = envBrdfTable(32, 256);
+  const float a = table[(31 * 32 + 31) * 2], b = table[(31 * 32 + 31) * 2 + 1];
+  const float gain = 1.0f + 0.04f * a + b;
+  EXPECT_GT(gain - 1.0f, 0.005f);  // the glossy term is there
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.rgb[(12 * 32 + 16) * 3 + c], L[c] * gain, 2e-4f * L[c]);
+  // Off centre n·v drops a little (≥ 0.94 here), and with it the glossy share.
   for (uint32_t y = 4; y < 20; y += 5)
     for (uint32_t x = 4; x < 28; x += 7)
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.rgb[(y * 32 + x) * 3 + c], L[c], 1e-4f) << x << "," << y;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.rgb[(y * 32 + x) * 3 + c], L[c] * gain, 0.01f * L[c]) << x << "," << y;
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 

@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gpu_scene.h"
+#include "probecast/renderer/glossy_sh.h"
 #include "raster.frag.h"
 #include "raster.vert.h"
 #include "raster_shared.h"
@@ -56,6 +57,8 @@ struct RasterRenderer::Impl {
   Buffer vertexNormals, vertexUvs;
   GpuImage color, depth;
   GpuImage probeTextures[RS_PROBE_TEXTURES];
+  GpuImage envBrdf;
+  static constexpr int kEnvBrdfSize = 32;
   VkSampler sampler = VK_NULL_HANDLE;
   Buffer readback;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
@@ -69,7 +72,7 @@ struct RasterRenderer::Impl {
   void writeDescriptors() {
     const Buffer* buffers[5] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures};
     VkDescriptorBufferInfo infos[5];
-    VkWriteDescriptorSet writes[6];
+    VkWriteDescriptorSet writes[7];
     for (uint32_t b = 0; b < 5; ++b) {
       infos[b] = {buffers[b]->buffer, 0, VK_WHOLE_SIZE};
       writes[b] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
@@ -80,6 +83,7 @@ struct RasterRenderer::Impl {
       writes[b].pBufferInfo = &infos[b];
     }
     VkDescriptorImageInfo images[RS_PROBE_TEXTURES];
+    const VkDescriptorImageInfo envInfo{sampler, envBrdf.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     for (int t = 0; t < RS_PROBE_TEXTURES; ++t)
       images[t] = {sampler, probeTextures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     writes[5] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
@@ -88,7 +92,13 @@ struct RasterRenderer::Impl {
     writes[5].descriptorCount = RS_PROBE_TEXTURES;
     writes[5].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     writes[5].pImageInfo = images;
-    vkUpdateDescriptorSets(d->device, 6, writes, 0, nullptr);
+    writes[6] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[6].dstSet = set;
+    writes[6].dstBinding = RS_BINDING_ENV_BRDF;
+    writes[6].descriptorCount = 1;
+    writes[6].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    writes[6].pImageInfo = &envInfo;
+    vkUpdateDescriptorSets(d->device, 7, writes, 0, nullptr);
   }
 
   void uploadVolume(const glm::uvec3 dims, const std::vector<float>& probes) {
@@ -147,8 +157,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   for (uint32_t b = 0; b < RS_BINDING_COUNT; ++b) {
     bindings[b] = {};
     bindings[b].binding = b;
-    bindings[b].descriptorType = b == RS_BINDING_PROBES ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER
-                                                        : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[b].descriptorType = b == RS_BINDING_PROBES || b == RS_BINDING_ENV_BRDF
+                                     ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER
+                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     bindings[b].descriptorCount = b == RS_BINDING_PROBES ? RS_PROBE_TEXTURES : 1;
     bindings[b].stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT;
   }
@@ -233,7 +244,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   vkDestroyShaderModule(d.device, fs, nullptr);
 
   VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 5},
-                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, RS_PROBE_TEXTURES}};
+                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, RS_PROBE_TEXTURES + 1}};
   VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dpi.maxSets = 1;
   dpi.poolSizeCount = 2;
@@ -244,6 +255,29 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   dai.descriptorSetCount = 1;
   dai.pSetLayouts = &s.setLayout;
   VK_CHECK(vkAllocateDescriptorSets(d.device, &dai, &s.set));
+  // The environment BRDF table, computed at start-up (glossy_sh.h), and the lobe fit.
+  {
+    const int n = Impl::kEnvBrdfSize;
+    const std::vector<float> table = envBrdfTable(n, 256);
+    Buffer staging = createBuffer(d, table.size() * sizeof(float), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    std::memcpy(staging.mapped, table.data(), table.size() * sizeof(float));
+    s.envBrdf = createImage(d, VK_FORMAT_R32G32_SFLOAT, {static_cast<uint32_t>(n), static_cast<uint32_t>(n), 1},
+                            VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+    submitAndWait(d, [&](VkCommandBuffer cmd) {
+      transitionImage(cmd, s.envBrdf, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageExtent = {static_cast<uint32_t>(n), static_cast<uint32_t>(n), 1};
+      vkCmdCopyBufferToImage(cmd, staging.buffer, s.envBrdf.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+      transitionImage(cmd, s.envBrdf, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    });
+    destroyBuffer(d, staging);
+    const GgxLobeFit fit = ggxLobeFit();
+    s.push.lobeBand1 = {static_cast<float>(fit.band1[0]), static_cast<float>(fit.band1[1]),
+                        static_cast<float>(fit.band1[2]), static_cast<float>(fit.band1[3])};
+    s.push.lobeBand2 = {static_cast<float>(fit.band2[0]), static_cast<float>(fit.band2[1]),
+                        static_cast<float>(fit.band2[2]), static_cast<float>(fit.band2[3])};
+  }
   // No volume yet: a 1³ black one keeps every descriptor valid.
   s.uploadVolume(glm::uvec3(1), std::vector<float>(27, 0.0f));
   s.push.lightCount = s.gpu.lightCount;
@@ -254,6 +288,7 @@ RasterRenderer::~RasterRenderer() {
   VulkanDevice& d = *s.d;
   vkDeviceWaitIdle(d.device);
   for (GpuImage& img : s.probeTextures) destroyImage(d, img);
+  destroyImage(d, s.envBrdf);
   destroyImage(d, s.color);
   destroyImage(d, s.depth);
   destroyBuffer(d, s.readback);
