@@ -1,5 +1,8 @@
 // `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
 #include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -9,6 +12,7 @@
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
+#include "probecast/service/client.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -20,7 +24,8 @@ void addViewCommand(CLI::App& app, int& exitCode) {
   auto grid = std::make_shared<GridOptions>();
   auto tracer = std::make_shared<TracerOptions>();
   struct Options {
-    std::string probes = "live", views = "lf:5x5", out = "out/view";
+    std::string probes = "live", views = "lf:5x5", out = "out/view", connect, token, tlsCa, tlsName;
+    double waitSeconds = 3.0;
     std::vector<uint32_t> size{320, 200};
     uint32_t updates = 4;
     float exposure = 1.0f;
@@ -33,6 +38,12 @@ void addViewCommand(CLI::App& app, int& exitCode) {
   tracer->add(cmd);
   cmd->add_option("--probes", o->probes, "probe volume file, or 'live' to trace it now");
   cmd->add_option("--updates", o->updates, "live: updates to accumulate")->check(CLI::Range(1, 100000));
+  cmd->add_option("--connect", o->connect, "take the probes from a probecast server (host:port) instead");
+  cmd->add_option("--token", o->token, "bearer token for --connect");
+  cmd->add_option("--tls-ca", o->tlsCa, "PEM root certificate to trust (TLS)")->check(CLI::ExistingFile);
+  cmd->add_option("--tls-name", o->tlsName, "server name to check in its certificate");
+  cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
+      ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--views", o->views, "mono, stereo or lf:NxM");
   cmd->add_option("--size", o->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
   cmd->add_option("--out", o->out, "output folder");
@@ -45,7 +56,37 @@ void addViewCommand(CLI::App& app, int& exitCode) {
     const scene::Scene s = scene->load();
     renderer::VulkanContext context(gpu->context());
     renderer::ProbeVolumeData volume;
-    if (o->probes == "live") {
+    if (!o->connect.empty()) {
+      service::ClientConfig cc;
+      cc.address = o->connect;
+      cc.token = o->token;
+      cc.name = "probecast-view";
+      if (!o->tlsCa.empty()) {
+        std::ifstream in(o->tlsCa);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        cc.tls = true;
+        cc.rootCertPem = ss.str();
+        cc.tlsServerName = o->tlsName;
+      }
+      service::ProbeClient client(cc);
+      client.start();
+      const auto start = std::chrono::steady_clock::now();
+      while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o->waitSeconds) &&
+             !client.stats().fatal)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      client.stop();
+      service::VolumeSnapshot snap;
+      if (!client.snapshot(snap))
+        throw std::runtime_error("no probe volume from " + o->connect + ": " + client.stats().lastError);
+      volume.dims = {snap.layout.grid[0], snap.layout.grid[1], snap.layout.grid[2]};
+      volume.min = {snap.bounds.min[0], snap.bounds.min[1], snap.bounds.min[2]};
+      volume.max = {snap.bounds.max[0], snap.bounds.max[1], snap.bounds.max[2]};
+      volume.probes = std::move(snap.probes);
+      volume.active = std::move(snap.active);
+      fmt::print("view: {} frames ({} bytes) from {}\n", client.stats().framesApplied, client.stats().bytesReceived,
+                 o->connect);
+    } else if (o->probes == "live") {
       const renderer::ProbeGrid g = grid->resolve(s);
       renderer::ProbeUpdater updater(context, s, g, tracer->options());
       for (uint32_t u = 0; u < o->updates; ++u) {

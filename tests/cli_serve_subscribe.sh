@@ -33,4 +33,7 @@ rel = (num / den) ** 0.5
 print("relative coefficient error %.4f" % rel)
 assert rel < 0.02, rel
 PY
+# The raster client fed by the stream.
+"$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views stereo --size 24x16 --out "$work/view" \
+  | grep -q "2 views"
 echo "serve/subscribe round trip ok"
