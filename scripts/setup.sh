@@ -70,7 +70,9 @@ main() {
   fi
   export DEBIAN_FRONTEND=noninteractive
   add_backports_source
-  echo "setup: installing:" $missing "mesa-vulkan-drivers(backports)"
+  local mesa=""
+  mesa_ok || mesa="mesa-vulkan-drivers (bookworm-backports)"
+  echo "setup: installing:" $missing $mesa
   sudo_if_needed apt-get update -q
   if [ -n "$missing" ]; then
     # shellcheck disable=SC2086
