@@ -15,6 +15,9 @@ void addViewCommand(CLI::App& app, int& exitCode);
 
 // Writes text to a file, creating parent folders; throws std::runtime_error with the path on failure.
 void writeTextFile(const std::string& path, const std::string& text);
+// Prints a benchmark's table, writes its JSON and (when a path is given) its SVG chart.
+void writeBenchOutputs(const std::string& table, const std::string& json, const std::string& jsonPath,
+                       const std::string& svg, const std::string& chartPath);
 // The command line as typed, for provenance in outputs.
 const std::string& commandLine();
 void setCommandLine(int argc, char** argv);

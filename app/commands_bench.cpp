@@ -59,6 +59,17 @@ void writeTextFile(const std::string& path, const std::string& text) {
   if (!out) throw std::runtime_error(path + ": cannot write");
 }
 
+void writeBenchOutputs(const std::string& table, const std::string& json, const std::string& jsonPath,
+                       const std::string& svg, const std::string& chartPath) {
+  fmt::print("{}", table);
+  writeTextFile(jsonPath, json);
+  fmt::print("wrote {}\n", jsonPath);
+  if (!chartPath.empty()) {
+    writeTextFile(chartPath, svg);
+    fmt::print("wrote {}\n", chartPath);
+  }
+}
+
 void addBenchCommands(CLI::App& app, int& exitCode) {
   CLI::App* bench = app.add_subcommand("bench", "measured speed and accuracy, machine-readable");
   bench->require_subcommand(1);
@@ -104,13 +115,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     options.command = commandLine();
     options.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::CodecBenchResult r = bench::runCodecBench(options);
-    fmt::print("{}", r.table);
-    writeTextFile(opt->json, r.json.dump(2) + "\n");
-    fmt::print("wrote {}\n", opt->json);
-    if (!opt->chart.empty()) {
-      writeTextFile(opt->chart, r.svg);
-      fmt::print("wrote {}\n", opt->chart);
-    }
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", opt->json, r.svg, opt->chart);
     exitCode = 0;
   });
 
@@ -147,13 +152,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     o.command = commandLine();
     o.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::UpdateBenchResult r = bench::runUpdateBench(o);
-    fmt::print("{}", r.table);
-    writeTextFile(uo->json, r.json.dump(2) + "\n");
-    fmt::print("wrote {}\n", uo->json);
-    if (!uo->chart.empty()) {
-      writeTextFile(uo->chart, r.svg);
-      fmt::print("wrote {}\n", uo->chart);
-    }
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", uo->json, r.svg, uo->chart);
     exitCode = 0;
   });
 
@@ -186,13 +185,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     so->bench.command = commandLine();
     so->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
-    fmt::print("{}", r.table);
-    writeTextFile(so->json, r.json.dump(2) + "\n");
-    fmt::print("wrote {}\n", so->json);
-    if (!so->chart.empty()) {
-      writeTextFile(so->chart, r.svg);
-      fmt::print("wrote {}\n", so->chart);
-    }
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
     exitCode = 0;
   });
 }

@@ -245,16 +245,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
 
   VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 5},
                                    {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, RS_PROBE_TEXTURES + 1}};
-  VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dpi.maxSets = 1;
-  dpi.poolSizeCount = 2;
-  dpi.pPoolSizes = sizes;
-  VK_CHECK(vkCreateDescriptorPool(d.device, &dpi, nullptr, &s.pool));
-  VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  dai.descriptorPool = s.pool;
-  dai.descriptorSetCount = 1;
-  dai.pSetLayouts = &s.setLayout;
-  VK_CHECK(vkAllocateDescriptorSets(d.device, &dai, &s.set));
+  createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
   // The environment BRDF table, computed at start-up (glossy_sh.h), and the lobe fit.
   {
     const int n = Impl::kEnvBrdfSize;

@@ -95,16 +95,7 @@ void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygen
 
   VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1},
                                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, PT_BINDING_COUNT - 1}};
-  VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dpi.maxSets = 1;
-  dpi.poolSizeCount = 2;
-  dpi.pPoolSizes = sizes;
-  VK_CHECK(vkCreateDescriptorPool(d.device, &dpi, nullptr, &pass.pool));
-  VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  dai.descriptorPool = pass.pool;
-  dai.descriptorSetCount = 1;
-  dai.pSetLayouts = &pass.setLayout;
-  VK_CHECK(vkAllocateDescriptorSets(d.device, &dai, &pass.set));
+  createSingleDescriptorSet(d, pass.setLayout, sizes, 2, pass.pool, pass.set);
 }
 
 void destroyRayTracingPass(VulkanDevice& d, RayTracingPass& pass) {

@@ -116,6 +116,20 @@ void transitionImage(VkCommandBuffer cmd, const GpuImage& img, VkImageLayout fro
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+void createSingleDescriptorSet(VulkanDevice& d, VkDescriptorSetLayout layout, const VkDescriptorPoolSize* sizes,
+                               uint32_t sizeCount, VkDescriptorPool& pool, VkDescriptorSet& set) {
+  VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dpi.maxSets = 1;
+  dpi.poolSizeCount = sizeCount;
+  dpi.pPoolSizes = sizes;
+  VK_CHECK(vkCreateDescriptorPool(d.device, &dpi, nullptr, &pool));
+  VkDescriptorSetAllocateInfo dai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  dai.descriptorPool = pool;
+  dai.descriptorSetCount = 1;
+  dai.pSetLayouts = &layout;
+  VK_CHECK(vkAllocateDescriptorSets(d.device, &dai, &set));
+}
+
 VkShaderModule createShaderModule(VulkanDevice& d, const uint32_t* code, size_t bytes) {
   VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   ci.codeSize = bytes;

@@ -36,6 +36,10 @@ void destroyImage(VulkanDevice& d, GpuImage& image);
 // A whole-image layout transition (synchronisation2, all commands): simple and correct, not fast.
 void transitionImage(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to);
 
+// A pool sized for exactly one set of `layout`, and that set.
+void createSingleDescriptorSet(VulkanDevice& d, VkDescriptorSetLayout layout, const VkDescriptorPoolSize* sizes,
+                               uint32_t sizeCount, VkDescriptorPool& pool, VkDescriptorSet& set);
+
 // A shader module from embedded SPIR-V.
 VkShaderModule createShaderModule(VulkanDevice& d, const uint32_t* code, size_t bytes);
 
