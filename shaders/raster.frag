@@ -1,7 +1,9 @@
 #version 460
-// Raster client shading: surface emission + direct light from punctual lights + diffuse indirect
-// albedo/π · E(n) from the probe volume (trilinear in 3D textures), linear radiance out.
+// Raster client shading: surface emission + direct light from punctual lights (shadow maps, 3×3
+// PCF) + diffuse indirect albedo/π · E(n) and split-sum glossy indirect from the probe volume
+// (trilinear in 3D textures), linear radiance out.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_multiview : require
 #include "raster_shared.h"
 
 layout(location = 0) in vec3 worldPosition;
@@ -17,6 +19,10 @@ layout(std430, binding = RS_BINDING_TEXELS) readonly buffer Texels { uint texels
 layout(std430, binding = RS_BINDING_TEXTURES) readonly buffer Textures { PtTexture textures[]; };
 layout(binding = RS_BINDING_PROBES) uniform sampler3D probeVolume[RS_PROBE_TEXTURES];
 layout(binding = RS_BINDING_ENV_BRDF) uniform sampler2D envBrdf;
+layout(std430, binding = RS_BINDING_VIEWS) readonly buffer Views { RsView views[]; };
+layout(std430, binding = RS_BINDING_SHADOW_LIGHTS) readonly buffer ShadowLights { RsShadowLight shadowLights[]; };
+layout(std430, binding = RS_BINDING_SHADOW_LAYERS) readonly buffer ShadowLayers { RsShadowLayer shadowLayers[]; };
+layout(binding = RS_BINDING_SHADOW_MAP) uniform sampler2DArrayShadow shadowMap;
 
 const float PI = 3.14159265358979;
 
@@ -69,6 +75,56 @@ bool probeCoefficients(vec3 p, out float c[28]) {
   return true;
 }
 
+// Interpolate-then-hallucinate (zh3h): the L2 band from the interpolated L1 alone, as
+// zh3HallucinateInPlace in codec/zh3.h (same axis, curve and expansion).
+void hallucinateZh3(inout float c[28]) {
+  const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
+  vec3 d[3];
+  vec3 a = vec3(0.0);
+  for (int k = 0; k < 3; ++k) {
+    d[k] = vec3(c[9 + k], c[3 + k], c[6 + k]);  // (c3, c1, c2) = (x, y, z)
+    a += luma[k] * d[k];
+  }
+  a = dot(a, a) > 1e-24 ? normalize(a) : vec3(0.0, 0.0, 1.0);
+  float y2[5] = float[5](1.092548431 * a.x * a.y, 1.092548431 * a.y * a.z, 0.315391565 * (3.0 * a.z * a.z - 1.0),
+                         1.092548431 * a.x * a.z, 0.546274215 * (a.x * a.x - a.y * a.y));
+  for (int k = 0; k < 3; ++k) {
+    float c00 = c[k];
+    float zonal = 0.0;
+    if (c00 > 0.0) {
+      float r = abs(dot(d[k], a)) / c00;
+      zonal = c00 * (0.08 * r + 0.6 * r * r) * sqrt(4.0 * PI / 5.0);
+    }
+    for (int m = 0; m < 5; ++m) c[(4 + m) * 3 + k] = zonal * y2[m];
+  }
+}
+
+// Visibility of light `i` from p (normal n) by its shadow map: 3×3 PCF of hardware 2×2
+// comparisons, normal offset of 1.5 texels against acne.
+float shadowVisibility(uint i, vec3 p, vec3 n) {
+  RsShadowLight s = shadowLights[i];
+  if (s.kind == RS_SHADOW_NONE) return 1.0;
+  uint layer = s.firstLayer;
+  float texel = s.texelScale;
+  if (s.kind != RS_SHADOW_ORTHO) {
+    vec3 d = p - lights[i].positionType.xyz;
+    vec3 ad = abs(d);
+    if (s.kind == RS_SHADOW_CUBE)
+      layer += ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u) : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
+    texel *= length(d);
+  }
+  vec4 clip = shadowLayers[layer].viewProj * vec4(p + n * (1.5 * texel), 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec3 ndc = clip.xyz / clip.w;
+  if (any(greaterThan(abs(ndc.xy), vec2(1.0))) || ndc.z > 1.0) return 1.0;
+  vec2 uv = ndc.xy * 0.5 + 0.5;
+  float step = 1.0 / float(pc.shadowMapSize);
+  float lit = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x) lit += texture(shadowMap, vec4(uv + vec2(x, y) * step, float(layer), ndc.z));
+  return lit / 9.0;
+}
+
 // L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) (CODEC.md §1), clamped ≥ 0.
 vec3 probeIrradiance(float c[28], vec3 n) {
   float x = n.x, y = n.y, z = n.z;
@@ -105,7 +161,7 @@ void main() {
   float metallic = m.baseColorMetallic.a;
   float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
   vec3 emission = m.emissionRoughness.rgb * sampleTexture(m.textures.y, texcoord);
-  vec3 wo = normalize(pc.eye.xyz - worldPosition);
+  vec3 wo = normalize(views[pc.viewBase + gl_ViewIndex].eye.xyz - worldPosition);
   vec3 n = normalize(worldNormal);
   if (dot(n, wo) < 0.0) n = -n;  // two-sided, as in the path tracer
   vec3 direct = vec3(0.0);
@@ -127,11 +183,12 @@ void main() {
       if (type == PT_LIGHT_SPOT) e *= smoothstep(l.cone.x, l.cone.y, dot(-wi, l.directionRange.xyz));
     }
     float cosine = dot(n, wi);
-    if (cosine > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e;
+    if (cosine > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e * shadowVisibility(i, worldPosition, n);
   }
   float c[28];
   vec3 indirect = vec3(0.0);
   if (probeCoefficients(worldPosition, c)) {
+    if (pc.volumeDims.w != 0.0) hallucinateZh3(c);
     float roughness = m.emissionRoughness.a;
     vec3 f0 = mix(vec3(0.04), base, metallic);
     indirect = base * (1.0 - metallic) / PI * probeIrradiance(c, n) +

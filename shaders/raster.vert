@@ -1,6 +1,8 @@
 #version 460
-// Raster client: world-space vertices (scenes are flattened at load) through one view-projection.
+// Raster client: world-space vertices (scenes are flattened at load) through the view-projection
+// of this pass's view; with multiview, gl_ViewIndex picks one of several views per pass.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_multiview : require
 #include "raster_shared.h"
 
 layout(location = 0) in vec3 inPosition;
@@ -10,10 +12,11 @@ layout(location = 0) out vec3 worldPosition;
 layout(location = 1) out vec3 worldNormal;
 layout(location = 2) out vec2 texcoord;
 layout(push_constant) uniform Push { RsPushConstants pc; };
+layout(std430, binding = RS_BINDING_VIEWS) readonly buffer Views { RsView views[]; };
 
 void main() {
   worldPosition = inPosition;
   worldNormal = inNormal;
   texcoord = inTexcoord;
-  gl_Position = pc.viewProj * vec4(inPosition, 1.0);
+  gl_Position = views[pc.viewBase + gl_ViewIndex].viewProj * vec4(inPosition, 1.0);
 }

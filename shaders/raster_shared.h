@@ -12,28 +12,53 @@
 #define RS_BINDING_TEXTURES 4
 #define RS_BINDING_PROBES 5            // sampler3D[RS_PROBE_TEXTURES], trilinear, clamp
 #define RS_BINDING_ENV_BRDF 6          // sampler2D: (A, B) over (n·v, roughness), glossy_sh.h
-#define RS_BINDING_COUNT 7
+#define RS_BINDING_VIEWS 7             // RsView[]: the views of the current view set
+#define RS_BINDING_SHADOW_LIGHTS 8     // RsShadowLight[], one per light
+#define RS_BINDING_SHADOW_LAYERS 9     // RsShadowLayer[], one per shadow-map layer
+#define RS_BINDING_SHADOW_MAP 10       // sampler2DArrayShadow: depth of every shadow layer
+#define RS_BINDING_COUNT 11
+
+#define RS_SHADOW_NONE 0u              // unshadowed (no layer left for it)
+#define RS_SHADOW_CUBE 1u              // point light: six 90° faces +x −x +y −y +z −z
+#define RS_SHADOW_PERSPECTIVE 2u       // spot light: one perspective layer
+#define RS_SHADOW_ORTHO 3u             // directional light: one orthographic layer over the scene
 
 #ifdef __cplusplus
 namespace probecast::shaders {
 #endif
 
+struct RsView {
+  mat4 viewProj;       // world → Vulkan clip (y down, z in [0, 1])
+  vec4 eye;            // xyz eye position, metres
+};
+
+struct RsShadowLight {
+  uint kind;           // RS_SHADOW_*
+  uint firstLayer;     // its first layer in the shadow map
+  float texelScale;    // world size of one texel: × distance to the light (perspective) or as is (ortho)
+  float pad;
+};
+
+struct RsShadowLayer {
+  mat4 viewProj;       // world → the layer's clip space (same conventions as a view)
+};
+
 struct RsPushConstants {
-  mat4 viewProj;       // world → Vulkan clip
-  vec4 eye;            // xyz camera position
   vec4 volumeMin;      // xyz position of probe (0,0,0); w = 1 if a probe volume is bound
   vec4 volumeMax;      // xyz position of the last probe
-  vec4 volumeDims;     // xyz probes per axis (as floats)
+  vec4 volumeDims;     // xyz probes per axis (as floats); w = 1: L1 only, hallucinate ZH3 per pixel
   vec4 lobeBand1;      // GGX zonal lobe fit of band 1: p1, p2, q1, q2 (glossy_sh.h)
   vec4 lobeBand2;      // band 2
   uint lightCount;
+  uint viewBase;       // index of this pass's first view in RsView[] (+ gl_ViewIndex)
+  uint shadowMapSize;  // texels per side of each shadow layer
   uint pad0;
-  uint pad1;
-  uint pad2;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RsPushConstants) == 176);
+static_assert(sizeof(RsPushConstants) == 96);
+static_assert(sizeof(RsView) == 80);
+static_assert(sizeof(RsShadowLight) == 16);
 }  // namespace probecast::shaders
 #endif
 

@@ -2,7 +2,10 @@
 #include "probecast/renderer/raster_client.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstring>
+#include <map>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -11,6 +14,7 @@
 #include "raster.frag.h"
 #include "raster.vert.h"
 #include "raster_shared.h"
+#include "shadow.vert.h"
 
 namespace probecast::renderer {
 void fillInactiveProbes(ProbeVolumeData& v) {
@@ -50,55 +54,118 @@ void fillInactiveProbes(ProbeVolumeData& v) {
   }
 }
 
+ProbeVolumeData decodeAs(const ProbeVolumeData& volume, Representation repr) {
+  ProbeVolumeData out = volume;
+  const bool l1Only = repr == Representation::Zh3Hallucinated;
+  out.hallucinateZh3 = l1Only;
+  uint8_t record[kMaxRecordBytes];
+  for (size_t p = 0; p * kProbeFloats < volume.probes.size(); ++p) {
+    float* probe = out.probes.data() + p * kProbeFloats;
+    encodeProbeRecord(repr, probe, record);
+    if (!decodeProbeRecord(repr, record, probe, !l1Only)) std::fill(probe, probe + kProbeFloats, 0.0f);
+  }
+  return out;
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+glm::mat4 vulkanPerspective(float fovy, float aspect, float znear, float zfar) {
+  glm::mat4 proj = glm::perspectiveRH_ZO(fovy, aspect, znear, zfar);
+  proj[1][1] = -proj[1][1];  // Vulkan's y points down
+  return proj;
+}
+
+VkDescriptorSetLayoutBinding layoutBinding(uint32_t binding, VkDescriptorType type, uint32_t count,
+                                           VkShaderStageFlags stages) {
+  VkDescriptorSetLayoutBinding b{};
+  b.binding = binding;
+  b.descriptorType = type;
+  b.descriptorCount = count;
+  b.stageFlags = stages;
+  return b;
+}
+
+VkWriteDescriptorSet bufferWrite(VkDescriptorSet set, uint32_t binding, const VkDescriptorBufferInfo* info) {
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = set;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  w.pBufferInfo = info;
+  return w;
+}
+
+VkWriteDescriptorSet imageWrite(VkDescriptorSet set, uint32_t binding, const VkDescriptorImageInfo* info,
+                                uint32_t count) {
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = set;
+  w.dstBinding = binding;
+  w.descriptorCount = count;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  w.pImageInfo = info;
+  return w;
+}
+
+VkRenderingAttachmentInfo attachment(VkImageView view, VkImageLayout layout, VkAttachmentStoreOp store) {
+  VkRenderingAttachmentInfo a{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  a.imageView = view;
+  a.imageLayout = layout;
+  a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  a.storeOp = store;
+  a.clearValue.depthStencil = {1.0f, 0};
+  return a;
+}
+}  // namespace
+
 struct RasterRenderer::Impl {
+  static constexpr uint32_t kMaxViews = 256;  // lf:16x16
+  static constexpr int kEnvBrdfSize = 32;
   VulkanDevice* d = nullptr;
-  uint32_t width = 0, height = 0;
+  RasterOptions options;
+  RasterTimings timings;
+  uint32_t width = 0, height = 0, chunk = 1;
   GpuScene gpu;
-  Buffer vertexNormals, vertexUvs;
-  GpuImage color, depth;
+  GpuImage color, depth;  // `chunk` layers each
   GpuImage probeTextures[RS_PROBE_TEXTURES];
   GpuImage envBrdf;
-  static constexpr int kEnvBrdfSize = 32;
-  VkSampler sampler = VK_NULL_HANDLE;
-  Buffer readback;
+  GpuImage shadowMap;  // one layer per shadow face, at least one
+  std::vector<glm::mat4> shadowMatrices;
+  bool shadowsDirty = true;
+  VkSampler sampler = VK_NULL_HANDLE, shadowSampler = VK_NULL_HANDLE;
+  Buffer readback, views, shadowLights, shadowLayers;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE, shadowLayout = VK_NULL_HANDLE;
+  std::map<uint32_t, VkPipeline> pipelines;  // by view mask (0: one view per pass)
+  VkPipeline shadowPipeline = VK_NULL_HANDLE;
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet set = VK_NULL_HANDLE;
   shaders::RsPushConstants push{};
   uint32_t indexCount = 0;
+  glm::vec3 sceneMin{0.0f}, sceneMax{0.0f};
 
   void writeDescriptors() {
-    const Buffer* buffers[5] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures};
-    VkDescriptorBufferInfo infos[5];
-    VkWriteDescriptorSet writes[7];
-    for (uint32_t b = 0; b < 5; ++b) {
+    const Buffer* buffers[8] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
+                                &views, &shadowLights, &shadowLayers};
+    const uint32_t bindings[8] = {RS_BINDING_TRIANGLE_MATERIAL, RS_BINDING_MATERIALS, RS_BINDING_LIGHTS,
+                                  RS_BINDING_TEXELS, RS_BINDING_TEXTURES, RS_BINDING_VIEWS,
+                                  RS_BINDING_SHADOW_LIGHTS, RS_BINDING_SHADOW_LAYERS};
+    VkDescriptorBufferInfo infos[8];
+    VkWriteDescriptorSet writes[11];
+    for (uint32_t b = 0; b < 8; ++b) {
       infos[b] = {buffers[b]->buffer, 0, VK_WHOLE_SIZE};
-      writes[b] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-      writes[b].dstSet = set;
-      writes[b].dstBinding = b;
-      writes[b].descriptorCount = 1;
-      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      writes[b].pBufferInfo = &infos[b];
+      writes[b] = bufferWrite(set, bindings[b], &infos[b]);
     }
     VkDescriptorImageInfo images[RS_PROBE_TEXTURES];
-    const VkDescriptorImageInfo envInfo{sampler, envBrdf.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     for (int t = 0; t < RS_PROBE_TEXTURES; ++t)
       images[t] = {sampler, probeTextures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    writes[5] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[5].dstSet = set;
-    writes[5].dstBinding = RS_BINDING_PROBES;
-    writes[5].descriptorCount = RS_PROBE_TEXTURES;
-    writes[5].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    writes[5].pImageInfo = images;
-    writes[6] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[6].dstSet = set;
-    writes[6].dstBinding = RS_BINDING_ENV_BRDF;
-    writes[6].descriptorCount = 1;
-    writes[6].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    writes[6].pImageInfo = &envInfo;
-    vkUpdateDescriptorSets(d->device, 7, writes, 0, nullptr);
+    const VkDescriptorImageInfo envInfo{sampler, envBrdf.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo shadowInfo{shadowSampler, shadowMap.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    writes[8] = imageWrite(set, RS_BINDING_PROBES, images, RS_PROBE_TEXTURES);
+    writes[9] = imageWrite(set, RS_BINDING_ENV_BRDF, &envInfo, 1);
+    writes[10] = imageWrite(set, RS_BINDING_SHADOW_MAP, &shadowInfo, 1);
+    vkUpdateDescriptorSets(d->device, 11, writes, 0, nullptr);
   }
 
   void uploadVolume(const glm::uvec3 dims, const std::vector<float>& probes) {
@@ -131,53 +198,178 @@ struct RasterRenderer::Impl {
     destroyBuffer(*d, staging);
     writeDescriptors();
   }
+
+  // Shadow layers for the current lights: matrices, per-light records, and a map big enough.
+  void planShadows(const scene::Scene& scene) {
+    const glm::vec3 center = 0.5f * (sceneMin + sceneMax);
+    const float radius = std::max(0.5f * glm::length(sceneMax - sceneMin), 1e-3f);
+    const float size = static_cast<float>(options.shadowMapSize);
+    std::vector<shaders::RsShadowLight> records;
+    shadowMatrices.clear();
+    for (const scene::Light& l : scene.lights) {
+      shaders::RsShadowLight r{RS_SHADOW_NONE, static_cast<uint32_t>(shadowMatrices.size()), 0.0f, 0.0f};
+      const float zfar = l.range > 0.0f ? l.range : 2.0f * radius + glm::length(l.position - center);
+      const float znear = std::max(1e-3f, 1e-4f * zfar);
+      const glm::vec3 dir = glm::length(l.direction) > 0.0f ? glm::normalize(l.direction) : glm::vec3(0, -1, 0);
+      const glm::vec3 up = std::abs(dir.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+      const bool wideSpot = l.type == scene::LightType::Spot && l.outerConeAngle > glm::radians(75.0f);
+      if (l.type == scene::LightType::Point || wideSpot) {
+        if (shadowMatrices.size() + 6 > options.maxShadowLayers) {
+          records.push_back(r);
+          continue;
+        }
+        static const glm::vec3 kFaceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+        static const glm::vec3 kFaceUp[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
+        const glm::mat4 proj = vulkanPerspective(glm::radians(90.0f), 1.0f, znear, zfar);
+        for (int f = 0; f < 6; ++f)
+          shadowMatrices.push_back(proj * glm::lookAtRH(l.position, l.position + kFaceDir[f], kFaceUp[f]));
+        r.kind = RS_SHADOW_CUBE;
+        r.texelScale = 2.0f / size;
+      } else if (shadowMatrices.size() + 1 > options.maxShadowLayers) {
+        records.push_back(r);
+        continue;
+      } else if (l.type == scene::LightType::Spot) {
+        const float fov = 2.0f * l.outerConeAngle + glm::radians(2.0f);
+        shadowMatrices.push_back(vulkanPerspective(fov, 1.0f, znear, zfar) *
+                                 glm::lookAtRH(l.position, l.position + dir, up));
+        r.kind = RS_SHADOW_PERSPECTIVE;
+        r.texelScale = 2.0f * std::tan(0.5f * fov) / size;
+      } else {
+        glm::mat4 ortho = glm::orthoRH_ZO(-radius, radius, -radius, radius, 0.0f, 2.0f * radius);
+        ortho[1][1] = -ortho[1][1];
+        shadowMatrices.push_back(ortho * glm::lookAtRH(center - dir * radius, center, up));
+        r.kind = RS_SHADOW_ORTHO;
+        r.texelScale = 2.0f * radius / size;
+      }
+      records.push_back(r);
+    }
+    if (records.empty()) records.push_back({RS_SHADOW_NONE, 0, 0.0f, 0.0f});
+    destroyBuffer(*d, shadowLights);
+    destroyBuffer(*d, shadowLayers);
+    shadowLights = createBufferWithData(*d, records.data(), records.size() * sizeof records[0],
+                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    shadowLayers = createBufferWithData(*d, shadowMatrices.data(), shadowMatrices.size() * sizeof(glm::mat4),
+                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    const uint32_t layers = std::max<uint32_t>(2, static_cast<uint32_t>(shadowMatrices.size()));
+    if (shadowMap.layers != layers) {
+      destroyImage(*d, shadowMap);
+      shadowMap = createImageArray(*d, VK_FORMAT_D32_SFLOAT, {options.shadowMapSize, options.shadowMapSize}, layers,
+                                   VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+      submitAndWait(*d, [&](VkCommandBuffer cmd) {
+        transitionImage(cmd, shadowMap, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      });
+    }
+    shadowsDirty = true;
+  }
+
+  void drawScene(VkCommandBuffer cmd, bool positionsOnly) {
+    const VkBuffer vbufs[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
+    const VkDeviceSize offsets[3] = {0, 0, 0};
+    vkCmdBindVertexBuffers(cmd, 0, positionsOnly ? 1 : 3, vbufs, offsets);
+    vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexed(cmd, indexCount, 1, 0, 0, 0);
+  }
+
+  void setViewport(VkCommandBuffer cmd, uint32_t w, uint32_t h) {
+    const VkViewport viewport{0, 0, static_cast<float>(w), static_cast<float>(h), 0, 1};
+    const VkRect2D scissor{{0, 0}, {w, h}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+  }
+
+  void renderShadows() {
+    if (!shadowsDirty) return;
+    const auto t0 = Clock::now();
+    const uint32_t n = options.shadowMapSize;
+    submitAndWait(*d, [&](VkCommandBuffer cmd) {
+      transitionImage(cmd, shadowMap, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+      for (size_t k = 0; k < shadowMatrices.size(); ++k) {
+        VkRenderingAttachmentInfo depthInfo = attachment(shadowMap.layerViews[k], VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                                                         VK_ATTACHMENT_STORE_OP_STORE);
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, {n, n}};
+        ri.layerCount = 1;
+        ri.pDepthAttachment = &depthInfo;
+        vkCmdBeginRendering(cmd, &ri);
+        setViewport(cmd, n, n);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, shadowPipeline);
+        vkCmdPushConstants(cmd, shadowLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(glm::mat4), &shadowMatrices[k]);
+        drawScene(cmd, true);
+        vkCmdEndRendering(cmd);
+      }
+      transitionImage(cmd, shadowMap, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    });
+    shadowsDirty = false;
+    timings.shadowMs = msSince(t0);
+  }
+
+  VkPipeline createPipeline(bool shadow, uint32_t viewMask);
+  VkPipeline pipelineFor(uint32_t viewMask) {
+    auto it = pipelines.find(viewMask);
+    if (it == pipelines.end()) it = pipelines.emplace(viewMask, createPipeline(false, viewMask)).first;
+    return it->second;
+  }
+
+  // Renders views [first, first + count) into layers 0..count-1 and reads them back.
+  void renderChunk(uint32_t first, uint32_t count, std::vector<Image>& out) {
+    submitAndWait(*d, [&](VkCommandBuffer cmd) {
+      transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+      transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+      const bool multiview = options.passes == ViewPasses::Multiview && count > 1;
+      const uint32_t passes = multiview ? 1 : count;
+      for (uint32_t p = 0; p < passes; ++p) {
+        const VkImageView colorView = multiview || chunk == 1 ? color.view : color.layerViews[p];
+        const VkImageView depthView = multiview || chunk == 1 ? depth.view : depth.layerViews[p];
+        VkRenderingAttachmentInfo colorInfo =
+            attachment(colorView, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
+        colorInfo.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        VkRenderingAttachmentInfo depthInfo =
+            attachment(depthView, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_DONT_CARE);
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, {width, height}};
+        ri.layerCount = 1;
+        ri.viewMask = multiview ? (1u << count) - 1u : 0u;
+        ri.colorAttachmentCount = 1;
+        ri.pColorAttachments = &colorInfo;
+        ri.pDepthAttachment = &depthInfo;
+        vkCmdBeginRendering(cmd, &ri);
+        setViewport(cmd, width, height);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineFor(ri.viewMask));
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &set, 0, nullptr);
+        push.viewBase = first + p;
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
+        drawScene(cmd, false);
+        vkCmdEndRendering(cmd);
+      }
+      transitionImage(cmd, color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, count};
+      region.imageExtent = {width, height, 1};
+      vkCmdCopyImageToBuffer(cmd, color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
+      VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr,
+                           0, nullptr);
+    });
+    const size_t pixels = static_cast<size_t>(width) * height;
+    const float* src = static_cast<const float*>(readback.mapped);
+    for (uint32_t v = 0; v < count; ++v) {
+      Image& img = out[first + v];
+      img.width = width;
+      img.height = height;
+      img.rgb.resize(pixels * 3);
+      const float* layer = src + v * pixels * 4;
+      for (size_t i = 0; i < pixels; ++i)
+        for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer[i * 4 + c];
+    }
+  }
 };
 
-RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene, uint32_t width, uint32_t height)
-    : impl_(std::make_unique<Impl>()) {
-  if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
-  if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
-  Impl& s = *impl_;
-  s.d = &context.device();
-  VulkanDevice& d = *s.d;
-  s.width = width;
-  s.height = height;
-  uploadGpuScene(d, scene, s.gpu);
-  s.indexCount = static_cast<uint32_t>(scene.indices.size());
-  s.color = createImage(d, VK_FORMAT_R32G32B32A32_SFLOAT, {width, height, 1},
-                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-  s.depth = createImage(d, VK_FORMAT_D32_SFLOAT, {width, height, 1}, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
-  s.readback = createBuffer(d, static_cast<VkDeviceSize>(width) * height * 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-  sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
-  sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  VK_CHECK(vkCreateSampler(d.device, &sci, nullptr, &s.sampler));
-
-  VkDescriptorSetLayoutBinding bindings[RS_BINDING_COUNT];
-  for (uint32_t b = 0; b < RS_BINDING_COUNT; ++b) {
-    bindings[b] = {};
-    bindings[b].binding = b;
-    bindings[b].descriptorType = b == RS_BINDING_PROBES || b == RS_BINDING_ENV_BRDF
-                                     ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER
-                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[b].descriptorCount = b == RS_BINDING_PROBES ? RS_PROBE_TEXTURES : 1;
-    bindings[b].stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT;
-  }
-  VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  lci.bindingCount = RS_BINDING_COUNT;
-  lci.pBindings = bindings;
-  VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &s.setLayout));
-  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                            sizeof(shaders::RsPushConstants)};
-  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pli.setLayoutCount = 1;
-  pli.pSetLayouts = &s.setLayout;
-  pli.pushConstantRangeCount = 1;
-  pli.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.layout));
-
-  const VkShaderModule vs = createShaderModule(d, kRasterVert, sizeof kRasterVert),
-                       fs = createShaderModule(d, kRasterFrag, sizeof kRasterFrag);
+VkPipeline RasterRenderer::Impl::createPipeline(bool shadow, uint32_t viewMask) {
+  const VkShaderModule vs = shadow ? createShaderModule(*d, kShadowVert, sizeof kShadowVert)
+                                   : createShaderModule(*d, kRasterVert, sizeof kRasterVert);
+  const VkShaderModule fs = shadow ? VK_NULL_HANDLE : createShaderModule(*d, kRasterFrag, sizeof kRasterFrag);
   VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
                                                {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
   stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -193,9 +385,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
                                                    {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0},
                                                    {2, 2, VK_FORMAT_R32G32_SFLOAT, 0}};
   VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-  vi.vertexBindingDescriptionCount = 3;
+  vi.vertexBindingDescriptionCount = shadow ? 1 : 3;
   vi.pVertexBindingDescriptions = vb;
-  vi.vertexAttributeDescriptionCount = 3;
+  vi.vertexAttributeDescriptionCount = shadow ? 1 : 3;
   vi.pVertexAttributeDescriptions = va;
   VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
   ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
@@ -204,8 +396,11 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   vps.scissorCount = 1;
   VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
   rs.polygonMode = VK_POLYGON_MODE_FILL;
-  rs.cullMode = VK_CULL_MODE_NONE;
+  rs.cullMode = VK_CULL_MODE_NONE;  // scenes are two-sided, as in the path tracer
   rs.lineWidth = 1.0f;
+  rs.depthBiasEnable = shadow ? VK_TRUE : VK_FALSE;
+  rs.depthBiasConstantFactor = 1.0f;
+  rs.depthBiasSlopeFactor = 1.5f;
   VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
   ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
   VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
@@ -215,7 +410,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   VkPipelineColorBlendAttachmentState cba{};
   cba.colorWriteMask = 0xF;
   VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-  cb.attachmentCount = 1;
+  cb.attachmentCount = shadow ? 0 : 1;
   cb.pAttachments = &cba;
   const VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
   VkPipelineDynamicStateCreateInfo dys{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
@@ -223,12 +418,13 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   dys.pDynamicStates = dyn;
   const VkFormat colorFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   VkPipelineRenderingCreateInfo rci{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-  rci.colorAttachmentCount = 1;
+  rci.viewMask = viewMask;
+  rci.colorAttachmentCount = shadow ? 0 : 1;
   rci.pColorAttachmentFormats = &colorFormat;
   rci.depthAttachmentFormat = VK_FORMAT_D32_SFLOAT;
   VkGraphicsPipelineCreateInfo gci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
   gci.pNext = &rci;
-  gci.stageCount = 2;
+  gci.stageCount = shadow ? 1 : 2;
   gci.pStages = stages;
   gci.pVertexInputState = &vi;
   gci.pInputAssemblyState = &ia;
@@ -238,13 +434,81 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   gci.pDepthStencilState = &ds;
   gci.pColorBlendState = &cb;
   gci.pDynamicState = &dys;
-  gci.layout = s.layout;
-  VK_CHECK(vkCreateGraphicsPipelines(d.device, VK_NULL_HANDLE, 1, &gci, nullptr, &s.pipeline));
-  vkDestroyShaderModule(d.device, vs, nullptr);
-  vkDestroyShaderModule(d.device, fs, nullptr);
+  gci.layout = shadow ? shadowLayout : layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateGraphicsPipelines(d->device, VK_NULL_HANDLE, 1, &gci, nullptr, &pipeline));
+  vkDestroyShaderModule(d->device, vs, nullptr);
+  if (fs) vkDestroyShaderModule(d->device, fs, nullptr);
+  return pipeline;
+}
 
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 5},
-                                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, RS_PROBE_TEXTURES + 1}};
+RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene, uint32_t width, uint32_t height,
+                               const RasterOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
+  if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
+  if (options.shadowMapSize < 16 || options.shadowMapSize > 8192)
+    throw std::invalid_argument("shadow map size must be 16..8192");
+  Impl& s = *impl_;
+  s.d = &context.device();
+  VulkanDevice& d = *s.d;
+  s.options = options;
+  s.width = width;
+  s.height = height;
+  s.chunk = std::min<uint32_t>(8, d.maxMultiviewViewCount);
+  s.sceneMin = scene.boundsMin;
+  s.sceneMax = scene.boundsMax;
+  uploadGpuScene(d, scene, s.gpu);
+  s.indexCount = static_cast<uint32_t>(scene.indices.size());
+  s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {width, height}, s.chunk,
+                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  s.depth = createImageArray(d, VK_FORMAT_D32_SFLOAT, {width, height}, s.chunk,
+                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  s.readback = createBuffer(d, static_cast<VkDeviceSize>(width) * height * 16 * s.chunk,
+                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  s.views = createBuffer(d, sizeof(shaders::RsView) * Impl::kMaxViews, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
+  sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  VK_CHECK(vkCreateSampler(d.device, &sci, nullptr, &s.sampler));
+  sci.compareEnable = VK_TRUE;  // hardware 2×2 depth comparison: lit where ref ≤ stored
+  sci.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+  VK_CHECK(vkCreateSampler(d.device, &sci, nullptr, &s.shadowSampler));
+
+  constexpr VkShaderStageFlags kFrag = VK_SHADER_STAGE_FRAGMENT_BIT;
+  constexpr VkDescriptorType kSsbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kImage = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  const VkDescriptorSetLayoutBinding bindings[RS_BINDING_COUNT] = {
+      layoutBinding(RS_BINDING_TRIANGLE_MATERIAL, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_MATERIALS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_LIGHTS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_TEXELS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_TEXTURES, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_PROBES, kImage, RS_PROBE_TEXTURES, kFrag),
+      layoutBinding(RS_BINDING_ENV_BRDF, kImage, 1, kFrag),
+      layoutBinding(RS_BINDING_VIEWS, kSsbo, 1, VK_SHADER_STAGE_VERTEX_BIT | kFrag),
+      layoutBinding(RS_BINDING_SHADOW_LIGHTS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_SHADOW_LAYERS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_SHADOW_MAP, kImage, 1, kFrag)};
+  VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  lci.bindingCount = RS_BINDING_COUNT;
+  lci.pBindings = bindings;
+  VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &s.setLayout));
+  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                            sizeof(shaders::RsPushConstants)};
+  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pli.setLayoutCount = 1;
+  pli.pSetLayouts = &s.setLayout;
+  pli.pushConstantRangeCount = 1;
+  pli.pPushConstantRanges = &range;
+  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.layout));
+  const VkPushConstantRange shadowRange{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(glm::mat4)};
+  pli.setLayoutCount = 0;
+  pli.pPushConstantRanges = &shadowRange;
+  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.shadowLayout));
+  s.shadowPipeline = s.createPipeline(true, 0);
+  s.pipelineFor(0);
+
+  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 2}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
   // The environment BRDF table, computed at start-up (glossy_sh.h), and the lobe fit.
   {
@@ -269,9 +533,11 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
     s.push.lobeBand2 = {static_cast<float>(fit.band2[0]), static_cast<float>(fit.band2[1]),
                         static_cast<float>(fit.band2[2]), static_cast<float>(fit.band2[3])};
   }
-  // No volume yet: a 1³ black one keeps every descriptor valid.
-  s.uploadVolume(glm::uvec3(1), std::vector<float>(27, 0.0f));
+  s.planShadows(scene);
+  s.push.shadowMapSize = options.shadowMapSize;
   s.push.lightCount = s.gpu.lightCount;
+  // No volume yet: a 1³ black one keeps every descriptor valid (and writes them all).
+  s.uploadVolume(glm::uvec3(1), std::vector<float>(27, 0.0f));
 }
 
 RasterRenderer::~RasterRenderer() {
@@ -279,15 +545,16 @@ RasterRenderer::~RasterRenderer() {
   VulkanDevice& d = *s.d;
   vkDeviceWaitIdle(d.device);
   for (GpuImage& img : s.probeTextures) destroyImage(d, img);
-  destroyImage(d, s.envBrdf);
-  destroyImage(d, s.color);
-  destroyImage(d, s.depth);
-  destroyBuffer(d, s.readback);
+  for (GpuImage* img : {&s.envBrdf, &s.color, &s.depth, &s.shadowMap}) destroyImage(d, *img);
+  for (Buffer* b : {&s.readback, &s.views, &s.shadowLights, &s.shadowLayers}) destroyBuffer(d, *b);
   destroyGpuScene(d, s.gpu);
-  if (s.sampler) vkDestroySampler(d.device, s.sampler, nullptr);
+  for (VkSampler sampler : {s.sampler, s.shadowSampler})
+    if (sampler) vkDestroySampler(d.device, sampler, nullptr);
   if (s.pool) vkDestroyDescriptorPool(d.device, s.pool, nullptr);
-  if (s.pipeline) vkDestroyPipeline(d.device, s.pipeline, nullptr);
-  if (s.layout) vkDestroyPipelineLayout(d.device, s.layout, nullptr);
+  for (auto& [mask, pipeline] : s.pipelines) vkDestroyPipeline(d.device, pipeline, nullptr);
+  if (s.shadowPipeline) vkDestroyPipeline(d.device, s.shadowPipeline, nullptr);
+  for (VkPipelineLayout l : {s.layout, s.shadowLayout})
+    if (l) vkDestroyPipelineLayout(d.device, l, nullptr);
   if (s.setLayout) vkDestroyDescriptorSetLayout(d.device, s.setLayout, nullptr);
 }
 
@@ -300,75 +567,50 @@ void RasterRenderer::setProbes(const ProbeVolumeData& volume) {
   impl_->push.volumeMin = {volume.min.x, volume.min.y, volume.min.z, 1.0f};
   impl_->push.volumeMax = {volume.max.x, volume.max.y, volume.max.z, 0.0f};
   impl_->push.volumeDims = {static_cast<float>(volume.dims.x), static_cast<float>(volume.dims.y),
-                            static_cast<float>(volume.dims.z), 0.0f};
+                            static_cast<float>(volume.dims.z), volume.hallucinateZh3 ? 1.0f : 0.0f};
+}
+
+void RasterRenderer::setShading(const scene::Scene& scene) {
+  Impl& s = *impl_;
+  if (scene.triangleMaterial.size() != s.indexCount / 3)
+    throw std::invalid_argument("setShading needs the same geometry (" + scene.name + " differs)");
+  vkDeviceWaitIdle(s.d->device);
+  uploadGpuShading(*s.d, scene, s.gpu);
+  s.push.lightCount = s.gpu.lightCount;
+  s.planShadows(scene);
+  s.writeDescriptors();
+}
+
+std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& views) {
+  Impl& s = *impl_;
+  if (views.size() > Impl::kMaxViews) throw std::invalid_argument("at most 256 views per view set");
+  std::vector<Image> out(views.size());
+  s.renderShadows();
+  const auto t0 = Clock::now();
+  auto* dst = static_cast<shaders::RsView*>(s.views.mapped);
+  for (size_t k = 0; k < views.size(); ++k) {
+    std::memcpy(&dst[k].viewProj, &views[k].viewProj[0][0], sizeof(float) * 16);
+    dst[k].eye = {views[k].eye.x, views[k].eye.y, views[k].eye.z, 1.0f};
+  }
+  const auto count = static_cast<uint32_t>(views.size());
+  for (uint32_t first = 0; first < count; first += s.chunk) s.renderChunk(first, std::min(s.chunk, count - first), out);
+  s.timings.viewsMs = msSince(t0);
+  return out;
+}
+
+Image RasterRenderer::render(const glm::mat4& viewProj, const glm::vec3& eye) {
+  ViewInfo view;
+  view.viewProj = viewProj;
+  view.eye = eye;
+  return std::move(renderViews({view})[0]);
 }
 
 glm::mat4 RasterRenderer::viewProjection(const CameraView& c) const {
   const float aspect = static_cast<float>(impl_->width) / static_cast<float>(impl_->height);
-  glm::mat4 proj = glm::perspectiveRH_ZO(c.yfov, aspect, 0.01f, 200.0f);
-  proj[1][1] = -proj[1][1];  // Vulkan's y points down
-  return proj * glm::lookAtRH(c.position, c.position + c.forward, c.up);
+  return vulkanPerspective(c.yfov, aspect, 0.01f, 200.0f) * glm::lookAtRH(c.position, c.position + c.forward, c.up);
 }
 
-Image RasterRenderer::render(const glm::mat4& viewProj, const glm::vec3& eye) {
-  Impl& s = *impl_;
-  VulkanDevice& d = *s.d;
-  std::memcpy(&s.push.viewProj, &viewProj[0][0], sizeof(float) * 16);
-  s.push.eye = {eye.x, eye.y, eye.z, 1.0f};
-  submitAndWait(d, [&](VkCommandBuffer cmd) {
-    transitionImage(cmd, s.color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
-    transitionImage(cmd, s.depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-    VkRenderingAttachmentInfo colorInfo{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    colorInfo.imageView = s.color.view;
-    colorInfo.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    colorInfo.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    colorInfo.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    VkRenderingAttachmentInfo depthInfo{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depthInfo.imageView = s.depth.view;
-    depthInfo.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depthInfo.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depthInfo.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    depthInfo.clearValue.depthStencil = {1.0f, 0};
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {s.width, s.height}};
-    ri.layerCount = 1;
-    ri.colorAttachmentCount = 1;
-    ri.pColorAttachments = &colorInfo;
-    ri.pDepthAttachment = &depthInfo;
-    vkCmdBeginRendering(cmd, &ri);
-    const VkViewport viewport{0, 0, static_cast<float>(s.width), static_cast<float>(s.height), 0, 1};
-    const VkRect2D scissor{{0, 0}, {s.width, s.height}};
-    vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vkCmdSetScissor(cmd, 0, 1, &scissor);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.layout, 0, 1, &s.set, 0, nullptr);
-    vkCmdPushConstants(cmd, s.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof s.push,
-                       &s.push);
-    const VkBuffer vbufs[3] = {s.gpu.accel.positions.buffer, s.gpu.normals.buffer, s.gpu.texcoords.buffer};
-    const VkDeviceSize offsets[3] = {0, 0, 0};
-    vkCmdBindVertexBuffers(cmd, 0, 3, vbufs, offsets);
-    vkCmdBindIndexBuffer(cmd, s.gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
-    vkCmdDrawIndexed(cmd, s.indexCount, 1, 0, 0, 0);
-    vkCmdEndRendering(cmd);
-    transitionImage(cmd, s.color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {s.width, s.height, 1};
-    vkCmdCopyImageToBuffer(cmd, s.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.readback.buffer, 1, &region);
-    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0,
-                         nullptr);
-  });
-  Image out;
-  out.width = s.width;
-  out.height = s.height;
-  out.rgb.resize(static_cast<size_t>(s.width) * s.height * 3);
-  const float* src = static_cast<const float*>(s.readback.mapped);
-  for (size_t i = 0; i < static_cast<size_t>(s.width) * s.height; ++i)
-    for (int c = 0; c < 3; ++c) out.rgb[i * 3 + c] = src[i * 4 + c];
-  return out;
-}
+uint32_t RasterRenderer::chunkSize() const { return impl_->chunk; }
+const RasterTimings& RasterRenderer::timings() const { return impl_->timings; }
 
 }  // namespace probecast::renderer

@@ -1,5 +1,6 @@
 #include "vk_device.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -104,8 +105,12 @@ void createDevice(VulkanDevice& d, bool validation, bool preferGpu) {
   d.physical = devices[best];
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   d.rtProperties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
+  VkPhysicalDeviceMultiviewProperties multiview{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MULTIVIEW_PROPERTIES};
+  d.rtProperties.pNext = &multiview;
   props.pNext = &d.rtProperties;
   vkGetPhysicalDeviceProperties2(d.physical, &props);
+  d.rtProperties.pNext = nullptr;
+  d.maxMultiviewViewCount = std::max(1u, multiview.maxMultiviewViewCount);
   d.name = props.properties.deviceName;
   vkGetPhysicalDeviceMemoryProperties(d.physical, &d.memory);
 
@@ -126,10 +131,13 @@ void createDevice(VulkanDevice& d, bool validation, bool preferGpu) {
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   v12.bufferDeviceAddress = VK_TRUE;
   v12.pNext = &as;
+  VkPhysicalDeviceVulkan11Features v11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
+  v11.multiview = VK_TRUE;  // core since 1.1 and mandatory
+  v11.pNext = &v12;
   VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   v13.synchronization2 = VK_TRUE;
   v13.dynamicRendering = VK_TRUE;
-  v13.pNext = &v12;
+  v13.pNext = &v11;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   features.pNext = &v13;
   VkPhysicalDeviceFeatures available{};

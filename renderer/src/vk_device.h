@@ -19,6 +19,7 @@ struct VulkanDevice {
   std::string name;
   VkPhysicalDeviceMemoryProperties memory{};
   VkPhysicalDeviceRayTracingPipelinePropertiesKHR rtProperties{};
+  uint32_t maxMultiviewViewCount = 1;
   std::atomic<uint32_t> validationMessages{0};
 
   PFN_vkCreateAccelerationStructureKHR vkCreateAccelerationStructureKHR = nullptr;

@@ -53,16 +53,19 @@ Buffer createBufferWithData(VulkanDevice& d, const void* data, size_t bytes, VkB
   return b;
 }
 
-GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImageUsageFlags usage, bool type3d) {
+namespace {
+GpuImage createImageLayers(VulkanDevice& d, VkFormat format, VkExtent3D extent, uint32_t layers,
+                           VkImageUsageFlags usage, bool type3d) {
   GpuImage img;
   img.format = format;
   img.extent = extent;
+  img.layers = layers;
   VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ici.imageType = type3d ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
   ici.format = format;
   ici.extent = extent;
   ici.mipLevels = 1;
-  ici.arrayLayers = 1;
+  ici.arrayLayers = layers;
   ici.samples = VK_SAMPLE_COUNT_1_BIT;
   ici.tiling = VK_IMAGE_TILING_OPTIMAL;
   ici.usage = usage;
@@ -84,14 +87,31 @@ GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImag
   const bool depth = format == VK_FORMAT_D32_SFLOAT;
   VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   vci.image = img.image;
-  vci.viewType = type3d ? VK_IMAGE_VIEW_TYPE_3D : VK_IMAGE_VIEW_TYPE_2D;
+  vci.viewType = type3d ? VK_IMAGE_VIEW_TYPE_3D : layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
   vci.format = format;
-  vci.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0, 1};
+  const auto aspect = static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT);
+  vci.subresourceRange = {aspect, 0, 1, 0, layers};
   VK_CHECK(vkCreateImageView(d.device, &vci, nullptr, &img.view));
+  if (layers > 1)
+    for (uint32_t k = 0; k < layers; ++k) {
+      vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
+      vci.subresourceRange = {aspect, 0, 1, k, 1};
+      VK_CHECK(vkCreateImageView(d.device, &vci, nullptr, &img.layerViews.emplace_back()));
+    }
   return img;
+}
+}  // namespace
+
+GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImageUsageFlags usage, bool type3d) {
+  return createImageLayers(d, format, extent, 1, usage, type3d);
+}
+
+GpuImage createImageArray(VulkanDevice& d, VkFormat format, VkExtent2D extent, uint32_t layers, VkImageUsageFlags usage) {
+  return createImageLayers(d, format, {extent.width, extent.height, 1}, layers, usage, false);
 }
 
 void destroyImage(VulkanDevice& d, GpuImage& img) {
+  for (VkImageView v : img.layerViews) vkDestroyImageView(d.device, v, nullptr);
   if (img.view) vkDestroyImageView(d.device, img.view, nullptr);
   if (img.image) vkDestroyImage(d.device, img.image, nullptr);
   if (img.memory) vkFreeMemory(d.device, img.memory, nullptr);
@@ -109,7 +129,8 @@ void transitionImage(VkCommandBuffer cmd, const GpuImage& img, VkImageLayout fro
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = img.image;
   const bool depth = img.format == VK_FORMAT_D32_SFLOAT;
-  b.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0, 1};
+  b.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0,
+                        img.layers};
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.imageMemoryBarrierCount = 1;
   dep.pImageMemoryBarriers = &b;

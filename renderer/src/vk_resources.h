@@ -1,6 +1,8 @@
 // Buffers and one-off command submission.
 #pragma once
 
+#include <vector>
+
 #include <cstddef>
 #include <functional>
 
@@ -28,10 +30,14 @@ struct GpuImage {
   VkImageView view = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent3D extent{};
+  uint32_t layers = 1;
+  std::vector<VkImageView> layerViews;  // 2D arrays only: one 2D view per layer
 };
 
 // A 2D or 3D image (depth > 1 or `type3d`) with one mip level and a view of all of it.
 GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImageUsageFlags usage, bool type3d = false);
+// A 2D array of `layers` layers: `view` sees them all (2D array), `layerViews[k]` layer k alone.
+GpuImage createImageArray(VulkanDevice& d, VkFormat format, VkExtent2D extent, uint32_t layers, VkImageUsageFlags usage);
 void destroyImage(VulkanDevice& d, GpuImage& image);
 // A whole-image layout transition (synchronisation2, all commands): simple and correct, not fast.
 void transitionImage(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to);
