@@ -10,6 +10,7 @@
 #include "probecast/codec/probe_file.h"
 #include "commands.h"
 #include "scene_options.h"
+#include "raster_bench.h"
 #include "stream_bench.h"
 #include "update_bench.h"
 
@@ -153,6 +154,53 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     o.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::UpdateBenchResult r = bench::runUpdateBench(o);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", uo->json, r.svg, uo->chart);
+    exitCode = 0;
+  });
+
+  CLI::App* raster = bench->add_subcommand("raster", "raster client: ms per view for 1..48 views, PSNR/SSIM per representation");
+  auto rscene = std::make_shared<SceneOptions>();
+  auto rgpu = std::make_shared<GpuOptions>();
+  auto rgrid = std::make_shared<GridOptions>();
+  auto rtracer = std::make_shared<TracerOptions>();
+  struct RasterOptions {
+    std::string json, chart;
+    std::vector<uint32_t> size{320, 200};
+    bench::RasterBenchOptions bench;
+  };
+  auto ro = std::make_shared<RasterOptions>();
+  rscene->add(raster);
+  rgpu->add(raster);
+  rgrid->add(raster);
+  rtracer->add(raster);
+  raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM), comma-separated")
+      ->delimiter(',');
+  raster->add_option("--size", ro->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
+  raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));
+  raster->add_option("--repeats", ro->bench.repeats, "timed renders per case (median)")->check(CLI::Range(1, 1000));
+  raster->add_option("--reference-spp", ro->bench.referenceSpp, "samples per pixel of the reference")
+      ->check(CLI::Range(1, 1 << 20));
+  raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
+      ->check(CLI::Range(16, 8192));
+  raster->add_option("--json", ro->json, "write the results as JSON here")->required();
+  raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
+  raster->callback([=, &exitCode] {
+    ro->bench.scene = rscene->load();
+    ro->bench.grid = rgrid->resolve(ro->bench.scene);
+    ro->bench.updater = rtracer->options();
+    ro->bench.context = rgpu->context();
+    ro->bench.width = ro->size[0];
+    ro->bench.height = ro->size[1];
+    ro->bench.command = commandLine();
+    ro->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    const bench::RasterBenchResult r = bench::runRasterBench(ro->bench);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", ro->json, r.svg, ro->chart);
+    if (!ro->chart.empty()) {
+      std::string views = ro->chart;
+      const size_t dot = views.rfind(".svg");
+      views = (dot == std::string::npos ? views : views.substr(0, dot)) + "_views.svg";
+      writeTextFile(views, r.svgViews);
+      fmt::print("wrote {}\n", views);
+    }
     exitCode = 0;
   });
 

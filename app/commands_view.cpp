@@ -94,11 +94,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
         fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);
       }
       fmt::print(stderr, "\n");
-      volume.dims = g.dims;
-      volume.min = g.min;
-      volume.max = g.max;
-      volume.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
-      volume.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+      volume = renderer::volumeFromUpdater(updater);
     } else {
       ProbeVolume file;
       if (!readProbeFile(o->probes, file, error)) throw std::runtime_error(error);

@@ -17,7 +17,7 @@ struct SceneOptions {
   std::string scene = "builtin:cornell";
   float t = 0.0f;
   void add(CLI::App* cmd) {
-    cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, hall)");
+    cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
     cmd->add_option("--t", t, "animation parameter of built-in scenes")->check(CLI::Range(0.0f, 1.0f));
   }
   scene::Scene load() const {

@@ -58,7 +58,7 @@ vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) 
   return base * (1.0 - metallic) / PI + d * g * f / max(4.0 * nl * nv, 1e-6);
 }
 
-// The probe volume's 27 SH coefficients at p (trilinear).
+// The probe volume's 27 SH coefficients at p (trilinear over active probes).
 bool probeCoefficients(vec3 p, out float c[28]) {
   for (int i = 0; i < 28; ++i) c[i] = 0.0;
   if (pc.volumeMin.w == 0.0) return false;
@@ -72,6 +72,10 @@ bool probeCoefficients(vec3 p, out float c[28]) {
     c[4 * t + 2] = v.z;
     c[4 * t + 3] = v.w;
   }
+  // Weighted by activity (raster_client.cpp): renormalise so inactive probes never darken.
+  float weight = c[27];
+  if (weight > 0.0)
+    for (int i = 0; i < 27; ++i) c[i] /= weight;
   return true;
 }
 

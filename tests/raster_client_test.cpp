@@ -83,12 +83,7 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   uo.samplesPerProbe = 64;
   ProbeUpdater updater(context, s, g, uo);
   updater.update();
-  ProbeVolumeData v;
-  v.dims = g.dims;
-  v.min = g.min;
-  v.max = g.max;
-  v.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
-  v.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+  const ProbeVolumeData v = volumeFromUpdater(updater);
   RasterRenderer raster(context, s, 48, 36);
   raster.setProbes(v);
   const CameraView cam = CameraView::fromScene(s);

@@ -11,6 +11,7 @@
 
 #include "gpu_scene.h"
 #include "probecast/renderer/glossy_sh.h"
+#include "probecast/renderer/probe_updater.h"
 #include "raster.frag.h"
 #include "raster.vert.h"
 #include "raster_shared.h"
@@ -52,6 +53,17 @@ void fillInactiveProbes(ProbeVolumeData& v) {
         }
     known.swap(next);
   }
+}
+
+ProbeVolumeData volumeFromUpdater(const ProbeUpdater& updater) {
+  const ProbeGrid& g = updater.grid();
+  ProbeVolumeData v;
+  v.dims = g.dims;
+  v.min = g.min;
+  v.max = g.max;
+  v.probes.assign(updater.probes(), updater.probes() + static_cast<size_t>(g.count()) * kProbeFloats);
+  v.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+  return v;
 }
 
 ProbeVolumeData decodeAs(const ProbeVolumeData& volume, Representation repr) {
@@ -168,7 +180,11 @@ struct RasterRenderer::Impl {
     vkUpdateDescriptorSets(d->device, 11, writes, 0, nullptr);
   }
 
-  void uploadVolume(const glm::uvec3 dims, const std::vector<float>& probes) {
+  // Coefficients premultiplied by a weight, the weight in the last texel's w: after trilinear
+  // filtering, dividing by the filtered weight renormalises over active probes only. Inactive
+  // probes weigh kInactiveWeight (their filled value only shows where no active probe is near).
+  static constexpr float kInactiveWeight = 1e-3f;
+  void uploadVolume(const glm::uvec3 dims, const std::vector<float>& probes, const std::vector<uint8_t>& active) {
     for (GpuImage& img : probeTextures) destroyImage(*d, img);
     const size_t count = static_cast<size_t>(dims.x) * dims.y * dims.z;
     Buffer staging = createBuffer(*d, count * 4 * sizeof(float) * RS_PROBE_TEXTURES, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
@@ -177,7 +193,8 @@ struct RasterRenderer::Impl {
       for (size_t p = 0; p < count; ++p)
         for (int c = 0; c < 4; ++c) {
           const int k = 4 * t + c;
-          dst[(static_cast<size_t>(t) * count + p) * 4 + c] = k < 27 ? probes[p * 27 + k] : 0.0f;
+          const float weight = active.empty() || active[p] ? 1.0f : kInactiveWeight;
+          dst[(static_cast<size_t>(t) * count + p) * 4 + c] = k < 27 ? weight * probes[p * 27 + k] : weight;
         }
     for (GpuImage& img : probeTextures)
       img = createImage(*d, VK_FORMAT_R32G32B32A32_SFLOAT, {dims.x, dims.y, dims.z},
@@ -537,7 +554,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.push.shadowMapSize = options.shadowMapSize;
   s.push.lightCount = s.gpu.lightCount;
   // No volume yet: a 1³ black one keeps every descriptor valid (and writes them all).
-  s.uploadVolume(glm::uvec3(1), std::vector<float>(27, 0.0f));
+  s.uploadVolume(glm::uvec3(1), std::vector<float>(27, 0.0f), {});
 }
 
 RasterRenderer::~RasterRenderer() {
@@ -563,7 +580,7 @@ void RasterRenderer::setProbes(const ProbeVolumeData& volume) {
   if (count == 0 || volume.probes.size() != count * 27) throw std::invalid_argument("probe volume size mismatch");
   ProbeVolumeData filled = volume;
   fillInactiveProbes(filled);
-  impl_->uploadVolume(volume.dims, filled.probes);
+  impl_->uploadVolume(volume.dims, filled.probes, volume.active);
   impl_->push.volumeMin = {volume.min.x, volume.min.y, volume.min.z, 1.0f};
   impl_->push.volumeMax = {volume.max.x, volume.max.y, volume.max.z, 0.0f};
   impl_->push.volumeDims = {static_cast<float>(volume.dims.x), static_cast<float>(volume.dims.y),

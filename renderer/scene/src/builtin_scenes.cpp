@@ -67,6 +67,32 @@ void makeClosedBox(float t, Scene& s) {
   s.lights.push_back(light);
 }
 
+// Two rooms x in [-2, 2], y in [0, 2], z in [-1, 1], split at x = 0 by a solid wall 0.2 m thick;
+// a point light in the +x room. Probes inside the wall must not leak darkness into the lit room
+// (nor light into the dark one). The camera looks at the wall from the lit room.
+void makeThinWall(float t, Scene& s) {
+  const uint32_t white = addMaterial(s, "white", glm::vec3(0.7f));
+  const uint32_t tint = addMaterial(s, "tint", glm::vec3(0.7f, 0.5f, 0.35f));
+  const float x0 = -2.0f, x1 = 2.0f, y0 = 0.0f, y1 = 2.0f, z0 = -1.0f, z1 = 1.0f;
+  addQuad(s, {x0, y0, z1}, {x1, y0, z1}, {x1, y0, z0}, {x0, y0, z0}, white);  // floor +Y
+  addQuad(s, {x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1}, white);  // ceiling −Y
+  addQuad(s, {x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0}, white);  // back +Z
+  addQuad(s, {x1, y0, z1}, {x0, y0, z1}, {x0, y1, z1}, {x1, y1, z1}, white);  // front −Z
+  addQuad(s, {x0, y0, z1}, {x0, y0, z0}, {x0, y1, z0}, {x0, y1, z1}, white);  // left +X
+  addQuad(s, {x1, y0, z0}, {x1, y0, z1}, {x1, y1, z1}, {x1, y1, z0}, tint);   // right −X
+  addBox(s, {0.0f, 1.0f, 0.0f}, {0.1f, 1.0f, 1.0f}, 0.0f, white);             // the wall, faces outward
+  Light light;
+  light.position = {1.2f + 0.3f * std::cos(glm::two_pi<float>() * t), 1.5f, 0.3f * std::sin(glm::two_pi<float>() * t)};
+  light.intensity = 3.0f;
+  s.lights.push_back(light);
+  Camera cam;
+  cam.name = "lit-room";
+  cam.position = {1.95f, 1.0f, 0.0f};
+  cam.forward = {-1.0f, 0.0f, 0.0f};
+  cam.yfov = 1.2f;
+  s.cameras.push_back(cam);
+}
+
 // A closed 20 m × 6 m × 20 m hall: a finely tessellated floor and 4,600 blocks (≈100k triangles in
 // all), four point lights under the ceiling. For performance figures on a realistic triangle count.
 void makeHall(float t, Scene& s) {
@@ -108,16 +134,17 @@ void makeHall(float t, Scene& s) {
 
 }  // namespace
 
-std::vector<std::string> builtinSceneNames() { return {"cornell", "closed-box", "hall"}; }
+std::vector<std::string> builtinSceneNames() { return {"cornell", "closed-box", "thin-wall", "hall"}; }
 
 bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error) {
   scene = Scene{};
   scene.name = "builtin:" + name;
   if (name == "cornell") makeCornell(t, scene);
   else if (name == "closed-box") makeClosedBox(t, scene);
+  else if (name == "thin-wall") makeThinWall(t, scene);
   else if (name == "hall") makeHall(t, scene);
   else {
-    error = "unknown built-in scene '" + name + "' (have: cornell, closed-box, hall)";
+    error = "unknown built-in scene '" + name + "' (have: cornell, closed-box, thin-wall, hall)";
     return false;
   }
   finalizeScene(scene);

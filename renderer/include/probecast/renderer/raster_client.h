@@ -1,7 +1,8 @@
 // The raster client: renders views of a scene with direct light from its punctual lights (shadow
 // maps with PCF), surface emission, diffuse indirect light albedo/π · E(n) and split-sum glossy
-// indirect light from a probe volume (SH in 3D textures, hardware trilinear filtering; inactive
-// probes are filled from active neighbours so they never darken them). Offscreen, dynamic
+// indirect light from a probe volume (SH in 3D textures, hardware trilinear filtering weighted by
+// probe activity, so probes inside walls never darken their active neighbours; inactive probes are
+// also filled from active neighbours for places no active probe reaches). Offscreen, dynamic
 // rendering, linear radiance out. A view set renders with its shadow maps drawn once, in chunks
 // of views: one pass per view, or one multiview pass per chunk.
 #pragma once
@@ -30,6 +31,10 @@ struct ProbeVolumeData {
   // pixel from the interpolated L1 (interpolate, then hallucinate).
   bool hallucinateZh3 = false;
 };
+
+class ProbeUpdater;
+// The updater's current probes and active mask as a volume.
+ProbeVolumeData volumeFromUpdater(const ProbeUpdater& updater);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back.
 // zh3h decodes L1 only and sets hallucinateZh3; zh3 expands to SH3 here, before upload.

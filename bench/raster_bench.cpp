@@ -1,0 +1,160 @@
+#include "raster_bench.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "image_metrics.h"
+#include "probecast/codec/record.h"
+#include "probecast/renderer/view_sets.h"
+#include "svg_chart.h"
+
+namespace probecast::bench {
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Representation {
+  std::string name;
+  bool viaCodec = false;
+  probecast::Representation repr = probecast::Representation::L2;
+};
+
+}  // namespace
+
+RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
+  using Clock = std::chrono::steady_clock;
+  const auto say = [&](const std::string& s) {
+    if (o.progress) o.progress(s);
+  };
+  renderer::VulkanContext context(o.context);
+  renderer::ProbeUpdater updater(context, o.scene, o.grid, o.updater);
+  for (uint32_t u = 0; u < o.updates; ++u) updater.update();
+  const renderer::ProbeVolumeData volume = renderer::volumeFromUpdater(updater);
+  say(fmt::format("raster bench: {} probe updates of {} probes done", o.updates, o.grid.count()));
+
+  const renderer::CameraView camera = renderer::CameraView::fromScene(o.scene);
+  renderer::ReferenceOptions ro;
+  ro.width = o.width;
+  ro.height = o.height;
+  ro.samplesPerPixel = o.referenceSpp;
+  ro.progress = [&](uint32_t done, uint32_t total) {
+    if (done == total || done % 64 == 0) say(fmt::format("raster bench: reference {}/{} spp", done, total));
+  };
+  const renderer::Image reference = renderer::renderReference(context, o.scene, camera, ro);
+
+  nlohmann::json json;
+  json["command"] = o.command;
+  json["scene"] = o.scene.name;
+  json["device"] = context.deviceName();
+  json["size"] = {o.width, o.height};
+  json["grid"] = {o.grid.dims.x, o.grid.dims.y, o.grid.dims.z};
+  json["probe_updates"] = o.updates;
+  json["reference_spp"] = o.referenceSpp;
+  json["shadow_map_size"] = o.raster.shadowMapSize;
+  json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
+  std::string table = fmt::format("raster bench: {} at {}x{} on {}\n", o.scene.name, o.width, o.height,
+                                  context.deviceName());
+
+  // Quality and mono speed per representation (float = the updater's probes without the codec).
+  const std::vector<Representation> reprs = {{"float", false},
+                                             {"l1", true, probecast::Representation::L1},
+                                             {"zh3h", true, probecast::Representation::Zh3Hallucinated},
+                                             {"zh3", true, probecast::Representation::Zh3},
+                                             {"l2", true, probecast::Representation::L2},
+                                             {"fp16", true, probecast::Representation::Fp16}};
+  renderer::RasterOptions perView = o.raster;
+  perView.passes = renderer::ViewPasses::PerView;
+  renderer::RasterRenderer raster(context, o.scene, o.width, o.height, perView);
+  ChartSeries qualitySeries{"representations (mono view)", {}, false};
+  table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
+  for (const Representation& r : reprs) {
+    raster.setProbes(r.viaCodec ? renderer::decodeAs(volume, r.repr) : volume);
+    const glm::mat4 vp = raster.viewProjection(camera);
+    renderer::Image image = raster.render(vp, camera.position);  // warm-up (and shadow maps)
+    std::vector<double> ms;
+    for (uint32_t k = 0; k < o.repeats; ++k) {
+      const auto t0 = Clock::now();
+      image = raster.render(vp, camera.position);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    }
+    const ImageMetrics m = compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    const double msPerView = median(ms);
+    json["representations"].push_back({{"representation", r.name},
+                                       {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},
+                                       {"psnr_db", m.psnrDb},
+                                       {"ssim", m.ssim},
+                                       {"ms_per_view", msPerView}});
+    qualitySeries.points.push_back({msPerView, m.psnrDb, r.name});
+    table += fmt::format("{:<6} {:>9.2f} {:>7.4f} {:>11.2f}\n", r.name, m.psnrDb, m.ssim, msPerView);
+    say(fmt::format("raster bench: {} {:.2f} dB", r.name, m.psnrDb));
+  }
+
+  // Speed per view set, both ways of drawing several views.
+  const renderer::ProbeVolumeData l2 = renderer::decodeAs(volume, probecast::Representation::L2);
+  raster.setProbes(l2);
+  renderer::RasterOptions multi = o.raster;
+  multi.passes = renderer::ViewPasses::Multiview;
+  renderer::RasterRenderer multiview(context, o.scene, o.width, o.height, multi);
+  multiview.setProbes(l2);
+  json["multiview_chunk"] = multiview.chunkSize();
+  std::vector<ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
+  table += fmt::format("\n{:<8} {:>6} {:>16} {:>16}\n", "views", "count", "per-view ms/view", "multiview ms/view");
+  renderer::ViewSetOptions vo;
+  vo.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
+  vo.displayDistance = std::max(0.1f, glm::length(0.5f * (o.scene.boundsMin + o.scene.boundsMax) - camera.position));
+  for (const std::string& name : o.viewSets) {
+    renderer::ViewSetSpec spec;
+    std::string error;
+    if (!renderer::parseViewSet(name, spec, error)) throw std::invalid_argument(error);
+    const auto views = renderer::makeViewSet(camera, spec, vo);
+    nlohmann::json row{{"views", name}, {"count", views.size()}};
+    double perViewMs[2] = {0, 0};
+    for (int way = 0; way < 2; ++way) {
+      renderer::RasterRenderer& r = way == 0 ? raster : multiview;
+      r.renderViews(views);  // warm-up
+      std::vector<double> ms;
+      for (uint32_t k = 0; k < o.repeats; ++k) {
+        r.renderViews(views);
+        ms.push_back(r.timings().viewsMs);
+      }
+      const double set = median(ms);
+      perViewMs[way] = set / static_cast<double>(views.size());
+      row[way == 0 ? "per_view_pass" : "multiview"] = {{"ms_per_view_set", set}, {"ms_per_view", perViewMs[way]}};
+      speedSeries[static_cast<size_t>(way)].points.push_back({static_cast<double>(views.size()), perViewMs[way], ""});
+    }
+    row["shadow_ms"] = raster.timings().shadowMs;
+    json["view_sets"].push_back(row);
+    table += fmt::format("{:<8} {:>6} {:>16.2f} {:>16.2f}\n", name, views.size(), perViewMs[0], perViewMs[1]);
+    say(fmt::format("raster bench: {} done", name));
+  }
+  table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
+  json["validation_messages"] = context.validationMessages();
+
+  ChartSpec spec;
+  spec.title = fmt::format("Raster client, {} at {}x{}: image quality against time per view", o.scene.name, o.width,
+                           o.height);
+  spec.xLabel = "ms per view (mono, median)";
+  spec.yLabel = "PSNR against the reference, dB";
+  spec.footnote = o.command;
+  RasterBenchResult result;
+  result.svg = renderSvgChart(spec, {qualitySeries});
+  ChartSpec views;
+  views.title = fmt::format("Raster client, {} at {}x{}: time per view against views per set", o.scene.name,
+                            o.width, o.height);
+  views.xLabel = "views in the set";
+  views.yLabel = "ms per view (median)";
+  views.logX = true;
+  views.footnote = o.command;
+  result.svgViews = renderSvgChart(views, speedSeries);
+  result.json = std::move(json);
+  result.table = std::move(table);
+  return result;
+}
+
+}  // namespace probecast::bench
