@@ -31,7 +31,7 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--target", o->target, "point the camera looks at X,Y,Z")->delimiter(',')->expected(3);
   cmd->add_option("--yfov", o->yfovDeg, "vertical field of view, degrees")->check(CLI::Range(1.0f, 179.0f));
   cmd->add_option("--out", o->out, "EXR file to write (linear radiance)")->required();
-  cmd->add_option("--png", o->png, "also write a gamma-2.2 PNG preview");
+  cmd->add_option("--png", o->png, "also write a PNG preview (filmic tone map)");
   cmd->add_option("--exposure", o->exposure, "scale applied to the PNG preview only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->callback([=, &exitCode] {
     const scene::Scene s = scene->load();

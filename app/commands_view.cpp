@@ -1,5 +1,6 @@
 // `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -14,8 +15,26 @@
 #include "probecast/renderer/view_sets.h"
 #include "probecast/service/client.h"
 #include "scene_options.h"
+#include "view_support.h"
 
 namespace probecast::app {
+
+renderer::ViewSetOptions viewSetOptions(const scene::Scene& s, uint32_t width, uint32_t height) {
+  const renderer::CameraView camera = renderer::CameraView::fromScene(s);
+  renderer::ViewSetOptions vo;
+  vo.aspect = static_cast<float>(width) / static_cast<float>(height);
+  vo.displayDistance = std::max(0.1f, glm::length(0.5f * (s.boundsMin + s.boundsMax) - camera.position));
+  return vo;
+}
+
+std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views) {
+  std::vector<View> out(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    std::memcpy(out[k].viewProj, &views[k].viewProj[0][0], sizeof out[k].viewProj);
+    for (int i = 0; i < 3; ++i) out[k].eye[i] = views[k].eye[i];
+  }
+  return out;
+}
 
 void addViewCommand(CLI::App& app, int& exitCode) {
   CLI::App* cmd = app.add_subcommand("view", "render views (mono, stereo, lf:NxM quilt) lit by probes");
@@ -25,6 +44,8 @@ void addViewCommand(CLI::App& app, int& exitCode) {
   auto tracer = std::make_shared<TracerOptions>();
   struct Options {
     std::string probes = "live", views = "lf:5x5", out = "out/view", connect, token, tlsCa, tlsName;
+    std::string repr = "float", passes = "per-view", toneMap = "filmic";
+    uint32_t shadowMap = 1024;
     double waitSeconds = 3.0;
     std::vector<uint32_t> size{320, 200};
     uint32_t updates = 4;
@@ -49,11 +70,19 @@ void addViewCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
+  cmd->add_option("--repr", o->repr, "local probes: pass them through the codec first (float = as traced)")
+      ->check(CLI::IsMember({"float", "l1", "zh3h", "zh3", "l2", "fp16"}));
+  cmd->add_option("--passes", o->passes, "per-view (one pass per view) or multiview (chunks of views per pass)")
+      ->check(CLI::IsMember({"per-view", "multiview"}));
+  cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
+  cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([=, &exitCode] {
     renderer::ViewSetSpec spec;
     std::string error;
     if (!renderer::parseViewSet(o->views, spec, error)) throw std::runtime_error(error);
     const scene::Scene s = scene->load();
+    const std::vector<renderer::ViewInfo> viewSet =
+        renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, viewSetOptions(s, o->size[0], o->size[1]));
     renderer::VulkanContext context(gpu->context());
     renderer::ProbeVolumeData volume;
     if (!o->connect.empty()) {
@@ -69,7 +98,9 @@ void addViewCommand(CLI::App& app, int& exitCode) {
         cc.rootCertPem = ss.str();
         cc.tlsServerName = o->tlsName;
       }
+      cc.interpolateThenHallucinate = true;
       service::ProbeClient client(cc);
+      client.setViews(priorityViews(viewSet));
       client.start();
       const auto start = std::chrono::steady_clock::now();
       while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o->waitSeconds) &&
@@ -84,6 +115,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
       volume.max = {snap.bounds.max[0], snap.bounds.max[1], snap.bounds.max[2]};
       volume.probes = std::move(snap.probes);
       volume.active = std::move(snap.active);
+      volume.hallucinateZh3 = snap.l1Only;
       fmt::print("view: {} frames ({} bytes) from {}\n", client.stats().framesApplied, client.stats().bytesReceived,
                  o->connect);
     } else if (o->probes == "live") {
@@ -104,21 +136,24 @@ void addViewCommand(CLI::App& app, int& exitCode) {
       volume.probes = std::move(file.probes);
       volume.active = std::move(file.active);
     }
-    renderer::RasterRenderer raster(context, s, o->size[0], o->size[1]);
+    if (o->repr != "float") {
+      if (!o->connect.empty()) throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
+      volume = renderer::decodeAs(volume, *parseRepresentation(o->repr));
+    }
+    renderer::RasterOptions ro;
+    ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
+    ro.shadowMapSize = o->shadowMap;
+    renderer::RasterRenderer raster(context, s, o->size[0], o->size[1], ro);
     raster.setProbes(volume);
-    const renderer::CameraView camera = renderer::CameraView::fromScene(s);
-    renderer::ViewSetOptions vo;
-    vo.aspect = static_cast<float>(o->size[0]) / static_cast<float>(o->size[1]);
-    vo.displayDistance = std::max(0.1f, glm::length(0.5f * (s.boundsMin + s.boundsMax) - camera.position));
-    const auto views = renderer::makeViewSet(camera, spec, vo);
-    std::vector<renderer::Image> images;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (const auto& v : views) images.push_back(raster.render(v.viewProj, v.eye));
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const auto& views = viewSet;
+    std::vector<renderer::Image> images = raster.renderViews(views);
+    const double ms = raster.timings().viewsMs;
     std::filesystem::create_directories(o->out);
     const renderer::Image quilt = renderer::composeQuilt(images, views, spec.columns, spec.rows);
     const auto w = static_cast<int>(quilt.width), h = static_cast<int>(quilt.height);
-    if (!bench::writePngPreview(o->out + "/quilt.png", quilt.rgb, w, h, o->exposure, error) ||
+    bench::ToneMap toneMap = bench::ToneMap::Filmic;
+    bench::parseToneMap(o->toneMap, toneMap);
+    if (!bench::writePngPreview(o->out + "/quilt.png", quilt.rgb, w, h, o->exposure, error, toneMap) ||
         !bench::writeExr(o->out + "/quilt.exr", quilt.rgb, w, h, error))
       throw std::runtime_error(error);
     if (o->exr)

@@ -36,11 +36,19 @@ bool readExr(const std::string& path, std::vector<float>& rgb, int& width, int& 
   return true;
 }
 
+bool parseToneMap(const std::string& name, ToneMap& out) {
+  if (name == "filmic") out = ToneMap::Filmic;
+  else if (name == "gamma") out = ToneMap::Gamma;
+  else return false;
+  return true;
+}
+
 bool writePngPreview(const std::string& path, const std::vector<float>& rgb, int width, int height, float exposure,
-                     std::string& error) {
+                     std::string& error, ToneMap toneMap) {
   std::vector<uint8_t> bytes(rgb.size());
   for (size_t i = 0; i < rgb.size(); ++i) {
-    const float v = std::isfinite(rgb[i]) ? std::max(0.0f, rgb[i] * exposure) : 0.0f;
+    float v = std::isfinite(rgb[i]) ? std::max(0.0f, rgb[i] * exposure) : 0.0f;
+    if (toneMap == ToneMap::Filmic) v = v * (2.51f * v + 0.03f) / (v * (2.43f * v + 0.59f) + 0.14f);
     bytes[i] = static_cast<uint8_t>(std::lround(255.0f * std::min(1.0f, std::pow(v, 1.0f / 2.2f))));
   }
   if (!stbi_write_png(path.c_str(), width, height, 3, bytes.data(), width * 3))

@@ -71,7 +71,10 @@ struct ProbeClient::Impl {
     }
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
-    if (!same || v.stream_epoch() != epoch) decoder = std::make_unique<StreamDecoder>(l);  // nothing held is valid
+    if (!same || v.stream_epoch() != epoch) {  // nothing held is valid
+      decoder = std::make_unique<StreamDecoder>(l);
+      decoder->setHallucinate(!config.interpolateThenHallucinate);
+    }
     layout = l;
     bounds = b;
     epoch = v.stream_epoch();
@@ -234,6 +237,7 @@ bool ProbeClient::snapshot(VolumeSnapshot& out) const {
   out.bounds = impl_->bounds;
   out.probes.assign(impl_->decoder->probes(), impl_->decoder->probes() + static_cast<size_t>(n) * kProbeFloats);
   out.active.assign(impl_->decoder->activeMask(), impl_->decoder->activeMask() + n);
+  out.l1Only = impl_->config.interpolateThenHallucinate && out.layout.repr == Representation::Zh3Hallucinated;
   out.framesApplied = impl_->stats.framesApplied;
   out.newestServerTimeUs = impl_->newestServerTimeUs;
   return true;

@@ -23,6 +23,9 @@ struct ClientConfig {
   std::string name = "probecast-client";
   int reconnectMinMs = 50;
   int reconnectMaxMs = 2000;
+  // zh3h streams: keep L1 only in the volume (VolumeSnapshot::l1Only) so a renderer can
+  // interpolate first and hallucinate per pixel; false: hallucinate per probe when decoding.
+  bool interpolateThenHallucinate = false;
 };
 
 struct VolumeSnapshot {
@@ -30,6 +33,7 @@ struct VolumeSnapshot {
   GridBounds bounds;
   std::vector<float> probes;    // 27 floats per probe (sh.h layout), last good volume
   std::vector<uint8_t> active;
+  bool l1Only = false;          // zh3h decoded without its hallucinated L2 band (see ClientConfig)
   uint32_t framesApplied = 0;
   uint64_t newestServerTimeUs = 0;
 };
