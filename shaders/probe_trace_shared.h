@@ -106,8 +106,8 @@ struct PtCameraPushConstants {
   float indirectClamp;
   uint emitterCount;
   float emitterPower;
-  uint pad0;
-  uint pad1;
+  float shiftRight;         // off-axis frustum: centre of the image on the tangent plane (× right)
+  float shiftUp;            // (× up); 0, 0 for a centred pinhole
 };
 
 #ifdef __cplusplus

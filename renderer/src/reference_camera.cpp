@@ -50,6 +50,8 @@ Image renderReference(VulkanContext& context, const scene::Scene& scene, const C
     push.forward = {f.x, f.y, f.z, std::tan(0.5f * camera.yfov)};
     push.right = {r.x, r.y, r.z, static_cast<float>(options.width) / static_cast<float>(options.height)};
     push.up = {u.x, u.y, u.z, 0.0f};
+    push.shiftRight = camera.shift.x;
+    push.shiftUp = camera.shift.y;
     push.width = options.width;
     push.height = options.height;
     push.seed = options.seed;

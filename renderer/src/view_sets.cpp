@@ -61,6 +61,11 @@ std::vector<ViewInfo> makeViewSet(const CameraView& camera, const ViewSetSpec& s
     ViewInfo v;
     v.viewProj = proj * glm::lookAtRH(eye, eye + f, u);
     v.eye = eye;
+    v.camera = camera;
+    v.camera.position = eye;
+    v.camera.forward = f;
+    v.camera.up = u;
+    v.camera.shift = -s / o.displayDistance;
     v.column = spec.kind == ViewSetSpec::Kind::Mono ? 0 : static_cast<int>(k) % spec.columns;
     v.row = spec.kind == ViewSetSpec::Kind::Mono ? 0 : static_cast<int>(k) / spec.columns;
     views.push_back(v);

@@ -18,6 +18,9 @@ struct CameraView {
   glm::vec3 forward{0.0f, 0.0f, -1.0f};
   glm::vec3 up{0.0f, 1.0f, 0.0f};
   float yfov = 0.6911f;  // radians
+  // Off-axis (sheared) frustum: the image centre on the plane one metre ahead, in metres along
+  // right and up. Zero for an ordinary centred camera.
+  glm::vec2 shift{0.0f};
   // The scene's first camera, or a view of its bounds from +Z when it has none.
   static CameraView fromScene(const scene::Scene& s);
 };

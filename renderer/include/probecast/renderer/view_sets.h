@@ -31,6 +31,7 @@ bool parseViewSet(const std::string& text, ViewSetSpec& spec, std::string& error
 struct ViewInfo {
   glm::mat4 viewProj;  // world → Vulkan clip (y down, z in [0, 1])
   glm::vec3 eye;
+  CameraView camera;  // the same view as a camera (off-axis shift included), for the reference tracer
   int column = 0;
   int row = 0;
 };
