@@ -81,6 +81,26 @@ TEST(ProbeHub, EncodedOnceSameBytesForEverySubscriber) {
   EXPECT_FALSE(hub.nextFrame(a).has_value());  // holds everything now
 }
 
+TEST(ProbeHub, AcksCountAppliedFramesAndRefuseFramesNeverSent) {
+  ProbeHub hub(rowConfig());
+  std::mt19937 rng(3);
+  const uint64_t id = hub.addSubscriber(0, 0, {}, nullptr);
+  std::string why;
+  EXPECT_FALSE(hub.acknowledge(id, 1, why));  // nothing sent yet
+  EXPECT_NE(why.find("only 0"), std::string::npos);
+  hub.publish(test::movingLightFrame(256, 0, 0.0f, rng).data(), nullptr);
+  ASSERT_TRUE(hub.nextFrame(id));
+  hub.publish(test::movingLightFrame(256, 1, 0.1f, rng).data(), nullptr);
+  ASSERT_TRUE(hub.nextFrame(id));
+  EXPECT_TRUE(hub.acknowledge(id, 1, why));
+  EXPECT_EQ(hub.stats(id).framesAcked, 1u);
+  EXPECT_TRUE(hub.acknowledge(id, 2, why));
+  EXPECT_EQ(hub.stats(id).framesAcked, 2u);
+  EXPECT_FALSE(hub.acknowledge(id, 1, why));  // backwards
+  EXPECT_FALSE(hub.acknowledge(id, 3, why));  // never sent
+  EXPECT_EQ(hub.stats(id).framesAcked, 2u);
+}
+
 TEST(ProbeHub, StaleVersionsAreSkippedNotQueued) {
   ProbeHub hub(rowConfig());
   std::mt19937 rng(3);

@@ -321,6 +321,12 @@ TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {
   oversized.mutable_hello()->set_client_name(std::string(100 * 1024, 'x'));
   EXPECT_EQ(statusAfter(*stub, oversized).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
+  pb::ClientMessage bogusAck;  // acknowledges a frame the server never sent
+  bogusAck.mutable_ack()->set_frame_sequence(1000000);
+  const grpc::Status ackStatus = statusAfter(*stub, hello, &bogusAck);
+  EXPECT_EQ(ackStatus.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(ackStatus.error_message().find("ack of frame"), std::string::npos);
+
   pb::ClientMessage wrongRepr = hello;
   wrongRepr.mutable_hello()->set_representation(pb::REPRESENTATION_L1);
   EXPECT_EQ(statusAfter(*stub, wrongRepr).error_code(), grpc::StatusCode::INVALID_ARGUMENT);

@@ -161,6 +161,8 @@ struct ProbeClient::Impl {
           stats.statsReceived += 1;
           stats.serverBytesSent = msg.stats().bytes_sent();
           stats.serverBricksBehind = msg.stats().bricks_behind();
+          stats.serverFramesAcked = msg.stats().frames_acked();
+          stats.serverAckRttUs = msg.stats().ack_rtt_us();
         } else if (msg.has_frame()) {
           if (!onFrame(msg.frame())) {
             ctx.TryCancel();

@@ -173,10 +173,34 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
   frame.serverTimeUs = publishedUs_;
   writeFrame(config_.layout, frame.sequence, sections, frame.payload);
   if (s.budget != 0) s.tokens -= static_cast<double>(frame.payload.size());
+  s.unacked.emplace_back(frame.sequence, Clock::now());
+  if (s.unacked.size() > 1024) s.unacked.pop_front();  // a client that never acks keeps a bounded record
   s.stats.bytesSent += frame.payload.size();
   s.stats.framesSent += 1;
   s.stats.bricksBehind = behind - static_cast<uint32_t>(n);
   return frame;
+}
+
+bool ProbeHub::acknowledge(uint64_t id, uint32_t sequence, std::string& why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = subscribers_.find(id);
+  if (it == subscribers_.end()) return why = "unknown subscriber", false;
+  Subscriber& s = it->second;
+  if (sequence > s.sequence)
+    return why = "ack of frame " + std::to_string(sequence) + " but only " + std::to_string(s.sequence) +
+                 " were sent", false;
+  if (sequence < s.stats.framesAcked)
+    return why = "ack of frame " + std::to_string(sequence) + " after frame " + std::to_string(s.stats.framesAcked),
+           false;
+  s.stats.framesAcked = sequence;
+  while (!s.unacked.empty() && s.unacked.front().first <= sequence) {
+    if (s.unacked.front().first == sequence)
+      s.stats.ackRttUs = static_cast<uint32_t>(std::min<int64_t>(
+          UINT32_MAX,
+          std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - s.unacked.front().second).count()));
+    s.unacked.pop_front();
+  }
+  return true;
 }
 
 SubscriberStats ProbeHub::stats(uint64_t id) const {

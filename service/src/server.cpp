@@ -102,6 +102,8 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
       s->set_bytes_sent(st.bytesSent);
       s->set_bricks_behind(st.bricksBehind);
       s->set_server_frame(hub_.serverFrame());
+      s->set_frames_acked(st.framesAcked);
+      s->set_ack_rtt_us(st.ackRttUs);
       writing_ = true;
       StartWrite(&out_);
       return;
@@ -140,7 +142,11 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
         hub_.setViews(id_, std::move(views));
         return grpc::Status::OK;
       }
-      case pb::ClientMessage::kAck: return grpc::Status::OK;
+      case pb::ClientMessage::kAck: {
+        std::string why;
+        if (!hub_.acknowledge(id_, m.ack().frame_sequence(), why)) return invalid(why);
+        return grpc::Status::OK;
+      }
       default: return invalid("empty client message");
     }
   }

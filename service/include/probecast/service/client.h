@@ -49,6 +49,8 @@ struct ClientStats {
   uint32_t statsReceived = 0;     // Stats messages from the server
   uint64_t serverBytesSent = 0;   // as the server counted them (latest Stats)
   uint32_t serverBricksBehind = 0;
+  uint32_t serverFramesAcked = 0; // our acks as the server counted them
+  uint32_t serverAckRttUs = 0;    // frame → ack round trip as the server measured it
 };
 
 class ProbeClient {

@@ -4,6 +4,7 @@
 // (a keyframe when it skipped some), never a queue of stale ones.
 #pragma once
 
+#include <deque>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -46,6 +47,8 @@ struct SubscriberStats {
   uint64_t bytesSent = 0;
   uint32_t bricksBehind = 0;
   uint32_t framesSent = 0;
+  uint32_t framesAcked = 0;  // the highest frame sequence the subscriber says it applied
+  uint32_t ackRttUs = 0;     // frame handed to the network → its ack back, latest, microseconds
 };
 
 class ProbeHub {
@@ -75,6 +78,9 @@ class ProbeHub {
   // nullopt when it holds everything or its budget is spent (it is woken later).
   std::optional<OutgoingFrame> nextFrame(uint64_t id);
   SubscriberStats stats(uint64_t id) const;
+  // The subscriber applied frames up to `sequence`. False (with the reason) for an ack of a frame
+  // never sent or one that goes backwards: the client is broken and its stream should end.
+  bool acknowledge(uint64_t id, uint32_t sequence, std::string& why);
 
   // The volume every subscriber converges to (the encoder's reconstruction), for tests and tools.
   void reconstruction(std::vector<float>& probes, std::vector<uint8_t>& active) const;
@@ -90,6 +96,7 @@ class ProbeHub {
     std::function<void()> wake;
     bool waiting = false;
     uint32_t sequence = 0;
+    std::deque<std::pair<uint32_t, Clock::time_point>> unacked;  // sequence, when handed out
     SubscriberStats stats;
   };
 
