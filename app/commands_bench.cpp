@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "scene_options.h"
 #include "raster_bench.h"
+#include "stability.h"
 #include "stream_bench.h"
 #include "update_bench.h"
 
@@ -201,6 +202,18 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
       writeTextFile(views, r.svgViews);
       fmt::print("wrote {}\n", views);
     }
+    exitCode = 0;
+  });
+
+  CLI::App* stability = bench->add_subcommand("stability", "the stability suite: where probe lighting fails, measured");
+  auto stabilityJson = std::make_shared<std::string>();
+  stability->add_option("--json", *stabilityJson, "write the results as JSON here")->required();
+  stability->callback([stabilityJson, &exitCode] {
+    bench::StabilityOptions so;
+    so.command = commandLine();
+    so.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    const bench::StabilityResult r = bench::runStabilitySuite(so);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", *stabilityJson, "", "");
     exitCode = 0;
   });
 

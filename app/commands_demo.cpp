@@ -3,17 +3,17 @@
 // subscribe, re-render whenever new lighting arrives (direct light at the current light position,
 // indirect light from the probes they hold), and the run ends with both compared against the
 // reference path tracer. Writes images, charts, report.md and report.json to --out.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <thread>
-
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "image_io.h"
@@ -34,13 +34,13 @@ using Clock = std::chrono::steady_clock;
 struct DemoOptions {
   std::string out = "out";
   std::string scene = "builtin:cornell";
-  double seconds = 24.0;       // streaming with the light moving
-  double turnsPerMinute = 1.5; // light speed (builtin scenes move it once around per unit of t)
-  uint32_t spp = 64;           // updater samples per probe per update
+  double seconds = 24.0;        // streaming with the light moving
+  double turnsPerMinute = 1.5;  // light speed (builtin scenes move it once around per unit of t)
+  uint32_t spp = 64;            // updater samples per probe per update
   std::vector<uint32_t> grid{8, 8, 8};
   std::string repr = "zh3";
   std::string lightField = "lf:5x5";
-  uint32_t settleUpdates = 24; // updates with the light frozen before the comparison
+  uint32_t settleUpdates = 24;  // updates with the light frozen before the comparison
   uint32_t referenceSpp = 64;
   uint64_t lightFieldBudget = 48 * 1024;  // bytes/s: the display sits on a thinner link
 };
@@ -111,7 +111,8 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
   demo->add_option("--seconds", o->seconds, "streaming time with the light moving")->check(CLI::Range(1.0, 3600.0));
   demo->add_option("--spp", o->spp, "updater samples per probe per update")->check(CLI::Range(1, 1 << 16));
   demo->add_option("--grid", o->grid, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(2, 64));
-  demo->add_option("--repr", o->repr, "representation streamed")->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
+  demo->add_option("--repr", o->repr, "representation streamed")
+      ->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
   demo->add_option("--light-field", o->lightField, "the light-field display's view set (lf:NxM)");
   demo->add_option("--settle-updates", o->settleUpdates, "updates with the light frozen before the comparison")
       ->check(CLI::Range(1, 10000));
@@ -120,7 +121,9 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
   demo->callback([o, &exitCode] {
     namespace fs = std::filesystem;
     const auto wallStart = Clock::now();
-    const auto secondsSince = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+    const auto secondsSince = [](Clock::time_point t0) {
+      return std::chrono::duration<double>(Clock::now() - t0).count();
+    };
     fs::create_directories(o->out);
     const std::string dir = o->out;
 
@@ -148,8 +151,9 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     std::random_device rd;
     sc.token = fmt::format("demo-{:08x}{:08x}", rd(), rd());
     service::ProbeServer server(sc, hub);
-    fmt::print("demo: server on 127.0.0.1:{} lighting {} ({}x{}x{} probes, {} spp/update, {}), light moving for {:.0f} s\n",
-               server.port(), scene0.name, grid.dims.x, grid.dims.y, grid.dims.z, o->spp, o->repr, o->seconds);
+    fmt::print(
+        "demo: server on 127.0.0.1:{} lighting {} ({}x{}x{} probes, {} spp/update, {}), light moving for {:.0f} s\n",
+        server.port(), scene0.name, grid.dims.x, grid.dims.y, grid.dims.z, o->spp, o->repr, o->seconds);
 
     // Animation: t follows wall time while streaming, then freezes for the comparison.
     const auto animStart = Clock::now();
@@ -250,7 +254,9 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
         moments.push_back(m);
         ++nextMoment;
       }
-      fmt::print(stderr, "\rdemo: {} {:4.1f}/{:.0f} s  updates {:4}  headset {:4} frames {:4} renders  display {:4} frames {:4} renders",
+      fmt::print(stderr,
+                 "\rdemo: {} {:4.1f}/{:.0f} s  updates {:4}  headset {:4} frames {:4} renders  display {:4} frames "
+                 "{:4} renders",
                  progressBar(now / o->seconds), std::min(now, o->seconds), o->seconds, updates.load(),
                  viewers[0].framesSeen, viewers[0].renders, viewers[1].framesSeen, viewers[1].renders);
       if (now >= o->seconds) break;
@@ -270,8 +276,9 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     frozen = true;
     const float finalT = frozenT;
     while (!stop && settled < o->settleUpdates) {
-      fmt::print(stderr, "\rdemo: {} light frozen at t = {:.3f}, settling {}/{} updates", progressBar(
-                 static_cast<double>(settled) / o->settleUpdates), finalT, settled.load(), o->settleUpdates);
+      fmt::print(stderr, "\rdemo: {} light frozen at t = {:.3f}, settling {}/{} updates",
+                 progressBar(static_cast<double>(settled) / o->settleUpdates), finalT, settled.load(),
+                 o->settleUpdates);
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
     stop = true;
@@ -284,8 +291,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     hub.reconstruction(serverProbes, serverActive);
     std::vector<bool> converged(viewers.size(), false);
     const auto waitStart = Clock::now();
-    while (secondsSince(waitStart) < 20.0 &&
-           !std::all_of(converged.begin(), converged.end(), [](bool c) { return c; }))
+    while (secondsSince(waitStart) < 20.0 && !std::all_of(converged.begin(), converged.end(), [](bool c) { return c; }))
       for (size_t k = 0; k < viewers.size(); ++k) {
         service::VolumeSnapshot snap;
         if (!viewers[k].client->snapshot(snap)) continue;
@@ -338,8 +344,8 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
         ssim.push_back(m.ssim);
         series.points.push_back({static_cast<double>(i), m.psnrDb, ""});
         ++referencesDone;
-        fmt::print(stderr, "\rdemo: {} reference images {}/{}", progressBar(static_cast<double>(referencesDone) /
-                   referencesTotal), referencesDone, referencesTotal);
+        fmt::print(stderr, "\rdemo: {} reference images {}/{}",
+                   progressBar(static_cast<double>(referencesDone) / referencesTotal), referencesDone, referencesTotal);
       }
       const std::string tag = k == 0 ? "stereo" : "quilt";
       writeViewerImages(dir + "/final_" + tag, v, v.images);
@@ -370,9 +376,10 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
                                    {"ssim", ssim},
                                    {"psnr_db_mean", meanPsnr},
                                    {"ssim_mean", meanSsim},
-                                   {"images", {{"final", "final_" + tag + ".png"},
-                                               {"reference", "reference_" + tag + ".png"},
-                                               {"difference_view0", "difference_" + tag + "_view0.png"}}}});
+                                   {"images",
+                                    {{"final", "final_" + tag + ".png"},
+                                     {"reference", "reference_" + tag + ".png"},
+                                     {"difference_view0", "difference_" + tag + "_view0.png"}}}});
       bandwidthSeries.push_back({v.name, v.bandwidth, true});
       psnrSeries.push_back(std::move(series));
       v.client->stop();
@@ -401,28 +408,32 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     std::string md = "# probecast demo\n\n";
     md += fmt::format("Produced by `{}` in {:.0f} s on {} (server and viewers on one machine, loopback gRPC).\n\n",
                       commandLine(), wall, serverContext.deviceName());
-    md += fmt::format("A server path-traces {} into {}x{}x{} probes ({} samples per probe per update, median "
-                      "{:.0f} ms per update) while its light circles, and streams them as `{}`. A stereo headset "
-                      "and a {} light-field display subscribe over gRPC, re-render each time new lighting arrives "
-                      "(direct light locally at the light's current position, indirect light from the probes they "
-                      "hold), and after {:.0f} s the light stops, the probes settle for {} updates, and every view "
-                      "is compared with the reference path tracer ({} samples per pixel).\n\n",
-                      scene0.name, grid.dims.x, grid.dims.y, grid.dims.z, o->spp, report["update_ms_median"].get<double>(),
-                      o->repr, o->lightField, streamSeconds, o->settleUpdates, o->referenceSpp);
-    md += "| viewer | views | size | budget | frames | renders | ms/view | bytes/s while moving | PSNR dB (mean) | SSIM (mean) | holds the server's volume |\n";
+    md += fmt::format(
+        "A server path-traces {} into {}x{}x{} probes ({} samples per probe per update, median "
+        "{:.0f} ms per update) while its light circles, and streams them as `{}`. A stereo headset "
+        "and a {} light-field display subscribe over gRPC, re-render each time new lighting arrives "
+        "(direct light locally at the light's current position, indirect light from the probes they "
+        "hold), and after {:.0f} s the light stops, the probes settle for {} updates, and every view "
+        "is compared with the reference path tracer ({} samples per pixel).\n\n",
+        scene0.name, grid.dims.x, grid.dims.y, grid.dims.z, o->spp, report["update_ms_median"].get<double>(), o->repr,
+        o->lightField, streamSeconds, o->settleUpdates, o->referenceSpp);
+    md +=
+        "| viewer | views | size | budget | frames | renders | ms/view | bytes/s while moving | PSNR dB (mean) | SSIM "
+        "(mean) | holds the server's volume |\n";
     md += "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& v : report["viewers"])
-      md += fmt::format("| {} | {} | {}x{} | {} | {} | {} | {:.1f} | {:.0f} | {:.2f} | {:.4f} | {} |\n",
-                        v["name"].get<std::string>(), v["views"].get<std::string>(), v["size"][0].get<int>(),
-                        v["size"][1].get<int>(),
-                        v["budget_bytes_per_s"].get<uint64_t>() ? fmt::format("{} B/s", v["budget_bytes_per_s"].get<uint64_t>())
-                                                                : std::string("none"),
-                        v["frames_applied"].get<uint32_t>(), v["renders"].get<uint32_t>(),
-                        v["render_ms_per_view_median"].get<double>(), v["bytes_per_s_streaming"].get<double>(),
-                        v["psnr_db_mean"].get<double>(), v["ssim_mean"].get<double>(),
-                        v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
-    md += "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without clamping; the "
-          "PNGs use a filmic tone map.\n\n";
+      md += fmt::format(
+          "| {} | {} | {}x{} | {} | {} | {} | {:.1f} | {:.0f} | {:.2f} | {:.4f} | {} |\n", v["name"].get<std::string>(),
+          v["views"].get<std::string>(), v["size"][0].get<int>(), v["size"][1].get<int>(),
+          v["budget_bytes_per_s"].get<uint64_t>() ? fmt::format("{} B/s", v["budget_bytes_per_s"].get<uint64_t>())
+                                                  : std::string("none"),
+          v["frames_applied"].get<uint32_t>(), v["renders"].get<uint32_t>(),
+          v["render_ms_per_view_median"].get<double>(), v["bytes_per_s_streaming"].get<double>(),
+          v["psnr_db_mean"].get<double>(), v["ssim_mean"].get<double>(),
+          v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
+    md +=
+        "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without clamping; the "
+        "PNGs use a filmic tone map.\n\n";
     md += "## While the light moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
     for (const auto& m : moments)
       md += fmt::format("At {:.1f} s (t = {:.3f}): ![stereo]({}) ![quilt]({})\n\n", m["seconds"].get<double>(),

@@ -1,9 +1,9 @@
 #include "raster_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
-
-#include <fmt/format.h>
 
 #include "image_metrics.h"
 #include "probecast/codec/record.h"
@@ -58,8 +58,8 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["reference_spp"] = o.referenceSpp;
   json["shadow_map_size"] = o.raster.shadowMapSize;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
-  std::string table = fmt::format("raster bench: {} at {}x{} on {}\n", o.scene.name, o.width, o.height,
-                                  context.deviceName());
+  std::string table =
+      fmt::format("raster bench: {} at {}x{} on {}\n", o.scene.name, o.width, o.height, context.deviceName());
 
   // Quality and mono speed per representation (float = the updater's probes without the codec).
   const std::vector<Representation> reprs = {{"float", false},
@@ -83,7 +83,8 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
       image = raster.render(vp, camera.position);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     }
-    const ImageMetrics m = compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    const ImageMetrics m =
+        compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
     const double msPerView = median(ms);
     json["representations"].push_back({{"representation", r.name},
                                        {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},
@@ -137,16 +138,16 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["validation_messages"] = context.validationMessages();
 
   ChartSpec spec;
-  spec.title = fmt::format("Raster client, {} at {}x{}: image quality against time per view", o.scene.name, o.width,
-                           o.height);
+  spec.title =
+      fmt::format("Raster client, {} at {}x{}: image quality against time per view", o.scene.name, o.width, o.height);
   spec.xLabel = "ms per view (mono, median)";
   spec.yLabel = "PSNR against the reference, dB";
   spec.footnote = o.command;
   RasterBenchResult result;
   result.svg = renderSvgChart(spec, {qualitySeries});
   ChartSpec views;
-  views.title = fmt::format("Raster client, {} at {}x{}: time per view against views per set", o.scene.name,
-                            o.width, o.height);
+  views.title =
+      fmt::format("Raster client, {} at {}x{}: time per view against views per set", o.scene.name, o.width, o.height);
   views.xLabel = "views in the set";
   views.yLabel = "ms per view (median)";
   views.logX = true;

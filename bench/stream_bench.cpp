@@ -37,7 +37,8 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
-// A 32 × 8 × 32 volume lit by a light circling above it (analytic SH, as the codec tests use).
+}  // namespace
+
 void lightingFrame(int frame, std::vector<float>& probes) {
   const int nx = 32, ny = 8, nz = 32;
   probes.assign(static_cast<size_t>(nx) * ny * nz * 27, 0.0f);
@@ -60,6 +61,8 @@ void lightingFrame(int frame, std::vector<float>& probes) {
           for (int c = 0; c < 3; ++c) p[i * 3 + c] = (i == 0 ? 0.3f : 0.0f) + e * rgb[c] * basis[i] * (i < 4 ? 0.8f : 0.4f);
       }
 }
+
+namespace {
 
 struct ServerReport {
   double cpuSeconds = 0;

@@ -31,4 +31,9 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& options);
 // for `seconds`, prints "report CPU_SECONDS ENCODE_MS_PER_FRAME FRAMES".
 int runStreamBenchServer(double hz, double seconds, const std::string& repr);
 
+// Lighting frame `frame` of the benchmark's volume: 32 × 8 × 32 probes (x fastest) lit by a light
+// circling above them (analytic SH), 27 floats per probe.
+constexpr uint16_t kLightingGrid[3] = {32, 8, 32};
+void lightingFrame(int frame, std::vector<float>& probes);
+
 }  // namespace probecast::bench
