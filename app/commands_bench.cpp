@@ -10,6 +10,7 @@
 #include "probecast/codec/probe_file.h"
 #include "commands.h"
 #include "scene_options.h"
+#include "pipeline_bench.h"
 #include "raster_bench.h"
 #include "stability.h"
 #include "stream_bench.h"
@@ -202,6 +203,49 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
       writeTextFile(views, r.svgViews);
       fmt::print("wrote {}\n", views);
     }
+    exitCode = 0;
+  });
+
+  CLI::App* pipeline = bench->add_subcommand("pipeline", "PSNR against wire bytes, update time and representation");
+  auto pscene = std::make_shared<SceneOptions>();
+  auto pgpu = std::make_shared<GpuOptions>();
+  auto pgrid = std::make_shared<GridOptions>();
+  struct PipelineCli {
+    std::string json, chart;
+    std::vector<uint32_t> size{160, 100};
+    bench::PipelineBenchOptions bench;
+  };
+  auto po = std::make_shared<PipelineCli>();
+  pscene->add(pipeline);
+  pgpu->add(pipeline);
+  pgrid->add(pipeline);
+  pipeline->add_option("--size", po->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
+  pipeline->add_option("--reference-spp", po->bench.referenceSpp, "samples per pixel of the reference")
+      ->check(CLI::Range(1, 1 << 20));
+  pipeline->add_option("--spps", po->bench.spps, "samples per probe to try")->delimiter(',')->check(CLI::Range(1, 1 << 16));
+  pipeline->add_option("--bounces", po->bench.bounces, "bounce limits to try")->delimiter(',')->check(CLI::Range(1, 16));
+  pipeline->add_option("--deadzones", po->bench.deadzones, "dead-zones to try")->delimiter(',')->check(CLI::Range(0, 127));
+  pipeline->add_option("--frames", po->bench.streamFrames, "moving-light frames streamed")->check(CLI::Range(2, 10000));
+  pipeline->add_option("--json", po->json, "write the results as JSON here")->required();
+  pipeline->add_option("--chart", po->chart, "SVG prefix: writes PREFIX_bytes.svg, PREFIX_update.svg, PREFIX_repr.svg");
+  pipeline->callback([=, &exitCode] {
+    po->bench.sceneSpec = pscene->scene;
+    po->bench.scene = pscene->load();
+    po->bench.t = pscene->t;
+    po->bench.grid = pgrid->resolve(po->bench.scene);
+    po->bench.context = pgpu->context();
+    po->bench.width = po->size[0];
+    po->bench.height = po->size[1];
+    po->bench.command = commandLine();
+    po->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    const bench::PipelineBenchResult r = bench::runPipelineBench(po->bench);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", po->json, "", "");
+    if (!po->chart.empty())
+      for (const auto& [suffix, svg] : {std::pair{"_bytes.svg", &r.svgBytes}, std::pair{"_update.svg", &r.svgUpdate},
+                                        std::pair{"_repr.svg", &r.svgRepr}}) {
+        writeTextFile(po->chart + suffix, *svg);
+        fmt::print("wrote {}{}\n", po->chart, suffix);
+      }
     exitCode = 0;
   });
 

@@ -399,6 +399,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     q.title = "Each view against its reference (light frozen, probes settled)";
     q.xLabel = "view index (quilt order)";
     q.yLabel = "PSNR, dB";
+    q.yFromZero = false;
     q.footnote = commandLine();
     writeTextFile(dir + "/psnr_per_view.svg", bench::renderSvgChart(q, psnrSeries));
     const double wall = secondsSince(wallStart);

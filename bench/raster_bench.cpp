@@ -142,6 +142,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
       fmt::format("Raster client, {} at {}x{}: image quality against time per view", o.scene.name, o.width, o.height);
   spec.xLabel = "ms per view (mono, median)";
   spec.yLabel = "PSNR against the reference, dB";
+  spec.yFromZero = false;
   spec.footnote = o.command;
   RasterBenchResult result;
   result.svg = renderSvgChart(spec, {qualitySeries});

@@ -50,7 +50,7 @@ struct Axis {
   }
 };
 
-Axis makeAxis(std::vector<double> values, bool log) {
+Axis makeAxis(std::vector<double> values, bool log, bool fromZero = true) {
   if (log) values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !(v > 0); }), values.end());
   if (values.empty()) return {log ? 1.0 : 0.0, log ? 10.0 : 1.0, log};
   double lo = *std::min_element(values.begin(), values.end());
@@ -60,7 +60,7 @@ Axis makeAxis(std::vector<double> values, bool log) {
     hi *= 1.3;
   } else {
     const double pad = hi > lo ? 0.08 * (hi - lo) : std::max(1e-9, std::fabs(hi) * 0.1 + 1e-9);
-    lo = std::min(0.0, lo - pad) == 0.0 && lo >= 0 ? 0.0 : lo - pad;
+    lo = fromZero && lo >= 0 ? 0.0 : lo - pad;
     hi += pad;
   }
   return {lo, hi, log};
@@ -84,7 +84,7 @@ std::string renderSvgChart(const ChartSpec& spec, const std::vector<ChartSeries>
       xs.push_back(p.x);
       ys.push_back(p.y);
     }
-  const Axis ax = makeAxis(xs, spec.logX), ay = makeAxis(ys, spec.logY);
+  const Axis ax = makeAxis(xs, spec.logX), ay = makeAxis(ys, spec.logY, spec.yFromZero);
   const double x0 = left, x1 = W - right, y0 = H - bottom, y1 = top;
   std::string svg = fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" "

@@ -24,6 +24,7 @@ struct ChartSpec {
   std::string yLabel;
   bool logX = false;
   bool logY = false;
+  bool yFromZero = true;  // linear y: start at 0 for non-negative data (false: fit the data)
   std::string footnote;  // e.g. the command that produced the data
 };
 

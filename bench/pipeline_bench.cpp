@@ -1,0 +1,217 @@
+#include "pipeline_bench.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "image_metrics.h"
+#include "probecast/codec/record.h"
+#include "probecast/codec/stream.h"
+#include "probecast/renderer/raster_client.h"
+#include "svg_chart.h"
+
+namespace probecast::bench {
+
+std::vector<size_t> paretoFront(const std::vector<ParetoPoint>& points) {
+  std::vector<size_t> order(points.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return points[a].cost != points[b].cost ? points[a].cost < points[b].cost : points[a].quality > points[b].quality;
+  });
+  std::vector<size_t> front;
+  double best = -std::numeric_limits<double>::infinity();
+  for (size_t i : order)
+    if (points[i].quality > best) {
+      front.push_back(i);
+      best = points[i].quality;
+    }
+  return front;
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+struct Point {
+  std::string label;
+  double cost = 0;
+  double psnr = 0;
+  double ssim = 0;
+};
+
+// A chart of PSNR against cost: every point, and the Pareto front joined.
+std::string paretoChart(const std::string& title, const std::string& xLabel, bool logX, const std::vector<Point>& pts,
+                        const std::string& command, nlohmann::json& json) {
+  std::vector<ParetoPoint> pp;
+  for (const Point& p : pts) pp.push_back({p.cost, p.psnr});
+  const std::vector<size_t> front = paretoFront(pp);
+  ChartSeries all{"configurations", {}, false}, best{"Pareto front", {}, true};
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const bool onFront = std::find(front.begin(), front.end(), i) != front.end();
+    all.points.push_back({pts[i].cost, pts[i].psnr, onFront ? "" : pts[i].label});
+    json.push_back({{"label", pts[i].label},
+                    {"cost", pts[i].cost},
+                    {"psnr_db", pts[i].psnr},
+                    {"ssim", pts[i].ssim},
+                    {"pareto", onFront}});
+  }
+  for (size_t i : front) best.points.push_back({pts[i].cost, pts[i].psnr, pts[i].label});
+  ChartSpec spec;
+  spec.title = title;
+  spec.xLabel = xLabel;
+  spec.yLabel = "PSNR against the reference, dB";
+  spec.logX = logX;
+  spec.yFromZero = false;
+  spec.footnote = command;
+  return renderSvgChart(spec, {all, best});
+}
+
+}  // namespace
+
+PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
+  const auto say = [&](const std::string& s) {
+    if (o.progress) o.progress(s);
+  };
+  const auto sceneAt = [&](float t) {
+    scene::Scene s;
+    std::string error;
+    if (!scene::loadScene(o.sceneSpec, t, s, error)) throw std::runtime_error(error);
+    return s;
+  };
+  renderer::VulkanContext context(o.context);
+  const scene::Scene finalScene = sceneAt(o.t);
+  const renderer::CameraView camera = renderer::CameraView::fromScene(finalScene);
+  renderer::ReferenceOptions ro;
+  ro.width = o.width;
+  ro.height = o.height;
+  ro.samplesPerPixel = o.referenceSpp;
+  say(fmt::format("pipeline bench: reference ({} spp)", o.referenceSpp));
+  const renderer::Image reference = renderer::renderReference(context, finalScene, camera, ro);
+  renderer::RasterRenderer raster(context, finalScene, o.width, o.height);
+  const auto score = [&](const renderer::ProbeVolumeData& v, Point& p) {
+    raster.setProbes(v);
+    const renderer::Image img = raster.render(raster.viewProjection(camera), camera.position);
+    const ImageMetrics m =
+        compareImages(img.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    p.psnr = m.psnrDb;
+    p.ssim = m.ssim;
+  };
+
+  PipelineBenchResult r;
+  nlohmann::json& j = r.json;
+  j["command"] = o.command;
+  j["scene"] = finalScene.name;
+  j["device"] = context.deviceName();
+  j["size"] = {o.width, o.height};
+  j["grid"] = {o.grid.dims.x, o.grid.dims.y, o.grid.dims.z};
+  j["reference_spp"] = o.referenceSpp;
+  j["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
+  std::string& table = r.table;
+  table = fmt::format("pipeline bench: {} at {}x{}, {}x{}x{} probes, on {}\n", finalScene.name, o.width, o.height,
+                      o.grid.dims.x, o.grid.dims.y, o.grid.dims.z, context.deviceName());
+
+  // (b) Update cost: samples per probe × bounces, the light still at t.
+  std::vector<Point> updatePoints;
+  for (uint32_t b : o.bounces)
+    for (uint32_t spp : o.spps) {
+      renderer::UpdaterOptions uo;
+      uo.samplesPerProbe = spp;
+      uo.maxBounces = b;
+      renderer::ProbeUpdater u(context, finalScene, o.grid, uo);
+      std::vector<double> ms;
+      for (uint32_t k = 0; k < o.updates; ++k) ms.push_back(u.update().milliseconds);
+      Point p{fmt::format("{} spp, {} bounce{}", spp, b, b == 1 ? "" : "s"), median(ms)};
+      score(renderer::volumeFromUpdater(u), p);
+      updatePoints.push_back(p);
+      say(fmt::format("pipeline bench: {}: {:.1f} ms/update, {:.2f} dB", p.label, p.cost, p.psnr));
+    }
+  r.svgUpdate = paretoChart(fmt::format("PSNR against probe update time ({} updates each)", o.updates),
+                            "ms per update (median)", true, updatePoints, o.command, j["update_cost"]);
+
+  // (c) Representation: one well-converged volume through each record type.
+  renderer::UpdaterOptions good;
+  good.samplesPerProbe = 128;
+  renderer::ProbeUpdater converged(context, finalScene, o.grid, good);
+  for (int k = 0; k < 8; ++k) converged.update();
+  const renderer::ProbeVolumeData volume = renderer::volumeFromUpdater(converged);
+  std::vector<Point> reprPoints;
+  for (Representation repr : kAllRepresentations) {
+    Point p{representationName(repr), static_cast<double>(recordSize(repr))};
+    score(renderer::decodeAs(volume, repr), p);
+    reprPoints.push_back(p);
+  }
+  Point floatPoint{"float", 108.0};
+  score(volume, floatPoint);
+  reprPoints.push_back(floatPoint);
+  r.svgRepr = paretoChart("PSNR against bytes per probe (representation)", "bytes per probe record", true, reprPoints,
+                          o.command, j["representation"]);
+
+  // (a) Wire bytes: a moving-light sequence ending at t, encoded per representation × dead-zone;
+  // bytes per second at `hz`, quality of what a subscriber holds at the end.
+  std::vector<renderer::ProbeVolumeData> frames;
+  {
+    renderer::UpdaterOptions uo;
+    uo.samplesPerProbe = 64;
+    uo.minBlendWeight = 0.25f;
+    renderer::ProbeUpdater u(context, sceneAt(o.t), o.grid, uo);
+    for (uint32_t f = 0; f < o.streamFrames; ++f) {
+      const float t = o.t - 0.004f * static_cast<float>(o.streamFrames - 1 - f);
+      u.setScene(sceneAt(t - std::floor(t)));
+      u.update();
+      frames.push_back(renderer::volumeFromUpdater(u));
+    }
+    say(fmt::format("pipeline bench: {} moving-light frames traced", o.streamFrames));
+  }
+  std::vector<Point> bytesPoints;
+  StreamLayout layout;
+  for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(o.grid.dims[a]);
+  for (Representation repr : kAllRepresentations)
+    for (int dz : o.deadzones) {
+      layout.repr = repr;
+      EncoderOptions eo;
+      eo.deadzone = dz;
+      StreamEncoder encoder(layout, eo);
+      StreamDecoder decoder(layout);
+      decoder.setHallucinate(false);
+      std::vector<uint8_t> bytes;
+      uint64_t total = 0;
+      for (size_t f = 0; f < frames.size(); ++f) {
+        encoder.update(frames[f].probes.data(), frames[f].active.data());
+        if (f == 0) encoder.writeKeyframeFrame(bytes);
+        else encoder.writeChangedFrame(bytes);
+        if (f > 0) total += bytes.size();  // steady state: the first (key)frame is a join, not a rate
+        if (decoder.apply(bytes.data(), bytes.size()) != CodecStatus::Ok)
+          throw std::runtime_error("pipeline bench: decoder refused its own stream");
+      }
+      renderer::ProbeVolumeData held = frames.back();
+      const size_t n = held.probes.size();
+      held.probes.assign(decoder.probes(), decoder.probes() + n);
+      held.active.assign(decoder.activeMask(), decoder.activeMask() + held.active.size());
+      held.hallucinateZh3 = repr == Representation::Zh3Hallucinated;
+      Point p{fmt::format("{} dz{}", representationName(repr), dz),
+              static_cast<double>(total) / static_cast<double>(frames.size() - 1) * o.hz};
+      score(held, p);
+      bytesPoints.push_back(p);
+    }
+  r.svgBytes = paretoChart(fmt::format("PSNR against wire bytes/s while the light moves ({:g} updates/s)", o.hz),
+                           "bytes per second (one subscriber)", true, bytesPoints, o.command, j["wire_bytes"]);
+
+  const auto section = [&](const std::string& name, const std::string& unit, const nlohmann::json& rows) {
+    table += fmt::format("\n{:<22} {:>14} {:>9} {:>7}  Pareto\n", name, unit, "PSNR dB", "SSIM");
+    for (const auto& row : rows)
+      table += fmt::format("{:<22} {:>14.1f} {:>9.2f} {:>7.4f}  {}\n", row["label"].get<std::string>(),
+                           row["cost"].get<double>(), row["psnr_db"].get<double>(), row["ssim"].get<double>(),
+                           row["pareto"].get<bool>() ? "*" : "");
+  };
+  section("update", "ms/update", j["update_cost"]);
+  section("representation", "bytes/probe", j["representation"]);
+  section("stream", "bytes/s", j["wire_bytes"]);
+  return r;
+}
+
+}  // namespace probecast::bench
