@@ -18,11 +18,13 @@
 #include "commands.h"
 #include "image_io.h"
 #include "image_metrics.h"
+#include "pipeline_bench.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
 #include "scene_options.h"
+#include "stability.h"
 #include "svg_chart.h"
 #include "view_support.h"
 
@@ -43,6 +45,7 @@ struct DemoOptions {
   uint32_t settleUpdates = 24;  // updates with the light frozen before the comparison
   uint32_t referenceSpp = 64;
   uint64_t lightFieldBudget = 48 * 1024;  // bytes/s: the display sits on a thinner link
+  bool skipSuites = false;     // no pipeline benchmark or stability suite in the report
 };
 
 struct Viewer {
@@ -118,6 +121,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       ->check(CLI::Range(1, 10000));
   demo->add_option("--reference-spp", o->referenceSpp, "samples per pixel of the reference images")
       ->check(CLI::Range(1, 1 << 16));
+  demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
   demo->callback([o, &exitCode] {
     namespace fs = std::filesystem;
     const auto wallStart = Clock::now();
@@ -402,6 +406,49 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     q.yFromZero = false;
     q.footnote = commandLine();
     writeTextFile(dir + "/psnr_per_view.svg", bench::renderSvgChart(q, psnrSeries));
+    // Speed against accuracy across the pipeline, and the stability suite.
+    std::string suites;
+    if (!o->skipSuites) {
+      const auto status = [](const std::string& s) { fmt::print(stderr, "\rdemo: {:<90}", s.substr(0, 90)); };
+      phaseStart = Clock::now();
+      bench::PipelineBenchOptions po;
+      po.sceneSpec = o->scene;
+      po.scene = finalScene;
+      po.t = finalT;
+      po.grid = grid;
+      po.width = 128;
+      po.height = 80;
+      po.referenceSpp = 2 * o->referenceSpp;
+      po.spps = {32, 128};
+      po.bounces = {1, 4};
+      po.deadzones = {0, 4, 16};
+      po.streamFrames = 16;
+      po.updates = 3;
+      po.command = commandLine() + " (pipeline part)";
+      po.progress = status;
+      const bench::PipelineBenchResult pr = bench::runPipelineBench(po);
+      writeTextFile(dir + "/pipeline.json", pr.json.dump(2) + "\n");
+      writeTextFile(dir + "/pipeline_bytes.svg", pr.svgBytes);
+      writeTextFile(dir + "/pipeline_update.svg", pr.svgUpdate);
+      writeTextFile(dir + "/pipeline_repr.svg", pr.svgRepr);
+      phases["pipeline"] = secondsSince(phaseStart);
+      phaseStart = Clock::now();
+      bench::StabilityOptions so;
+      so.command = commandLine() + " (stability part)";
+      so.progress = status;
+      const bench::StabilityResult sr = bench::runStabilitySuite(so);
+      writeTextFile(dir + "/stability.json", sr.json.dump(2) + "\n");
+      phases["stability"] = secondsSince(phaseStart);
+      report["phase_seconds"] = phases;
+      fmt::print(stderr, "\n");
+      suites += "\n## Speed against accuracy across the pipeline\n\n"
+                "Same scene, same view (the light frozen where the demo stopped it), one run; the Pareto front of "
+                "each chart is joined. Data: [pipeline.json](pipeline.json).\n\n"
+                "![PSNR against wire bytes](pipeline_bytes.svg)\n\n![PSNR against update time](pipeline_update.svg)"
+                "\n\n![PSNR against representation](pipeline_repr.svg)\n\n```\n" + pr.table + "```\n";
+      suites += "\n## Stability: where probe lighting fails, measured\n\nEach case is also a test "
+                "(`ctest -L stability`). Data: [stability.json](stability.json).\n\n" + sr.markdown;
+    }
     const double wall = secondsSince(wallStart);
     report["wall_seconds"] = wall;
     writeTextFile(dir + "/report.json", report.dump(2) + "\n");
@@ -445,6 +492,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     md += "| reference | ![](reference_stereo.png) | ![](reference_quilt.png) |\n";
     md += "| difference, view 0 | ![](difference_stereo_view0.png) | ![](difference_quilt_view0.png) |\n\n";
     md += "Data: [report.json](report.json).\n";
+    md += suites;
     writeTextFile(dir + "/report.md", md);
     for (const auto& v : report["viewers"])
       fmt::print("demo: {:<20} {:>7} {:>4} frames, {:>8.0f} B/s while moving, PSNR {:.2f} dB, SSIM {:.4f}\n",
