@@ -90,6 +90,9 @@ struct SceneNeeds {
   double bytesAllL2 = 0, bytesSmallest = 0;     // a keyframe's worth of records
   double staticFrameBytes = 0;                  // a frame after publishing the same lighting again
   double firstFrameBytes = 0;
+  // Bytes per probe per frame of the live stream (zh3, dead-zone 1, every update published), all
+  // headers included: the light still (the updater keeps refining: Monte Carlo noise) and moving.
+  double liveStillBytesPerProbe = 0, liveMovingBytesPerProbe = 0;
 };
 SceneNeeds measureSceneNeeds(renderer::VulkanContext& context, double maxError);
 

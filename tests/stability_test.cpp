@@ -109,6 +109,11 @@ TEST(Stability, StaticLightingCostsNoBytesAndMostProbesNeedLessThanL2AtTenPercen
   EXPECT_LT(r.bytesSmallest, r.bytesAllL2);
   EXPECT_GT(r.needL1 + r.needZh3, r.probes / 2);  // measured 309 of 473 (Mesa 25 lavapipe)
   EXPECT_LT(r.staticFrameBytes, 0.01 * r.firstFrameBytes);
+  std::printf("live zh3 stream: %.2f B/probe/frame still, %.2f moving (raw fp16: 56)\n", r.liveStillBytesPerProbe,
+              r.liveMovingBytesPerProbe);
+  // Both far below a raw grid and below a keyframe of zh3 records (16 B): deltas and the dead-zone.
+  EXPECT_LT(r.liveMovingBytesPerProbe, 16.0);
+  EXPECT_LT(r.liveStillBytesPerProbe, 16.0);
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
