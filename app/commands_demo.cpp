@@ -298,7 +298,6 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     const auto waitStart = Clock::now();
     while (secondsSince(waitStart) < 30.0 &&
            !std::all_of(converged.begin(), converged.end(), [](bool c) { return c; })) {
-      hub.tick();  // nothing is published any more: refilled budgets must still wake subscribers
       for (size_t k = 0; k < viewers.size(); ++k) {
         service::VolumeSnapshot snap;
         if (!viewers[k].client->snapshot(snap)) continue;

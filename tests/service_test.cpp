@@ -145,6 +145,21 @@ TEST(Service, TwentySubscribersConvergeBitIdentical) {
   }
 }
 
+TEST(Service, BudgetLimitedSubscriberFinishesWhenNothingMoreIsPublished) {
+  // One frame of lighting, then silence: nobody calls hub.tick(). The server's own ticker must
+  // refill the budget and wake the subscriber until it holds everything.
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  std::mt19937 rng(8);
+  hub.publish(test::movingLightFrame(1024, 0, 0.01f, rng).data(), nullptr);
+  ProbeClient client(clientFor(server.port(), 4000));  // a few seconds for the whole volume
+  client.start();
+  ASSERT_TRUE(waitFor([&] { return client.stats().framesApplied >= 1; }, 10s));
+  EXPECT_FALSE(matchesServer(client, hub));  // the first burst cannot hold it all
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, hub); }, 20s));
+  EXPECT_GE(client.stats().framesApplied, 2u);
+}
+
 TEST(Service, LateJoinerGetsKeyframesAndConverges) {
   ProbeHub hub(volumeConfig());
   ProbeServer server(plaintextConfig(), hub);

@@ -3,7 +3,10 @@
 
 #include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <stdexcept>
+#include <thread>
 
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
@@ -251,6 +254,11 @@ struct ProbeServer::Impl {
   std::unique_ptr<Service> service;
   std::unique_ptr<grpc::Server> server;
   int port = 0;
+  // Refilled byte budgets wake their subscribers even when no lighting is being published.
+  std::thread ticker;
+  std::mutex tickMutex;
+  std::condition_variable tickWake;
+  bool stopping = false;
 };
 
 ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std::make_unique<Impl>()) {
@@ -279,6 +287,14 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
   s.server = builder.BuildAndStart();
   if (!s.server || s.port == 0) throw std::runtime_error("cannot listen on " + config.listen);
   if (auto* health = s.server->GetHealthCheckService()) health->SetServingStatus("probecast.v1.ProbeStream", true);
+  s.ticker = std::thread([&s, &hub] {
+    std::unique_lock<std::mutex> lock(s.tickMutex);
+    while (!s.tickWake.wait_for(lock, std::chrono::milliseconds(ServerConfig::kTickMs), [&s] { return s.stopping; })) {
+      lock.unlock();
+      hub.tick();
+      lock.lock();
+    }
+  });
 }
 
 ProbeServer::~ProbeServer() { shutdown(); }
@@ -286,6 +302,12 @@ ProbeServer::~ProbeServer() { shutdown(); }
 int ProbeServer::port() const { return impl_->port; }
 
 void ProbeServer::shutdown() {
+  {
+    std::lock_guard<std::mutex> lock(impl_->tickMutex);
+    impl_->stopping = true;
+  }
+  impl_->tickWake.notify_all();
+  if (impl_->ticker.joinable()) impl_->ticker.join();
   if (!impl_->server) return;
   impl_->server->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(500));
   impl_->server->Wait();

@@ -19,6 +19,9 @@ struct ServerConfig {
   uint32_t maxSubscribers = 1024;
   uint32_t maxViews = 64;               // per view update
   uint32_t maxMessageBytes = 64 * 1024; // largest client message accepted
+  // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
+  // even while nothing new is published.
+  static constexpr int kTickMs = 50;
 };
 
 class ProbeServer {
