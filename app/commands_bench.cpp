@@ -123,20 +123,14 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   });
 
   CLI::App* update = bench->add_subcommand("update", "probe updater speed, convergence and flicker");
-  auto scene = std::make_shared<SceneOptions>();
-  auto gpu = std::make_shared<GpuOptions>();
-  auto grid = std::make_shared<GridOptions>();
-  auto tracer = std::make_shared<TracerOptions>();
+  auto ut = std::make_shared<TracingOptions>();
   struct UpdateOptions {
     std::string json, chart;
     uint32_t updates = 16, referenceSamples = 16384;
     std::vector<float> wMins{0.02f, 0.05f, 0.1f, 0.25f};
   };
   auto uo = std::make_shared<UpdateOptions>();
-  scene->add(update);
-  gpu->add(update);
-  grid->add(update);
-  tracer->add(update);
+  ut->add(update);
   update->add_option("--json", uo->json, "write the results as JSON here")->required();
   update->add_option("--chart", uo->chart, "write an SVG chart of error against time here");
   update->add_option("--updates", uo->updates, "updates per run")->check(CLI::Range(2, 10000));
@@ -145,10 +139,10 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   update->add_option("--w-mins", uo->wMins, "w_min values for the flicker runs")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
   update->callback([=, &exitCode] {
     bench::UpdateBenchOptions o;
-    o.scene = scene->load();
-    o.grid = grid->resolve(o.scene);
-    o.updater = tracer->options();
-    o.context = gpu->context();
+    o.scene = ut->scene.load();
+    o.grid = ut->grid.resolve(o.scene);
+    o.updater = ut->tracer.options();
+    o.context = ut->gpu.context();
     o.updates = uo->updates;
     o.referenceSamples = uo->referenceSamples;
     o.minBlendWeights = uo->wMins;
@@ -160,20 +154,14 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   });
 
   CLI::App* raster = bench->add_subcommand("raster", "raster client: ms per view for 1..48 views, PSNR/SSIM per representation");
-  auto rscene = std::make_shared<SceneOptions>();
-  auto rgpu = std::make_shared<GpuOptions>();
-  auto rgrid = std::make_shared<GridOptions>();
-  auto rtracer = std::make_shared<TracerOptions>();
+  auto rt = std::make_shared<TracingOptions>();
   struct RasterOptions {
     std::string json, chart;
     std::vector<uint32_t> size{320, 200};
     bench::RasterBenchOptions bench;
   };
   auto ro = std::make_shared<RasterOptions>();
-  rscene->add(raster);
-  rgpu->add(raster);
-  rgrid->add(raster);
-  rtracer->add(raster);
+  rt->add(raster);
   raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM), comma-separated")
       ->delimiter(',');
   raster->add_option("--size", ro->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
@@ -186,10 +174,10 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   raster->add_option("--json", ro->json, "write the results as JSON here")->required();
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
   raster->callback([=, &exitCode] {
-    ro->bench.scene = rscene->load();
-    ro->bench.grid = rgrid->resolve(ro->bench.scene);
-    ro->bench.updater = rtracer->options();
-    ro->bench.context = rgpu->context();
+    ro->bench.scene = rt->scene.load();
+    ro->bench.grid = rt->grid.resolve(ro->bench.scene);
+    ro->bench.updater = rt->tracer.options();
+    ro->bench.context = rt->gpu.context();
     ro->bench.width = ro->size[0];
     ro->bench.height = ro->size[1];
     ro->bench.command = commandLine();
@@ -207,18 +195,14 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   });
 
   CLI::App* pipeline = bench->add_subcommand("pipeline", "PSNR against wire bytes, update time and representation");
-  auto pscene = std::make_shared<SceneOptions>();
-  auto pgpu = std::make_shared<GpuOptions>();
-  auto pgrid = std::make_shared<GridOptions>();
+  auto pt = std::make_shared<TracingOptions>();
   struct PipelineCli {
     std::string json, chart;
     std::vector<uint32_t> size{160, 100};
     bench::PipelineBenchOptions bench;
   };
   auto po = std::make_shared<PipelineCli>();
-  pscene->add(pipeline);
-  pgpu->add(pipeline);
-  pgrid->add(pipeline);
+  pt->add(pipeline, false);
   pipeline->add_option("--size", po->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
   pipeline->add_option("--reference-spp", po->bench.referenceSpp, "samples per pixel of the reference")
       ->check(CLI::Range(1, 1 << 20));
@@ -229,11 +213,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   pipeline->add_option("--json", po->json, "write the results as JSON here")->required();
   pipeline->add_option("--chart", po->chart, "SVG prefix: writes PREFIX_bytes.svg, PREFIX_update.svg, PREFIX_repr.svg");
   pipeline->callback([=, &exitCode] {
-    po->bench.sceneSpec = pscene->scene;
-    po->bench.scene = pscene->load();
-    po->bench.t = pscene->t;
-    po->bench.grid = pgrid->resolve(po->bench.scene);
-    po->bench.context = pgpu->context();
+    po->bench.sceneSpec = pt->scene.scene;
+    po->bench.scene = pt->scene.load();
+    po->bench.t = pt->scene.t;
+    po->bench.grid = pt->grid.resolve(po->bench.scene);
+    po->bench.context = pt->gpu.context();
     po->bench.width = po->size[0];
     po->bench.height = po->size[1];
     po->bench.command = commandLine();

@@ -95,4 +95,18 @@ struct TracerOptions {
   }
 };
 
+// Scene, device, grid and tracer options together, for the commands that trace probes.
+struct TracingOptions {
+  SceneOptions scene;
+  GpuOptions gpu;
+  GridOptions grid;
+  TracerOptions tracer;
+  void add(CLI::App* cmd, bool withTracer = true) {
+    scene.add(cmd);
+    gpu.add(cmd);
+    grid.add(cmd);
+    if (withTracer) tracer.add(cmd);
+  }
+};
+
 }  // namespace probecast::app

@@ -467,7 +467,7 @@ StabilityResult runStabilitySuite(const StabilityOptions& o) {
   std::string& md = out.markdown;
 
   say("stability: flicker and lag against w_min");
-  const auto fl = measureFlickerLag(context, {0.02f, 0.05f, 0.1f, 0.25f}, 16, 48);
+  const auto fl = measureFlickerLag(context, {0.02f, 0.05f, 0.1f, 0.25f}, 32, 48);
   md +=
       "### Temporal flicker against lag (builtin:cornell, 4³ probes, 32 samples per probe per update)\n\n"
       "| w_min | flicker per update | error before the jump | updates to recover after the light jumps "

@@ -17,7 +17,7 @@ renderer::ContextOptions validated() {
 
 TEST(Stability, SmallerWMinFlickersLessAndRecoversSlower) {
   renderer::VulkanContext context(validated());
-  const auto r = measureFlickerLag(context, {0.02f, 0.25f}, 16, 32);
+  const auto r = measureFlickerLag(context, {0.02f, 0.25f}, 32, 32);
   ASSERT_EQ(r.size(), 2u);
   for (const FlickerLag& f : r)
     std::printf("w_min %.2f: flicker %.2f%% per update, recovery after the jump %d updates\n", f.wMin,
