@@ -162,7 +162,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   };
   auto ro = std::make_shared<RasterOptions>();
   rt->add(raster);
-  raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM), comma-separated")
+  raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM, lfh:NxM), comma-separated")
       ->delimiter(',');
   raster->add_option("--size", ro->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
   raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));

@@ -117,7 +117,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
   demo->add_option("--grid", o->grid, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(2, 64));
   demo->add_option("--repr", o->repr, "representation streamed")
       ->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
-  demo->add_option("--light-field", o->lightField, "the light-field display's view set (lf:NxM)");
+  demo->add_option("--light-field", o->lightField, "the light-field display's view set (lf:NxM or lfh:NxM)");
   demo->add_option("--settle-updates", o->settleUpdates, "updates with the light frozen before the comparison")
       ->check(CLI::Range(1, 10000));
   demo->add_option("--reference-spp", o->referenceSpp, "samples per pixel of the reference images")
@@ -336,7 +336,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     for (Viewer& v : viewers) {
       const size_t n = v.views.size(), c = static_cast<size_t>(v.spec.columns);
       v.referenceViews = {0};
-      if (v.spec.kind == renderer::ViewSetSpec::Kind::LightField && n > 5) {
+      if (v.spec.kind != renderer::ViewSetSpec::Kind::Mono && v.spec.kind != renderer::ViewSetSpec::Kind::Stereo && n > 5) {
         for (size_t i : {c - 1, n / 2, n - c, n - 1}) v.referenceViews.push_back(i);
       } else {
         for (size_t i = 1; i < n; ++i) v.referenceViews.push_back(i);

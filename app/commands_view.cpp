@@ -65,7 +65,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--tls-name", o->tlsName, "server name to check in its certificate");
   cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
       ->check(CLI::Range(0.1, 3600.0));
-  cmd->add_option("--views", o->views, "mono, stereo or lf:NxM");
+  cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
   cmd->add_option("--size", o->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));

@@ -148,5 +148,37 @@ TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+TEST(ViewSets, HorizontalLightFieldPutsEveryViewOnOneLineInQuiltOrder) {
+  // lfh:4x2: 8 eyes on one horizontal line across the cone, view 0 leftmost, equally spaced,
+  // tiles in quilt order (column k mod 4, row k div 4); the two middle eyes straddle the camera.
+  ViewSetSpec spec;
+  std::string error;
+  ASSERT_TRUE(parseViewSet("lfh:4x2", spec, error));
+  EXPECT_EQ(spec.kind, ViewSetSpec::Kind::HorizontalLightField);
+  CameraView cam;
+  cam.position = {0, 1, 4};
+  cam.forward = {0, 0, -1};
+  cam.up = {0, 1, 0};
+  ViewSetOptions vo;
+  vo.displayDistance = 4.0f;
+  vo.lfConeDeg = 40.0f;
+  const auto views = makeViewSet(cam, spec, vo);
+  ASSERT_EQ(views.size(), 8u);
+  const float span = 2.0f * 4.0f * std::tan(glm::radians(20.0f)), step = span / 7.0f;
+  for (size_t k = 0; k < views.size(); ++k) {
+    EXPECT_NEAR(views[k].eye.x, -0.5f * span + step * static_cast<float>(k), 1e-5f) << k;
+    EXPECT_FLOAT_EQ(views[k].eye.y, 1.0f);  // no vertical parallax
+    EXPECT_FLOAT_EQ(views[k].eye.z, 4.0f);
+    EXPECT_EQ(views[k].column, static_cast<int>(k % 4));
+    EXPECT_EQ(views[k].row, static_cast<int>(k / 4));
+    // Every view sees the display centre (the scene point 4 m ahead) at the image centre.
+    const glm::vec4 c = views[k].viewProj * glm::vec4(0, 1, 0, 1);
+    EXPECT_NEAR(c.x / c.w, 0.0f, 1e-5f);
+    EXPECT_NEAR(c.y / c.w, 0.0f, 1e-5f);
+  }
+  EXPECT_FALSE(parseViewSet("lfh:2x", spec, error));
+  EXPECT_FALSE(parseViewSet("lfh:17x1", spec, error));
+}
+
 }  // namespace
 }  // namespace probecast::renderer

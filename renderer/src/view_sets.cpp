@@ -23,7 +23,11 @@ bool parseViewSet(const std::string& text, ViewSetSpec& spec, std::string& error
     spec = {ViewSetSpec::Kind::LightField, n, m};
     return true;
   }
-  error = "views must be mono, stereo or lf:NxM with 1 ≤ N, M ≤ 16 (got '" + text + "')";
+  if (std::sscanf(text.c_str(), "lfh:%dx%d%c", &n, &m, &tail) == 2 && n >= 1 && m >= 1 && n <= 16 && m <= 16) {
+    spec = {ViewSetSpec::Kind::HorizontalLightField, n, m};
+    return true;
+  }
+  error = "views must be mono, stereo, lf:NxM or lfh:NxM with 1 ≤ N, M ≤ 16 (got '" + text + "')";
   return false;
 }
 
@@ -40,6 +44,11 @@ std::vector<ViewInfo> makeViewSet(const CameraView& camera, const ViewSetSpec& s
   } else if (spec.kind == ViewSetSpec::Kind::Stereo) {
     offsets.push_back({-0.5f * o.ipd, 0});
     offsets.push_back({0.5f * o.ipd, 0});
+  } else if (spec.kind == ViewSetSpec::Kind::HorizontalLightField) {
+    const int count = spec.count();
+    const float span = 2.0f * o.displayDistance * std::tan(glm::radians(0.5f * o.lfConeDeg));
+    const float step = count > 1 ? span / static_cast<float>(count - 1) : 0.0f;
+    for (int k = 0; k < count; ++k) offsets.push_back({(static_cast<float>(k) - 0.5f * static_cast<float>(count - 1)) * step, 0});
   } else {
     const float span = 2.0f * o.displayDistance * std::tan(glm::radians(0.5f * o.lfConeDeg));
     const float step = spec.columns > 1 ? span / static_cast<float>(spec.columns - 1) : 0.0f;

@@ -5,8 +5,11 @@
 // `displayDistance`, so all views agree on that plane (zero parallax there).
 //   stereo: eyes at ±IPD/2 (64 mm) along right, parallel axes.
 //   lf:NxM: N columns × M rows of eyes spanning a viewing cone of `lfConeDeg` horizontally (and
-//           the same angular step vertically); view 0 is bottom-left, then left → right, rows
-//           bottom → top (the quilt order of Looking Glass displays).
+//           the same angular step vertically): full parallax; view 0 is bottom-left, then
+//           left → right, rows bottom → top.
+//   lfh:NxM: N × M eyes on one horizontal line across the cone, view 0 leftmost, laid out in the
+//           quilt the same way (tile k at column k mod N, row k div N): horizontal parallax only,
+//           as a Looking Glass display expects its quilt.
 #pragma once
 
 #include <string>
@@ -19,13 +22,13 @@
 namespace probecast::renderer {
 
 struct ViewSetSpec {
-  enum class Kind { Mono, Stereo, LightField } kind = Kind::Mono;
+  enum class Kind { Mono, Stereo, LightField, HorizontalLightField } kind = Kind::Mono;
   int columns = 1;
   int rows = 1;
   int count() const { return columns * rows; }
 };
 
-// Parses "mono", "stereo" or "lf:NxM" (1 ≤ N, M ≤ 16); false with a message otherwise.
+// Parses "mono", "stereo", "lf:NxM" or "lfh:NxM" (1 ≤ N, M ≤ 16); false with a message otherwise.
 bool parseViewSet(const std::string& text, ViewSetSpec& spec, std::string& error);
 
 struct ViewInfo {
