@@ -134,6 +134,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
 
     // The server: its own Vulkan device, the updater, the hub and gRPC on a free loopback port.
     const scene::Scene scene0 = sceneAt(o->scene, 0.0f);
+    const bool animated = o->scene.rfind("builtin:", 0) == 0;  // built-in scenes move their light with t
     GridOptions gridOptions;
     gridOptions.dims = o->grid;
     const renderer::ProbeGrid grid = gridOptions.resolve(scene0);
@@ -175,7 +176,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       try {
         while (!stop) {
           const bool wasFrozen = frozen;
-          updater.setScene(sceneAt(o->scene, tNow()));
+          if (animated) updater.setScene(sceneAt(o->scene, tNow()));
           const renderer::UpdateStats st = updater.update();
           hub.publish(updater.probes(), updater.activeMask());
           ++updates;
@@ -223,7 +224,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       service::VolumeSnapshot snap;
       if (!v.client->snapshot(snap)) return false;
       v.framesSeen = snap.framesApplied;
-      v.raster->setShading(sceneAt(o->scene, tNow()));  // direct light is local: the light as it is now
+      if (animated) v.raster->setShading(sceneAt(o->scene, tNow()));  // direct light is local: the light now
       v.raster->setProbes(volumeOf(snap));
       v.images = v.raster->renderViews(v.views);
       v.renderMsPerView.push_back(v.raster->timings().viewsMs / static_cast<double>(v.views.size()));
