@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "probecast/renderer/glossy_sh.h"
 #include "probecast/renderer/probe_updater.h"
@@ -145,6 +146,42 @@ TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
             raster.render(monoViews[0].viewProj, monoViews[0].eye).rgb);
   EXPECT_FALSE(parseViewSet("lf:0x3", spec, error));
   EXPECT_FALSE(parseViewSet("quad", spec, error));
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+TEST(RasterClient, BadProbeVolumesAreRefusedAndTheLastGoodOneKept) {
+  ContextOptions co;
+  co.validation = true;
+  VulkanContext context(co);
+  scene::Scene s;
+  std::string error;
+  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  RasterRenderer raster(context, s, 24, 16);
+  ProbeVolumeData good;
+  good.dims = {2, 2, 2};
+  good.min = s.boundsMin;
+  good.max = s.boundsMax;
+  good.probes.assign(8 * 27, 0.0f);
+  for (int p = 0; p < 8; ++p) good.probes[p * 27] = 1.0f;
+  raster.setProbes(good);
+  const CameraView cam = CameraView::fromScene(s);
+  const Image before = raster.render(raster.viewProjection(cam), cam.position);
+  ProbeVolumeData nan = good;
+  nan.probes[5 * 27 + 4] = std::nanf("");
+  EXPECT_THROW(raster.setProbes(nan), std::invalid_argument);
+  ProbeVolumeData inf = good;
+  inf.probes[3] = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(raster.setProbes(inf), std::invalid_argument);
+  ProbeVolumeData flat = good;
+  flat.max.x = flat.min.x;
+  EXPECT_THROW(raster.setProbes(flat), std::invalid_argument);
+  ProbeVolumeData mask = good;
+  mask.active.assign(7, 1);
+  EXPECT_THROW(raster.setProbes(mask), std::invalid_argument);
+  ProbeVolumeData small = good;
+  small.probes.pop_back();
+  EXPECT_THROW(raster.setProbes(small), std::invalid_argument);
+  EXPECT_EQ(raster.render(raster.viewProjection(cam), cam.position).rgb, before.rgb);  // nothing lost
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 

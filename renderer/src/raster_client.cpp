@@ -578,6 +578,17 @@ RasterRenderer::~RasterRenderer() {
 void RasterRenderer::setProbes(const ProbeVolumeData& volume) {
   const size_t count = static_cast<size_t>(volume.dims.x) * volume.dims.y * volume.dims.z;
   if (count == 0 || volume.probes.size() != count * 27) throw std::invalid_argument("probe volume size mismatch");
+  if (!volume.active.empty() && volume.active.size() != count)
+    throw std::invalid_argument("probe volume: active mask of " + std::to_string(volume.active.size()) +
+                                " entries for " + std::to_string(count) + " probes");
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(volume.min[a]) || !std::isfinite(volume.max[a]) ||
+        (volume.dims[a] > 1 && !(volume.max[a] > volume.min[a])))
+      throw std::invalid_argument("probe volume bounds must be finite with max > min along every axis of 2+ probes");
+  for (size_t i = 0; i < volume.probes.size(); ++i)
+    if (!std::isfinite(volume.probes[i]))
+      throw std::invalid_argument("probe volume: non-finite coefficient at probe " + std::to_string(i / 27) +
+                                  " (the codec and probe files never produce one; sanitise first)");
   ProbeVolumeData filled = volume;
   fillInactiveProbes(filled);
   impl_->uploadVolume(volume.dims, filled.probes, volume.active);

@@ -47,7 +47,8 @@ enum class ViewPasses {
 
 struct RasterOptions {
   uint32_t shadowMapSize = 1024;  // texels per side of each shadow layer
-  uint32_t maxShadowLayers = 24;  // point lights take 6, spot and directional lights 1
+  uint32_t maxShadowLayers = 24;  // point lights take 6, spot and directional lights 1; lights past
+                                  // the budget (in scene order) are lit unshadowed
   ViewPasses passes = ViewPasses::PerView;
 };
 
@@ -68,6 +69,8 @@ class RasterRenderer {
   RasterRenderer(const RasterRenderer&) = delete;
   RasterRenderer& operator=(const RasterRenderer&) = delete;
 
+  // Throws std::invalid_argument (and keeps the previous volume) for a volume whose size, mask or
+  // bounds do not add up, or that holds a non-finite coefficient.
   void setProbes(const ProbeVolumeData& volume);
   // The same geometry with new lights or materials (an animated scene); shadows are redrawn.
   void setShading(const scene::Scene& scene);
