@@ -321,7 +321,14 @@ NetworkFaults measureNetworkFaults() {
   NetworkFaults r;
   service::ProbeClient client(config(0));
   client.start();
-  waitSeconds([&] { return client.stats().framesApplied >= 20; }, 20.0);
+  waitSeconds([&] { return client.stats().framesApplied >= 50; }, 20.0);
+  const auto percentileMs = [](std::vector<uint32_t> us, double p) {
+    if (us.empty()) return 0.0;
+    std::sort(us.begin(), us.end());
+    return 1e-3 * us[std::min(us.size() - 1, static_cast<size_t>(p * static_cast<double>(us.size() - 1) + 0.5))];
+  };
+  r.latencyP50Ms = percentileMs(client.latenciesUs(), 0.5);
+  r.latencyP99Ms = percentileMs(client.latenciesUs(), 0.99);
   // The outage: the link is gone for 2 s while the lighting keeps changing.
   client.stop();
   service::VolumeSnapshot before, during;
@@ -354,6 +361,7 @@ NetworkFaults measureNetworkFaults() {
   r.fastSecondsToBitExact = std::chrono::duration<double>(Clock::now() - t0).count();
   waitSeconds([&] { return holdsServerVolume(slow, hub); }, 30.0);
   r.slowLinkSecondsToBitExact = std::chrono::duration<double>(Clock::now() - t0).count();
+  r.slowLinkLatencyP50Ms = percentileMs(slow.latenciesUs(), 0.5);
   stop = true;
   producer.join();
   for (service::ProbeClient* c : {&client, &newcomer, &slow, &fast}) c->stop();
@@ -536,15 +544,20 @@ StabilityResult runStabilitySuite(const StabilityOptions& o) {
                          {"newcomer_bytes", nf.newcomerBytes},
                          {"slow_link_budget", nf.slowLinkBudget},
                          {"slow_link_seconds_to_bit_exact", nf.slowLinkSecondsToBitExact},
-                         {"fast_seconds_to_bit_exact", nf.fastSecondsToBitExact}};
+                         {"fast_seconds_to_bit_exact", nf.fastSecondsToBitExact},
+                         {"latency_ms_p50", nf.latencyP50Ms}, {"latency_ms_p99", nf.latencyP99Ms},
+                         {"slow_link_latency_ms_p50", nf.slowLinkLatencyP50Ms}};
   md += fmt::format(
       "\n### Network faults (loopback gRPC, 32×8×32 probes, zh3)\n\n"
       "A 2 s outage while the light moves: the viewer kept its last volume ({}); after the link came "
       "back it held the server's volume bit for bit ({}) in {:.2f} s, receiving {:.0f} bytes where a "
       "newcomer needed {:.0f}. A subscriber on a {:.0f} B/s link reached the same volume in {:.1f} s "
-      "while an unlimited one took {:.2f} s.\n",
+      "while an unlimited one took {:.2f} s. Produce → decoded latency with the light moving (50 updates/s): "
+      "p50 {:.1f} ms, p99 {:.1f} ms unlimited; {:.0f} ms p50 on the slow link (versions wait for budget, "
+      "and stale ones are skipped, not queued).\n",
       nf.lightingKeptDuringOutage ? "yes" : "no", nf.bitExactAfterResume ? "yes" : "no", nf.secondsToBitExact,
-      nf.resumeBytes, nf.newcomerBytes, nf.slowLinkBudget, nf.slowLinkSecondsToBitExact, nf.fastSecondsToBitExact);
+      nf.resumeBytes, nf.newcomerBytes, nf.slowLinkBudget, nf.slowLinkSecondsToBitExact, nf.fastSecondsToBitExact,
+      nf.latencyP50Ms, nf.latencyP99Ms, nf.slowLinkLatencyP50Ms);
 
   say("stability: extreme inputs");
   const ExtremeInputs ex = measureExtremeInputs();

@@ -67,6 +67,9 @@ struct NetworkFaults {
   double slowLinkBudget = 0;              // bytes/s
   double slowLinkSecondsToBitExact = 0;
   double fastSecondsToBitExact = 0;       // unlimited subscriber, same moment
+  // Produce → decoded latency of the frames applied (server and client share a clock here).
+  double latencyP50Ms = 0, latencyP99Ms = 0;  // unlimited subscriber, light moving at 50 Hz
+  double slowLinkLatencyP50Ms = 0;            // the slow-link subscriber: versions wait for budget
 };
 NetworkFaults measureNetworkFaults();
 

@@ -84,6 +84,10 @@ TEST(Stability, NetworkFaultsKeepTheLastVolumeAndRecoverBitExact) {
   EXPECT_GT(r.slowLinkSecondsToBitExact, 1.0);  // the budget paces it…
   EXPECT_LT(r.slowLinkSecondsToBitExact, 20.0);  // …and it still gets there
   EXPECT_LT(r.fastSecondsToBitExact, r.slowLinkSecondsToBitExact);
+  std::printf("latency p50 %.1f ms, p99 %.1f ms; slow link p50 %.0f ms\n", r.latencyP50Ms, r.latencyP99Ms,
+              r.slowLinkLatencyP50Ms);
+  EXPECT_GT(r.latencyP50Ms, 0.0);
+  EXPECT_LT(r.latencyP50Ms, r.slowLinkLatencyP50Ms);  // the budget, not the network, sets its pace
 }
 
 TEST(Stability, ExtremeInputsDecodeFiniteWithBoundedError) {
