@@ -15,7 +15,8 @@
 #include "raster.frag.h"
 #include "raster.vert.h"
 #include "raster_shared.h"
-#include "shadow.vert.h"
+#include "shadow_maps.h"
+#include "vk_pipeline.h"
 
 namespace probecast::renderer {
 void fillInactiveProbes(ProbeVolumeData& v) {
@@ -83,12 +84,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-glm::mat4 vulkanPerspective(float fovy, float aspect, float znear, float zfar) {
-  glm::mat4 proj = glm::perspectiveRH_ZO(fovy, aspect, znear, zfar);
-  proj[1][1] = -proj[1][1];  // Vulkan's y points down
-  return proj;
-}
-
 VkDescriptorSetLayoutBinding layoutBinding(uint32_t binding, VkDescriptorType type, uint32_t count,
                                            VkShaderStageFlags stages) {
   VkDescriptorSetLayoutBinding b{};
@@ -120,15 +115,6 @@ VkWriteDescriptorSet imageWrite(VkDescriptorSet set, uint32_t binding, const VkD
   return w;
 }
 
-VkRenderingAttachmentInfo attachment(VkImageView view, VkImageLayout layout, VkAttachmentStoreOp store) {
-  VkRenderingAttachmentInfo a{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  a.imageView = view;
-  a.imageLayout = layout;
-  a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-  a.storeOp = store;
-  a.clearValue.depthStencil = {1.0f, 0};
-  return a;
-}
 }  // namespace
 
 struct RasterRenderer::Impl {
@@ -142,15 +128,12 @@ struct RasterRenderer::Impl {
   GpuImage color, depth;  // `chunk` layers each
   GpuImage probeTextures[RS_PROBE_TEXTURES];
   GpuImage envBrdf;
-  GpuImage shadowMap;  // one layer per shadow face, at least one
-  std::vector<glm::mat4> shadowMatrices;
-  bool shadowsDirty = true;
+  ShadowMaps shadows;
   VkSampler sampler = VK_NULL_HANDLE, shadowSampler = VK_NULL_HANDLE;
-  Buffer readback, views, shadowLights, shadowLayers;
+  Buffer readback, views;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-  VkPipelineLayout layout = VK_NULL_HANDLE, shadowLayout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
   std::map<uint32_t, VkPipeline> pipelines;  // by view mask (0: one view per pass)
-  VkPipeline shadowPipeline = VK_NULL_HANDLE;
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet set = VK_NULL_HANDLE;
   shaders::RsPushConstants push{};
@@ -159,7 +142,7 @@ struct RasterRenderer::Impl {
 
   void writeDescriptors() {
     const Buffer* buffers[8] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
-                                &views, &shadowLights, &shadowLayers};
+                                &views, &shadows.lights, &shadows.layers};
     const uint32_t bindings[8] = {RS_BINDING_TRIANGLE_MATERIAL, RS_BINDING_MATERIALS, RS_BINDING_LIGHTS,
                                   RS_BINDING_TEXELS, RS_BINDING_TEXTURES, RS_BINDING_VIEWS,
                                   RS_BINDING_SHADOW_LIGHTS, RS_BINDING_SHADOW_LAYERS};
@@ -173,7 +156,7 @@ struct RasterRenderer::Impl {
     for (int t = 0; t < RS_PROBE_TEXTURES; ++t)
       images[t] = {sampler, probeTextures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo envInfo{sampler, envBrdf.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    const VkDescriptorImageInfo shadowInfo{shadowSampler, shadowMap.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo shadowInfo{shadowSampler, shadows.depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     writes[8] = imageWrite(set, RS_BINDING_PROBES, images, RS_PROBE_TEXTURES);
     writes[9] = imageWrite(set, RS_BINDING_ENV_BRDF, &envInfo, 1);
     writes[10] = imageWrite(set, RS_BINDING_SHADOW_MAP, &shadowInfo, 1);
@@ -216,114 +199,26 @@ struct RasterRenderer::Impl {
     writeDescriptors();
   }
 
-  // Shadow layers for the current lights: matrices, per-light records, and a map big enough.
-  void planShadows(const scene::Scene& scene) {
-    const glm::vec3 center = 0.5f * (sceneMin + sceneMax);
-    const float radius = std::max(0.5f * glm::length(sceneMax - sceneMin), 1e-3f);
-    const float size = static_cast<float>(options.shadowMapSize);
-    std::vector<shaders::RsShadowLight> records;
-    shadowMatrices.clear();
-    for (const scene::Light& l : scene.lights) {
-      shaders::RsShadowLight r{RS_SHADOW_NONE, static_cast<uint32_t>(shadowMatrices.size()), 0.0f, 0.0f};
-      const float zfar = l.range > 0.0f ? l.range : 2.0f * radius + glm::length(l.position - center);
-      const float znear = std::max(1e-3f, 1e-4f * zfar);
-      const glm::vec3 dir = glm::length(l.direction) > 0.0f ? glm::normalize(l.direction) : glm::vec3(0, -1, 0);
-      const glm::vec3 up = std::abs(dir.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
-      const bool wideSpot = l.type == scene::LightType::Spot && l.outerConeAngle > glm::radians(75.0f);
-      if (l.type == scene::LightType::Point || wideSpot) {
-        if (shadowMatrices.size() + 6 > options.maxShadowLayers) {
-          records.push_back(r);
-          continue;
-        }
-        static const glm::vec3 kFaceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-        static const glm::vec3 kFaceUp[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
-        const glm::mat4 proj = vulkanPerspective(glm::radians(90.0f), 1.0f, znear, zfar);
-        for (int f = 0; f < 6; ++f)
-          shadowMatrices.push_back(proj * glm::lookAtRH(l.position, l.position + kFaceDir[f], kFaceUp[f]));
-        r.kind = RS_SHADOW_CUBE;
-        r.texelScale = 2.0f / size;
-      } else if (shadowMatrices.size() + 1 > options.maxShadowLayers) {
-        records.push_back(r);
-        continue;
-      } else if (l.type == scene::LightType::Spot) {
-        const float fov = 2.0f * l.outerConeAngle + glm::radians(2.0f);
-        shadowMatrices.push_back(vulkanPerspective(fov, 1.0f, znear, zfar) *
-                                 glm::lookAtRH(l.position, l.position + dir, up));
-        r.kind = RS_SHADOW_PERSPECTIVE;
-        r.texelScale = 2.0f * std::tan(0.5f * fov) / size;
-      } else {
-        glm::mat4 ortho = glm::orthoRH_ZO(-radius, radius, -radius, radius, 0.0f, 2.0f * radius);
-        ortho[1][1] = -ortho[1][1];
-        shadowMatrices.push_back(ortho * glm::lookAtRH(center - dir * radius, center, up));
-        r.kind = RS_SHADOW_ORTHO;
-        r.texelScale = 2.0f * radius / size;
-      }
-      records.push_back(r);
-    }
-    if (records.empty()) records.push_back({RS_SHADOW_NONE, 0, 0.0f, 0.0f});
-    destroyBuffer(*d, shadowLights);
-    destroyBuffer(*d, shadowLayers);
-    shadowLights = createBufferWithData(*d, records.data(), records.size() * sizeof records[0],
-                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    shadowLayers = createBufferWithData(*d, shadowMatrices.data(), shadowMatrices.size() * sizeof(glm::mat4),
-                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    const uint32_t layers = std::max<uint32_t>(2, static_cast<uint32_t>(shadowMatrices.size()));
-    if (shadowMap.layers != layers) {
-      destroyImage(*d, shadowMap);
-      shadowMap = createImageArray(*d, VK_FORMAT_D32_SFLOAT, {options.shadowMapSize, options.shadowMapSize}, layers,
-                                   VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
-      submitAndWait(*d, [&](VkCommandBuffer cmd) {
-        transitionImage(cmd, shadowMap, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-      });
-    }
-    shadowsDirty = true;
-  }
-
-  void drawScene(VkCommandBuffer cmd, bool positionsOnly) {
+  void drawScene(VkCommandBuffer cmd) {
     const VkBuffer vbufs[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
     const VkDeviceSize offsets[3] = {0, 0, 0};
-    vkCmdBindVertexBuffers(cmd, 0, positionsOnly ? 1 : 3, vbufs, offsets);
+    vkCmdBindVertexBuffers(cmd, 0, 3, vbufs, offsets);
     vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, indexCount, 1, 0, 0, 0);
   }
 
-  void setViewport(VkCommandBuffer cmd, uint32_t w, uint32_t h) {
-    const VkViewport viewport{0, 0, static_cast<float>(w), static_cast<float>(h), 0, 1};
-    const VkRect2D scissor{{0, 0}, {w, h}};
-    vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vkCmdSetScissor(cmd, 0, 1, &scissor);
-  }
-
-  void renderShadows() {
-    if (!shadowsDirty) return;
-    const auto t0 = Clock::now();
-    const uint32_t n = options.shadowMapSize;
-    submitAndWait(*d, [&](VkCommandBuffer cmd) {
-      transitionImage(cmd, shadowMap, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-      for (size_t k = 0; k < shadowMatrices.size(); ++k) {
-        VkRenderingAttachmentInfo depthInfo = attachment(shadowMap.layerViews[k], VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                                         VK_ATTACHMENT_STORE_OP_STORE);
-        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, {n, n}};
-        ri.layerCount = 1;
-        ri.pDepthAttachment = &depthInfo;
-        vkCmdBeginRendering(cmd, &ri);
-        setViewport(cmd, n, n);
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, shadowPipeline);
-        vkCmdPushConstants(cmd, shadowLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(glm::mat4), &shadowMatrices[k]);
-        drawScene(cmd, true);
-        vkCmdEndRendering(cmd);
-      }
-      transitionImage(cmd, shadowMap, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-    });
-    shadowsDirty = false;
-    timings.shadowMs = msSince(t0);
-  }
-
-  VkPipeline createPipeline(bool shadow, uint32_t viewMask);
   VkPipeline pipelineFor(uint32_t viewMask) {
     auto it = pipelines.find(viewMask);
-    if (it == pipelines.end()) it = pipelines.emplace(viewMask, createPipeline(false, viewMask)).first;
+    if (it == pipelines.end()) {
+      GraphicsPipelineDesc desc;
+      desc.vertexCode = kRasterVert;
+      desc.vertexBytes = sizeof kRasterVert;
+      desc.fragmentCode = kRasterFrag;
+      desc.fragmentBytes = sizeof kRasterFrag;
+      desc.viewMask = viewMask;
+      desc.layout = layout;
+      it = pipelines.emplace(viewMask, createGraphicsPipeline(*d, desc)).first;
+    }
     return it->second;
   }
 
@@ -337,11 +232,10 @@ struct RasterRenderer::Impl {
       for (uint32_t p = 0; p < passes; ++p) {
         const VkImageView colorView = multiview || chunk == 1 ? color.view : color.layerViews[p];
         const VkImageView depthView = multiview || chunk == 1 ? depth.view : depth.layerViews[p];
-        VkRenderingAttachmentInfo colorInfo =
-            attachment(colorView, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
-        colorInfo.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
-        VkRenderingAttachmentInfo depthInfo =
-            attachment(depthView, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_DONT_CARE);
+        const VkRenderingAttachmentInfo colorInfo =
+            clearedAttachment(colorView, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
+        const VkRenderingAttachmentInfo depthInfo =
+            clearedAttachment(depthView, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_DONT_CARE);
         VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
         ri.renderArea = {{0, 0}, {width, height}};
         ri.layerCount = 1;
@@ -350,12 +244,12 @@ struct RasterRenderer::Impl {
         ri.pColorAttachments = &colorInfo;
         ri.pDepthAttachment = &depthInfo;
         vkCmdBeginRendering(cmd, &ri);
-        setViewport(cmd, width, height);
+        setViewportScissor(cmd, width, height);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineFor(ri.viewMask));
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &set, 0, nullptr);
         push.viewBase = first + p;
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
-        drawScene(cmd, false);
+        drawScene(cmd);
         vkCmdEndRendering(cmd);
       }
       transitionImage(cmd, color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
@@ -382,82 +276,6 @@ struct RasterRenderer::Impl {
     }
   }
 };
-
-VkPipeline RasterRenderer::Impl::createPipeline(bool shadow, uint32_t viewMask) {
-  const VkShaderModule vs = shadow ? createShaderModule(*d, kShadowVert, sizeof kShadowVert)
-                                   : createShaderModule(*d, kRasterVert, sizeof kRasterVert);
-  const VkShaderModule fs = shadow ? VK_NULL_HANDLE : createShaderModule(*d, kRasterFrag, sizeof kRasterFrag);
-  VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-                                               {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
-  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-  stages[0].module = vs;
-  stages[0].pName = "main";
-  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-  stages[1].module = fs;
-  stages[1].pName = "main";
-  const VkVertexInputBindingDescription vb[3] = {{0, 12, VK_VERTEX_INPUT_RATE_VERTEX},
-                                                 {1, 12, VK_VERTEX_INPUT_RATE_VERTEX},
-                                                 {2, 8, VK_VERTEX_INPUT_RATE_VERTEX}};
-  const VkVertexInputAttributeDescription va[3] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
-                                                   {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0},
-                                                   {2, 2, VK_FORMAT_R32G32_SFLOAT, 0}};
-  VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-  vi.vertexBindingDescriptionCount = shadow ? 1 : 3;
-  vi.pVertexBindingDescriptions = vb;
-  vi.vertexAttributeDescriptionCount = shadow ? 1 : 3;
-  vi.pVertexAttributeDescriptions = va;
-  VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-  ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-  VkPipelineViewportStateCreateInfo vps{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-  vps.viewportCount = 1;
-  vps.scissorCount = 1;
-  VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-  rs.polygonMode = VK_POLYGON_MODE_FILL;
-  rs.cullMode = VK_CULL_MODE_NONE;  // scenes are two-sided, as in the path tracer
-  rs.lineWidth = 1.0f;
-  rs.depthBiasEnable = shadow ? VK_TRUE : VK_FALSE;
-  rs.depthBiasConstantFactor = 1.0f;
-  rs.depthBiasSlopeFactor = 1.5f;
-  VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-  ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-  VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-  ds.depthTestEnable = VK_TRUE;
-  ds.depthWriteEnable = VK_TRUE;
-  ds.depthCompareOp = VK_COMPARE_OP_LESS;
-  VkPipelineColorBlendAttachmentState cba{};
-  cba.colorWriteMask = 0xF;
-  VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-  cb.attachmentCount = shadow ? 0 : 1;
-  cb.pAttachments = &cba;
-  const VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-  VkPipelineDynamicStateCreateInfo dys{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-  dys.dynamicStateCount = 2;
-  dys.pDynamicStates = dyn;
-  const VkFormat colorFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-  VkPipelineRenderingCreateInfo rci{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-  rci.viewMask = viewMask;
-  rci.colorAttachmentCount = shadow ? 0 : 1;
-  rci.pColorAttachmentFormats = &colorFormat;
-  rci.depthAttachmentFormat = VK_FORMAT_D32_SFLOAT;
-  VkGraphicsPipelineCreateInfo gci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-  gci.pNext = &rci;
-  gci.stageCount = shadow ? 1 : 2;
-  gci.pStages = stages;
-  gci.pVertexInputState = &vi;
-  gci.pInputAssemblyState = &ia;
-  gci.pViewportState = &vps;
-  gci.pRasterizationState = &rs;
-  gci.pMultisampleState = &ms;
-  gci.pDepthStencilState = &ds;
-  gci.pColorBlendState = &cb;
-  gci.pDynamicState = &dys;
-  gci.layout = shadow ? shadowLayout : layout;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateGraphicsPipelines(d->device, VK_NULL_HANDLE, 1, &gci, nullptr, &pipeline));
-  vkDestroyShaderModule(d->device, vs, nullptr);
-  if (fs) vkDestroyShaderModule(d->device, fs, nullptr);
-  return pipeline;
-}
 
 RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene, uint32_t width, uint32_t height,
                                const RasterOptions& options)
@@ -518,12 +336,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   pli.pushConstantRangeCount = 1;
   pli.pPushConstantRanges = &range;
   VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.layout));
-  const VkPushConstantRange shadowRange{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(glm::mat4)};
-  pli.setLayoutCount = 0;
-  pli.pPushConstantRanges = &shadowRange;
-  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.shadowLayout));
-  s.shadowPipeline = s.createPipeline(true, 0);
   s.pipelineFor(0);
+  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, s.shadows);
 
   const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 2}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
@@ -550,7 +364,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
     s.push.lobeBand2 = {static_cast<float>(fit.band2[0]), static_cast<float>(fit.band2[1]),
                         static_cast<float>(fit.band2[2]), static_cast<float>(fit.band2[3])};
   }
-  s.planShadows(scene);
+  planShadowMaps(d, scene, s.shadows);
   s.push.shadowMapSize = options.shadowMapSize;
   s.push.lightCount = s.gpu.lightCount;
   // No volume yet: a 1³ black one keeps every descriptor valid (and writes them all).
@@ -562,16 +376,15 @@ RasterRenderer::~RasterRenderer() {
   VulkanDevice& d = *s.d;
   vkDeviceWaitIdle(d.device);
   for (GpuImage& img : s.probeTextures) destroyImage(d, img);
-  for (GpuImage* img : {&s.envBrdf, &s.color, &s.depth, &s.shadowMap}) destroyImage(d, *img);
-  for (Buffer* b : {&s.readback, &s.views, &s.shadowLights, &s.shadowLayers}) destroyBuffer(d, *b);
+  for (GpuImage* img : {&s.envBrdf, &s.color, &s.depth}) destroyImage(d, *img);
+  for (Buffer* b : {&s.readback, &s.views}) destroyBuffer(d, *b);
+  destroyShadowMaps(d, s.shadows);
   destroyGpuScene(d, s.gpu);
   for (VkSampler sampler : {s.sampler, s.shadowSampler})
     if (sampler) vkDestroySampler(d.device, sampler, nullptr);
   if (s.pool) vkDestroyDescriptorPool(d.device, s.pool, nullptr);
   for (auto& [mask, pipeline] : s.pipelines) vkDestroyPipeline(d.device, pipeline, nullptr);
-  if (s.shadowPipeline) vkDestroyPipeline(d.device, s.shadowPipeline, nullptr);
-  for (VkPipelineLayout l : {s.layout, s.shadowLayout})
-    if (l) vkDestroyPipelineLayout(d.device, l, nullptr);
+  if (s.layout) vkDestroyPipelineLayout(d.device, s.layout, nullptr);
   if (s.setLayout) vkDestroyDescriptorSetLayout(d.device, s.setLayout, nullptr);
 }
 
@@ -605,7 +418,7 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   vkDeviceWaitIdle(s.d->device);
   uploadGpuShading(*s.d, scene, s.gpu);
   s.push.lightCount = s.gpu.lightCount;
-  s.planShadows(scene);
+  planShadowMaps(*s.d, scene, s.shadows);
   s.writeDescriptors();
 }
 
@@ -613,7 +426,8 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   Impl& s = *impl_;
   if (views.size() > Impl::kMaxViews) throw std::invalid_argument("at most 256 views per view set");
   std::vector<Image> out(views.size());
-  s.renderShadows();
+  drawShadowMaps(*s.d, s.gpu, s.indexCount, s.shadows);
+  s.timings.shadowMs = s.shadows.lastDrawMs;
   const auto t0 = Clock::now();
   auto* dst = static_cast<shaders::RsView*>(s.views.mapped);
   for (size_t k = 0; k < views.size(); ++k) {

@@ -31,6 +31,12 @@ bool parseViewSet(const std::string& text, ViewSetSpec& spec, std::string& error
   return false;
 }
 
+glm::mat4 vulkanPerspective(float yfov, float aspect, float znear, float zfar) {
+  glm::mat4 proj = glm::perspectiveRH_ZO(yfov, aspect, znear, zfar);
+  proj[1][1] = -proj[1][1];  // Vulkan's y points down
+  return proj;
+}
+
 std::vector<ViewInfo> makeViewSet(const CameraView& camera, const ViewSetSpec& spec, const ViewSetOptions& o) {
   const glm::vec3 f = glm::normalize(camera.forward);
   const glm::vec3 r = glm::normalize(glm::cross(f, camera.up));

@@ -48,6 +48,9 @@ struct ViewSetOptions {
   float zfar = 200.0f;
 };
 
+// glm's right-handed perspective with z in [0, 1] and y flipped: Vulkan clip conventions.
+glm::mat4 vulkanPerspective(float yfov, float aspect, float znear, float zfar);
+
 std::vector<ViewInfo> makeViewSet(const CameraView& camera, const ViewSetSpec& spec, const ViewSetOptions& options);
 
 // Places equally sized views into a quilt of columns × rows tiles: view (column, row) at tile

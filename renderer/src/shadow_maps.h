@@ -1,0 +1,39 @@
+// Shadow maps of a scene's punctual lights, for the raster client: one layer of a D32 2D array
+// per face — six 90° faces for a point light (+x −x +y −y +z −z; spot lights wider than 150° are
+// treated the same), one perspective layer for a spot light, one orthographic layer over the
+// scene for a directional light — drawn depth-only with a slope-scaled bias. The fragment shader
+// reads them through RsShadowLight / RsShadowLayer (raster_shared.h). Lights past the layer budget
+// (in scene order) stay unshadowed.
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gpu_scene.h"
+#include "probecast/scene/scene.h"
+#include "vk_resources.h"
+
+namespace probecast::renderer {
+
+struct ShadowMaps {
+  uint32_t size = 1024;      // texels per side of a layer
+  uint32_t maxLayers = 24;
+  GpuImage depth;            // at least 2 layers, so the shaders always see an array
+  Buffer lights;             // RsShadowLight per scene light
+  Buffer layers;             // RsShadowLayer per layer in use
+  std::vector<glm::mat4> matrices;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  bool dirty = true;         // planned but not drawn yet
+  double lastDrawMs = 0.0;
+};
+
+void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, ShadowMaps& out);
+// Plans the layers for the scene's lights (bounds from the scene); drawn at the next draw call.
+void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps);
+// Draws every planned layer of `gpu`'s triangles if the plan changed since the last draw.
+void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, ShadowMaps& maps);
+void destroyShadowMaps(VulkanDevice& d, ShadowMaps& maps);
+
+}  // namespace probecast::renderer
