@@ -64,6 +64,8 @@ struct Viewer {
   uint64_t lastBytes = 0;
 };
 
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -105,6 +107,109 @@ std::string progressBar(double fraction) {
          "]";
 }
 
+// The pipeline benchmark (small) and the stability suite, written next to the report; returns
+// their report sections.
+std::string runSuites(const DemoOptions& o, const std::string& dir, const scene::Scene& finalScene, float finalT,
+                      const renderer::ProbeGrid& grid, nlohmann::json& phases) {
+  const auto status = [](const std::string& s) { fmt::print(stderr, "\rdemo: {:<90}", s.substr(0, 90)); };
+  auto phaseStart = Clock::now();
+  bench::PipelineBenchOptions po;
+  po.sceneSpec = o.scene;
+  po.scene = finalScene;
+  po.t = finalT;
+  po.grid = grid;
+  po.width = 128;
+  po.height = 80;
+  po.referenceSpp = 2 * o.referenceSpp;
+  po.spps = {32, 128};
+  po.bounces = {1, 4};
+  po.deadzones = {0, 4, 16};
+  po.streamFrames = 16;
+  po.updates = 3;
+  po.command = commandLine() + " (pipeline part)";
+  po.progress = status;
+  const bench::PipelineBenchResult pr = bench::runPipelineBench(po);
+  writeTextFile(dir + "/pipeline.json", pr.json.dump(2) + "\n");
+  writeTextFile(dir + "/pipeline_bytes.svg", pr.svgBytes);
+  writeTextFile(dir + "/pipeline_update.svg", pr.svgUpdate);
+  writeTextFile(dir + "/pipeline_repr.svg", pr.svgRepr);
+  phases["pipeline"] = secondsSince(phaseStart);
+  phaseStart = Clock::now();
+  bench::StabilityOptions so;
+  so.command = commandLine() + " (stability part)";
+  so.progress = status;
+  const bench::StabilityResult sr = bench::runStabilitySuite(so);
+  writeTextFile(dir + "/stability.json", sr.json.dump(2) + "\n");
+  phases["stability"] = secondsSince(phaseStart);
+  fmt::print(stderr, "\n");
+  return "\n## Speed against accuracy across the pipeline\n\n"
+         "Same scene, same view (the light frozen where the demo stopped it), one run; the Pareto front of "
+         "each chart is joined. Data: [pipeline.json](pipeline.json).\n\n"
+         "![PSNR against wire bytes](pipeline_bytes.svg)\n\n![PSNR against update time](pipeline_update.svg)"
+         "\n\n![PSNR against representation](pipeline_repr.svg)\n\n```\n" +
+         pr.table +
+         "```\n"
+         "\n## Stability: where probe lighting fails, measured\n\nEach case is also a test "
+         "(`ctest -L stability`). Data: [stability.json](stability.json).\n\n" +
+         sr.markdown;
+}
+
+// report.md without the suites' sections.
+std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, const std::string& device,
+                           const std::vector<size_t>& viewsAboveScene) {
+  std::string md = "# probecast demo\n\n";
+  md += fmt::format("Produced by `{}` in {:.0f} s on {} (server and viewers on one machine, loopback gRPC).\n\n",
+                    commandLine(), report["wall_seconds"].get<double>(), device);
+  md += fmt::format(
+      "A server path-traces {} into {}x{}x{} probes ({} samples per probe per update, median "
+      "{:.0f} ms per update) while its light circles, and streams them as `{}`. A stereo headset "
+      "and a {} light-field display subscribe over gRPC, re-render each time new lighting arrives "
+      "(direct light locally at the light's current position, indirect light from the probes they "
+      "hold), and after {:.0f} s the light stops, the probes settle for {} updates, and every view "
+      "is compared with the reference path tracer ({} samples per pixel).\n\n",
+      report["scene"].get<std::string>(), report["grid"][0].get<int>(), report["grid"][1].get<int>(),
+      report["grid"][2].get<int>(), o.spp, report["update_ms_median"].get<double>(), o.repr, o.lightField,
+      report["stream_seconds"].get<double>(), o.settleUpdates, o.referenceSpp);
+  md +=
+      "| viewer | views | size | budget | frames | renders | ms/view | bytes/s while moving | PSNR dB (mean) | SSIM "
+      "(mean) | holds the server's volume |\n";
+  md += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& v : report["viewers"])
+    md += fmt::format(
+        "| {} | {} | {}x{} | {} | {} | {} | {:.1f} | {:.0f} | {:.2f} | {:.4f} | {} |\n", v["name"].get<std::string>(),
+        v["views"].get<std::string>(), v["size"][0].get<int>(), v["size"][1].get<int>(),
+        v["budget_bytes_per_s"].get<uint64_t>() ? fmt::format("{} B/s", v["budget_bytes_per_s"].get<uint64_t>())
+                                                : std::string("none"),
+        v["frames_applied"].get<uint32_t>(), v["renders"].get<uint32_t>(), v["render_ms_per_view_median"].get<double>(),
+        v["bytes_per_s_streaming"].get<double>(), v["psnr_db_mean"].get<double>(), v["ssim_mean"].get<double>(),
+        v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
+  md += fmt::format(
+      "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without "
+      "clamping; the PNGs use a filmic tone map. The reference has noise of its own: two "
+      "references of the headset's left eye with different seeds differ by {:.2f} dB PSNR, SSIM "
+      "{:.4f} — the ceiling these figures can reach. Light-field views compared: the corners and "
+      "the centre ({} in quilt order).\n\n",
+      report["reference_noise_floor"]["psnr_db"].get<double>(), report["reference_noise_floor"]["ssim"].get<double>(),
+      report["viewers"][1]["reference_views"].dump());
+  if (!viewsAboveScene.empty())
+    md += fmt::format(
+        "Views {} look from above the scene's top (the light field's top rows): they see the "
+        "outer face of the ceiling lit by the probes inside — a leak the reference does not have, "
+        "and why they score lowest.\n\n",
+        nlohmann::json(viewsAboveScene).dump());
+  md += "## While the light moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
+  for (const auto& m : report["moments"])
+    md += fmt::format("At {:.1f} s (t = {:.3f}): ![stereo]({}) ![quilt]({})\n\n", m["seconds"].get<double>(),
+                      m["t"].get<double>(), m.value("stereo", ""), m.value("quilt", ""));
+  md += "## Against the reference\n\n![PSNR per view](psnr_per_view.svg)\n\n";
+  md += "| | headset (stereo) | light-field quilt |\n|---|---|---|\n";
+  md += "| probecast | ![](final_stereo.png) | ![](final_quilt.png) |\n";
+  md += "| reference | ![](reference_stereo.png) | ![](reference_quilt.png) |\n";
+  md += "| difference, view 0 | ![](difference_stereo_view0.png) | ![](difference_quilt_view0.png) |\n\n";
+  md += "Data: [report.json](report.json).\n";
+  return md;
+}
+
 }  // namespace
 
 void addDemoCommand(CLI::App& app, int& exitCode) {
@@ -126,9 +231,6 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
   demo->callback([o, &exitCode] {
     namespace fs = std::filesystem;
     const auto wallStart = Clock::now();
-    const auto secondsSince = [](Clock::time_point t0) {
-      return std::chrono::duration<double>(Clock::now() - t0).count();
-    };
     fs::create_directories(o->out);
     const std::string dir = o->out;
 
@@ -337,7 +439,8 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     for (Viewer& v : viewers) {
       const size_t n = v.views.size(), c = static_cast<size_t>(v.spec.columns);
       v.referenceViews = {0};
-      if (v.spec.kind != renderer::ViewSetSpec::Kind::Mono && v.spec.kind != renderer::ViewSetSpec::Kind::Stereo && n > 5) {
+      if (v.spec.kind != renderer::ViewSetSpec::Kind::Mono && v.spec.kind != renderer::ViewSetSpec::Kind::Stereo &&
+          n > 5) {
         for (size_t i : {c - 1, n / 2, n - c, n - 1}) v.referenceViews.push_back(i);
       } else {
         for (size_t i = 1; i < n; ++i) v.referenceViews.push_back(i);
@@ -443,108 +546,17 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     // Speed against accuracy across the pipeline, and the stability suite.
     std::string suites;
     if (!o->skipSuites) {
-      const auto status = [](const std::string& s) { fmt::print(stderr, "\rdemo: {:<90}", s.substr(0, 90)); };
-      phaseStart = Clock::now();
-      bench::PipelineBenchOptions po;
-      po.sceneSpec = o->scene;
-      po.scene = finalScene;
-      po.t = finalT;
-      po.grid = grid;
-      po.width = 128;
-      po.height = 80;
-      po.referenceSpp = 2 * o->referenceSpp;
-      po.spps = {32, 128};
-      po.bounces = {1, 4};
-      po.deadzones = {0, 4, 16};
-      po.streamFrames = 16;
-      po.updates = 3;
-      po.command = commandLine() + " (pipeline part)";
-      po.progress = status;
-      const bench::PipelineBenchResult pr = bench::runPipelineBench(po);
-      writeTextFile(dir + "/pipeline.json", pr.json.dump(2) + "\n");
-      writeTextFile(dir + "/pipeline_bytes.svg", pr.svgBytes);
-      writeTextFile(dir + "/pipeline_update.svg", pr.svgUpdate);
-      writeTextFile(dir + "/pipeline_repr.svg", pr.svgRepr);
-      phases["pipeline"] = secondsSince(phaseStart);
-      phaseStart = Clock::now();
-      bench::StabilityOptions so;
-      so.command = commandLine() + " (stability part)";
-      so.progress = status;
-      const bench::StabilityResult sr = bench::runStabilitySuite(so);
-      writeTextFile(dir + "/stability.json", sr.json.dump(2) + "\n");
-      phases["stability"] = secondsSince(phaseStart);
+      suites = runSuites(*o, dir, finalScene, finalT, grid, phases);
       report["phase_seconds"] = phases;
-      fmt::print(stderr, "\n");
-      suites +=
-          "\n## Speed against accuracy across the pipeline\n\n"
-          "Same scene, same view (the light frozen where the demo stopped it), one run; the Pareto front of "
-          "each chart is joined. Data: [pipeline.json](pipeline.json).\n\n"
-          "![PSNR against wire bytes](pipeline_bytes.svg)\n\n![PSNR against update time](pipeline_update.svg)"
-          "\n\n![PSNR against representation](pipeline_repr.svg)\n\n```\n" +
-          pr.table + "```\n";
-      suites +=
-          "\n## Stability: where probe lighting fails, measured\n\nEach case is also a test "
-          "(`ctest -L stability`). Data: [stability.json](stability.json).\n\n" +
-          sr.markdown;
     }
     const double wall = secondsSince(wallStart);
     report["wall_seconds"] = wall;
     writeTextFile(dir + "/report.json", report.dump(2) + "\n");
 
-    std::string md = "# probecast demo\n\n";
-    md += fmt::format("Produced by `{}` in {:.0f} s on {} (server and viewers on one machine, loopback gRPC).\n\n",
-                      commandLine(), wall, serverContext.deviceName());
-    md += fmt::format(
-        "A server path-traces {} into {}x{}x{} probes ({} samples per probe per update, median "
-        "{:.0f} ms per update) while its light circles, and streams them as `{}`. A stereo headset "
-        "and a {} light-field display subscribe over gRPC, re-render each time new lighting arrives "
-        "(direct light locally at the light's current position, indirect light from the probes they "
-        "hold), and after {:.0f} s the light stops, the probes settle for {} updates, and every view "
-        "is compared with the reference path tracer ({} samples per pixel).\n\n",
-        scene0.name, grid.dims.x, grid.dims.y, grid.dims.z, o->spp, report["update_ms_median"].get<double>(), o->repr,
-        o->lightField, streamSeconds, o->settleUpdates, o->referenceSpp);
-    md +=
-        "| viewer | views | size | budget | frames | renders | ms/view | bytes/s while moving | PSNR dB (mean) | SSIM "
-        "(mean) | holds the server's volume |\n";
-    md += "|---|---|---|---|---|---|---|---|---|---|---|\n";
-    for (const auto& v : report["viewers"])
-      md += fmt::format(
-          "| {} | {} | {}x{} | {} | {} | {} | {:.1f} | {:.0f} | {:.2f} | {:.4f} | {} |\n", v["name"].get<std::string>(),
-          v["views"].get<std::string>(), v["size"][0].get<int>(), v["size"][1].get<int>(),
-          v["budget_bytes_per_s"].get<uint64_t>() ? fmt::format("{} B/s", v["budget_bytes_per_s"].get<uint64_t>())
-                                                  : std::string("none"),
-          v["frames_applied"].get<uint32_t>(), v["renders"].get<uint32_t>(),
-          v["render_ms_per_view_median"].get<double>(), v["bytes_per_s_streaming"].get<double>(),
-          v["psnr_db_mean"].get<double>(), v["ssim_mean"].get<double>(),
-          v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
-    md += fmt::format(
-        "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without "
-        "clamping; the PNGs use a filmic tone map. The reference has noise of its own: two "
-        "references of the headset's left eye with different seeds differ by {:.2f} dB PSNR, SSIM "
-        "{:.4f} — the ceiling these figures can reach. Light-field views compared: the corners and "
-        "the centre ({} in quilt order).\n\n",
-        report["reference_noise_floor"]["psnr_db"].get<double>(), report["reference_noise_floor"]["ssim"].get<double>(),
-        report["viewers"][1]["reference_views"].dump());
     std::vector<size_t> above;  // light-field eyes above the scene: they see the ceiling's outer face
     for (size_t i : viewers[1].referenceViews)
       if (viewers[1].views[i].eye.y > finalScene.boundsMax.y) above.push_back(i);
-    if (!above.empty())
-      md += fmt::format(
-          "Views {} look from above the scene's top (the light field's top rows): they see the "
-          "outer face of the ceiling lit by the probes inside — a leak the reference does not have, "
-          "and why they score lowest.\n\n",
-          nlohmann::json(above).dump());
-    md += "## While the light moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
-    for (const auto& m : moments)
-      md += fmt::format("At {:.1f} s (t = {:.3f}): ![stereo]({}) ![quilt]({})\n\n", m["seconds"].get<double>(),
-                        m["t"].get<double>(), m.value("stereo", ""), m.value("quilt", ""));
-    md += "## Against the reference\n\n![PSNR per view](psnr_per_view.svg)\n\n";
-    md += "| | headset (stereo) | light-field quilt |\n|---|---|---|\n";
-    md += "| probecast | ![](final_stereo.png) | ![](final_quilt.png) |\n";
-    md += "| reference | ![](reference_stereo.png) | ![](reference_quilt.png) |\n";
-    md += "| difference, view 0 | ![](difference_stereo_view0.png) | ![](difference_quilt_view0.png) |\n\n";
-    md += "Data: [report.json](report.json).\n";
-    md += suites;
+    const std::string md = reportMarkdown(*o, report, serverContext.deviceName(), above) + suites;
     writeTextFile(dir + "/report.md", md);
     for (const auto& v : report["viewers"])
       fmt::print("demo: {:<20} {:>7} {:>4} frames, {:>8.0f} B/s while moving, PSNR {:.2f} dB, SSIM {:.4f}\n",
