@@ -10,25 +10,19 @@ namespace probecast::app {
 
 void addBakeCommand(CLI::App& app, int& exitCode) {
   CLI::App* bake = app.add_subcommand("bake", "path-trace a probe grid and write it (float SH + active mask)");
-  auto scene = std::make_shared<SceneOptions>();
-  auto gpu = std::make_shared<GpuOptions>();
-  auto grid = std::make_shared<GridOptions>();
-  auto tracer = std::make_shared<TracerOptions>();
+  auto tr = std::make_shared<TracingOptions>();
   auto out = std::make_shared<std::string>();
   auto updates = std::make_shared<uint32_t>(4);
-  scene->add(bake);
-  gpu->add(bake);
-  grid->add(bake);
-  tracer->add(bake);
+  tr->add(bake);
   bake->add_option("--updates", *updates, "updates to accumulate")->check(CLI::Range(1, 100000));
   bake->add_option("--out", *out, "probe volume file to write")->required();
   bake->callback([=, &exitCode] {
-    const scene::Scene s = scene->load();
-    renderer::VulkanContext context(gpu->context());
-    const renderer::ProbeGrid g = grid->resolve(s);
-    renderer::ProbeUpdater updater(context, s, g, tracer->options());
+    const scene::Scene s = tr->scene.load();
+    renderer::VulkanContext context(tr->gpu.context());
+    const renderer::ProbeGrid g = tr->grid.resolve(s);
+    renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
     fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe\n", s.name, s.triangleCount(),
-               context.deviceName(), g.dims.x, g.dims.y, g.dims.z, tracer->spp);
+               context.deviceName(), g.dims.x, g.dims.y, g.dims.z, tr->tracer.spp);
     uint32_t active = 0;
     for (uint32_t p = 0; p < g.count(); ++p) active += updater.activeMask()[p];
     fmt::print("bake: {} of {} probes active ({} inside geometry)\n", active, g.count(), g.count() - active);
@@ -44,7 +38,7 @@ void addBakeCommand(CLI::App& app, int& exitCode) {
       volume.boundsMax[a] = g.max[a];
     }
     volume.updates = *updates;
-    volume.samplesPerProbe = tracer->spp;
+    volume.samplesPerProbe = tr->tracer.spp;
     volume.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
     volume.active.assign(updater.activeMask(), updater.activeMask() + g.count());
     std::string error;

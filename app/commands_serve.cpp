@@ -46,10 +46,7 @@ Representation parseRepr(const std::string& name) {
 
 void addServeCommands(CLI::App& app, int& exitCode) {
   CLI::App* serve = app.add_subcommand("serve", "stream probes over gRPC (live from the updater or a probe file)");
-  auto scene = std::make_shared<SceneOptions>();
-  auto gpu = std::make_shared<GpuOptions>();
-  auto grid = std::make_shared<GridOptions>();
-  auto tracer = std::make_shared<TracerOptions>();
+  auto tr = std::make_shared<TracingOptions>();
   struct Options {
     std::string probes, repr = "zh3", listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
     bool plaintext = false;
@@ -57,10 +54,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     double hz = 10.0, seconds = 0.0, animate = 0.05;
   };
   auto o = std::make_shared<Options>();
-  scene->add(serve);
-  gpu->add(serve);
-  grid->add(serve);
-  tracer->add(serve);
+  tr->add(serve);
   serve->add_option("--probes", o->probes, "serve a baked probe volume file instead of tracing live");
   serve->add_option("--repr", o->repr, "l1, zh3h, zh3, l2 or fp16");
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
@@ -106,15 +100,15 @@ void addServeCommands(CLI::App& app, int& exitCode) {
         hc.bounds.max[a] = volume.boundsMax[a];
       }
     } else {
-      s = scene->load();
-      const renderer::ProbeGrid g = grid->resolve(s);
+      s = tr->scene.load();
+      const renderer::ProbeGrid g = tr->grid.resolve(s);
       for (int a = 0; a < 3; ++a) {
         hc.layout.grid[a] = static_cast<uint16_t>(g.dims[a]);
         hc.bounds.min[a] = g.min[a];
         hc.bounds.max[a] = g.max[a];
       }
-      context = std::make_unique<renderer::VulkanContext>(gpu->context());
-      updater = std::make_unique<renderer::ProbeUpdater>(*context, s, g, tracer->options());
+      context = std::make_unique<renderer::VulkanContext>(tr->gpu.context());
+      updater = std::make_unique<renderer::ProbeUpdater>(*context, s, g, tr->tracer.options());
     }
     if (!isValidLayout(hc.layout)) throw std::runtime_error("grid too large for the stream format");
     service::ProbeHub hub(hc);
@@ -130,7 +124,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     const auto start = std::chrono::steady_clock::now();
     const auto period = std::chrono::duration<double>(1.0 / o->hz);
     auto next = start;
-    float t = scene->t;
+    float t = tr->scene.t;
     uint32_t frames = 0;
     auto lastReport = start;
     while (!gInterrupted) {
@@ -141,7 +135,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
           t = std::fmod(t + static_cast<float>(o->animate / o->hz), 1.0f);
           scene::Scene moved;
           std::string error;
-          if (scene::loadScene(scene->scene, t, moved, error)) updater->setScene(moved);
+          if (scene::loadScene(tr->scene.scene, t, moved, error)) updater->setScene(moved);
         }
         updater->update();
         hub.publish(updater->probes(), updater->activeMask());

@@ -38,10 +38,7 @@ std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views) {
 
 void addViewCommand(CLI::App& app, int& exitCode) {
   CLI::App* cmd = app.add_subcommand("view", "render views (mono, stereo, lf:NxM quilt) lit by probes");
-  auto scene = std::make_shared<SceneOptions>();
-  auto gpu = std::make_shared<GpuOptions>();
-  auto grid = std::make_shared<GridOptions>();
-  auto tracer = std::make_shared<TracerOptions>();
+  auto tr = std::make_shared<TracingOptions>();
   struct Options {
     std::string probes = "live", views = "lf:5x5", out = "out/view", connect, token, tlsCa, tlsName;
     std::string repr = "float", passes = "per-view", toneMap = "filmic";
@@ -53,10 +50,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
     bool exr = false;
   };
   auto o = std::make_shared<Options>();
-  scene->add(cmd);
-  gpu->add(cmd);
-  grid->add(cmd);
-  tracer->add(cmd);
+  tr->add(cmd);
   cmd->add_option("--probes", o->probes, "probe volume file, or 'live' to trace it now");
   cmd->add_option("--updates", o->updates, "live: updates to accumulate")->check(CLI::Range(1, 100000));
   cmd->add_option("--connect", o->connect, "take the probes from a probecast server (host:port) instead");
@@ -80,10 +74,10 @@ void addViewCommand(CLI::App& app, int& exitCode) {
     renderer::ViewSetSpec spec;
     std::string error;
     if (!renderer::parseViewSet(o->views, spec, error)) throw std::runtime_error(error);
-    const scene::Scene s = scene->load();
+    const scene::Scene s = tr->scene.load();
     const std::vector<renderer::ViewInfo> viewSet =
         renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, viewSetOptions(s, o->size[0], o->size[1]));
-    renderer::VulkanContext context(gpu->context());
+    renderer::VulkanContext context(tr->gpu.context());
     renderer::ProbeVolumeData volume;
     if (!o->connect.empty()) {
       service::ClientConfig cc;
@@ -119,8 +113,8 @@ void addViewCommand(CLI::App& app, int& exitCode) {
       fmt::print("view: {} frames ({} bytes) from {}\n", client.stats().framesApplied, client.stats().bytesReceived,
                  o->connect);
     } else if (o->probes == "live") {
-      const renderer::ProbeGrid g = grid->resolve(s);
-      renderer::ProbeUpdater updater(context, s, g, tracer->options());
+      const renderer::ProbeGrid g = tr->grid.resolve(s);
+      renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
       for (uint32_t u = 0; u < o->updates; ++u) {
         updater.update();
         fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);

@@ -7,6 +7,8 @@
 #include "probecast/renderer/glossy_sh.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/raster_client.h"
+#include "probecast/renderer/view_sets.h"
+#include "vulkan_test_support.h"
 
 namespace probecast::renderer {
 namespace {
@@ -16,9 +18,7 @@ TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
   // reflects albedo/π · E = L; the glossy split sum adds L · (F0·A + B) (the prefiltered constant
   // radiance is L whatever the lobe), F0 = 0.04, (A, B) from the environment-BRDF table at
   // roughness 1 and n·v ≈ 1 (its last texel; the sampler clamps there). No lights, no emission.
-  ContextOptions co;
-  co.validation = true;
-  VulkanContext context(co);
+  VulkanContext context(test::validatedContext());
   scene::Scene s;
   scene::Material white;
   white.baseColor = glm::vec3(1.0f);
@@ -70,12 +70,8 @@ TEST(RasterClient, InactiveProbesAreFilledFromActiveNeighbours) {
 }
 
 TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
-  ContextOptions co;
-  co.validation = true;
-  VulkanContext context(co);
-  scene::Scene s;
-  std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
   ProbeGrid g;
   g.dims = {4, 4, 4};
   g.min = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
@@ -100,21 +96,10 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
-}  // namespace
-}  // namespace probecast::renderer
-
-#include "probecast/renderer/view_sets.h"
-
-namespace probecast::renderer {
-namespace {
-
 TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
-  ContextOptions co;
-  co.validation = true;
-  VulkanContext context(co);
-  scene::Scene s;
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
   std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
   RasterRenderer raster(context, s, 20, 16);
   ViewSetSpec spec;
   ASSERT_TRUE(parseViewSet("lf:3x2", spec, error));
@@ -150,12 +135,8 @@ TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
 }
 
 TEST(RasterClient, BadProbeVolumesAreRefusedAndTheLastGoodOneKept) {
-  ContextOptions co;
-  co.validation = true;
-  VulkanContext context(co);
-  scene::Scene s;
-  std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
   RasterRenderer raster(context, s, 24, 16);
   ProbeVolumeData good;
   good.dims = {2, 2, 2};

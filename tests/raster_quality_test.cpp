@@ -9,6 +9,7 @@
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
+#include "vulkan_test_support.h"
 
 namespace probecast::renderer {
 namespace {
@@ -19,12 +20,6 @@ namespace {
 // 0.02 for driver and reference-noise differences, and stay far above the no-probe render.
 constexpr double FLOOR_PSNR = 23.5;
 constexpr double FLOOR_SSIM = 0.92;
-
-ContextOptions validated() {
-  ContextOptions co;
-  co.validation = true;
-  return co;
-}
 
 double rmse(const Image& a, const Image& b) {
   double sum = 0.0;
@@ -51,7 +46,7 @@ TEST(RasterQuality, ShadowMapDarkensExactlyTheOccludedFloor) {
   // A white floor lit by a point light 2 m above it (no probes, no ambient); a 0.6 m square
   // occluder 1 m up. Unshadowed, the floor right below the light reflects
   // albedo/π · I/d² = 1/π · 4/4; in the occluder's shadow it is black.
-  VulkanContext context(validated());
+  VulkanContext context(test::validatedContext());
   scene::Scene s;
   scene::Material white;
   white.baseColor = glm::vec3(1.0f);
@@ -88,10 +83,8 @@ TEST(RasterQuality, ShadowMapDarkensExactlyTheOccludedFloor) {
 }
 
 TEST(RasterQuality, L2AndStoredZh3AreCloserToTheFloatRenderThanL1) {
-  VulkanContext context(validated());
-  scene::Scene s;
-  std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
   const ProbeVolumeData volume = tracedVolume(context, s, {4, 4, 4}, 2);
   RasterRenderer raster(context, s, 64, 48);
   const CameraView cam = CameraView::fromScene(s);
@@ -118,10 +111,9 @@ TEST(RasterQuality, L2AndStoredZh3AreCloserToTheFloatRenderThanL1) {
 }
 
 TEST(RasterQuality, MultiviewChunksMatchOnePassPerView) {
-  VulkanContext context(validated());
-  scene::Scene s;
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.25f);
   std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.25f, s, error));
   const ProbeVolumeData volume = tracedVolume(context, s, {4, 4, 4}, 1);
   RasterOptions perView, multi;
   perView.passes = ViewPasses::PerView;
@@ -149,10 +141,9 @@ TEST(RasterQuality, OffAxisViewsMatchTheReferenceOfTheSameShearedCamera) {
   // shifts); without the shift it looks elsewhere. (With the default 35° cone the top row sits
   // above the ceiling, outside the box, where interior probes light the ceiling's outer face:
   // a leak the demo report shows.)
-  VulkanContext context(validated());
-  scene::Scene s;
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
   std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
   const ProbeVolumeData volume = tracedVolume(context, s, {4, 4, 4}, 2);
   RasterRenderer raster(context, s, 64, 40);
   raster.setProbes(volume);
@@ -182,10 +173,8 @@ TEST(RasterQuality, OffAxisViewsMatchTheReferenceOfTheSameShearedCamera) {
 }
 
 TEST(RasterQuality, CornellAgainstTheReferenceAboveTheRecordedFloor) {
-  VulkanContext context(validated());
-  scene::Scene s;
-  std::string error;
-  ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
   const ProbeVolumeData volume = tracedVolume(context, s, {8, 8, 8}, 4);
   const CameraView cam = CameraView::fromScene(s);
   RasterRenderer raster(context, s, 80, 50);

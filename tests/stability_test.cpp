@@ -5,18 +5,13 @@
 #include <cstdio>
 
 #include "stability.h"
+#include "vulkan_test_support.h"
 
 namespace probecast::bench {
 namespace {
 
-renderer::ContextOptions validated() {
-  renderer::ContextOptions co;
-  co.validation = true;
-  return co;
-}
-
 TEST(Stability, SmallerWMinFlickersLessAndRecoversSlower) {
-  renderer::VulkanContext context(validated());
+  renderer::VulkanContext context(test::validatedContext());
   const auto r = measureFlickerLag(context, {0.02f, 0.25f}, 32, 32);
   ASSERT_EQ(r.size(), 2u);
   for (const FlickerLag& f : r)
@@ -62,7 +57,7 @@ TEST(Stability, RingingUnderASmallLightIsNegativeAndClampingReducesTheError) {
 }
 
 TEST(Stability, ProbesInsideAThinWallDoNotDarkenTheLitRoom) {
-  renderer::VulkanContext context(validated());
+  renderer::VulkanContext context(test::validatedContext());
   const WallLeak r = measureWallLeak(context);
   std::printf("thin wall: %u/%u probes inactive; mean radiance error %.1f%% classified, %.1f%% not\n",
               r.inactiveProbes, r.probes, 100 * r.meanErrorRelClassified, 100 * r.meanErrorRelUnclassified);
@@ -105,7 +100,7 @@ TEST(Stability, ExtremeInputsDecodeFiniteWithBoundedError) {
 }
 
 TEST(Stability, StaticLightingCostsNoBytesAndMostProbesNeedLessThanL2AtTenPercent) {
-  renderer::VulkanContext context(validated());
+  renderer::VulkanContext context(test::validatedContext());
   const SceneNeeds r = measureSceneNeeds(context, 0.10);
   std::printf("at 10%%: l1 %u, zh3 %u, l2 %u, more %u of %u; static frame %.0f bytes, first %.0f\n", r.needL1,
               r.needZh3, r.needL2, r.needMore, r.probes, r.staticFrameBytes, r.firstFrameBytes);

@@ -328,14 +328,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   lci.bindingCount = RS_BINDING_COUNT;
   lci.pBindings = bindings;
   VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &s.setLayout));
-  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                            sizeof(shaders::RsPushConstants)};
-  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pli.setLayoutCount = 1;
-  pli.pSetLayouts = &s.setLayout;
-  pli.pushConstantRangeCount = 1;
-  pli.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &s.layout));
+  s.layout = createPipelineLayout(d, s.setLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                                  sizeof(shaders::RsPushConstants));
   s.pipelineFor(0);
   createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, s.shadows);
 

@@ -15,11 +15,7 @@ namespace probecast::renderer {
 void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, ShadowMaps& out) {
   out.size = size;
   out.maxLayers = maxLayers;
-  const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(glm::mat4)};
-  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pli.pushConstantRangeCount = 1;
-  pli.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &out.layout));
+  out.layout = createPipelineLayout(d, VK_NULL_HANDLE, VK_SHADER_STAGE_VERTEX_BIT, sizeof(glm::mat4));
   GraphicsPipelineDesc desc;
   desc.vertexCode = kShadowVert;
   desc.vertexBytes = sizeof kShadowVert;

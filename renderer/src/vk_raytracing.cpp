@@ -32,13 +32,7 @@ void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygen
   lci.pBindings = bindings.data();
   VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &pass.setLayout));
 
-  VkPushConstantRange range{VK_SHADER_STAGE_RAYGEN_BIT_KHR, 0, pushBytes};
-  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pli.setLayoutCount = 1;
-  pli.pSetLayouts = &pass.setLayout;
-  pli.pushConstantRangeCount = 1;
-  pli.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &pass.layout));
+  pass.layout = createPipelineLayout(d, pass.setLayout, VK_SHADER_STAGE_RAYGEN_BIT_KHR, pushBytes);
 
   const VkShaderModule modules[4] = {
       createShaderModule(d, raygen, raygenBytes),

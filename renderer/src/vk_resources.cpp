@@ -137,6 +137,19 @@ void transitionImage(VkCommandBuffer cmd, const GpuImage& img, VkImageLayout fro
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+VkPipelineLayout createPipelineLayout(VulkanDevice& d, VkDescriptorSetLayout setLayout, VkShaderStageFlags pushStages,
+                                      uint32_t pushBytes) {
+  const VkPushConstantRange range{pushStages, 0, pushBytes};
+  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pli.setLayoutCount = setLayout ? 1 : 0;
+  pli.pSetLayouts = &setLayout;
+  pli.pushConstantRangeCount = 1;
+  pli.pPushConstantRanges = &range;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VK_CHECK(vkCreatePipelineLayout(d.device, &pli, nullptr, &layout));
+  return layout;
+}
+
 void createSingleDescriptorSet(VulkanDevice& d, VkDescriptorSetLayout layout, const VkDescriptorPoolSize* sizes,
                                uint32_t sizeCount, VkDescriptorPool& pool, VkDescriptorSet& set) {
   VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};

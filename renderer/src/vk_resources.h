@@ -42,6 +42,10 @@ void destroyImage(VulkanDevice& d, GpuImage& image);
 // A whole-image layout transition (synchronisation2, all commands): simple and correct, not fast.
 void transitionImage(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to);
 
+// A pipeline layout of at most one descriptor set (null: none) and one push-constant range.
+VkPipelineLayout createPipelineLayout(VulkanDevice& d, VkDescriptorSetLayout setLayout, VkShaderStageFlags pushStages,
+                                      uint32_t pushBytes);
+
 // A pool sized for exactly one set of `layout`, and that set.
 void createSingleDescriptorSet(VulkanDevice& d, VkDescriptorSetLayout layout, const VkDescriptorPoolSize* sizes,
                                uint32_t sizeCount, VkDescriptorPool& pool, VkDescriptorSet& set);
