@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -396,7 +397,7 @@ ExtremeInputs measureExtremeInputs() {
   return r;
 }
 
-SceneNeeds measureSceneNeeds(renderer::VulkanContext& context, double maxError) {
+std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, const std::vector<double>& maxErrors) {
   const scene::Scene s = builtin("cornell", 0.0f);
   const renderer::ProbeGrid grid = cellCentred(s, {8, 8, 8});
   renderer::UpdaterOptions o;
@@ -404,30 +405,22 @@ SceneNeeds measureSceneNeeds(renderer::VulkanContext& context, double maxError) 
   renderer::ProbeUpdater u(context, s, grid, o);
   for (int k = 0; k < 4; ++k) u.update();
   const renderer::ProbeVolumeData v = renderer::volumeFromUpdater(u);
-  SceneNeeds r;
-  r.maxError = maxError;
+  // Per active probe, the irradiance error of its l1, zh3 and l2 records.
+  constexpr Representation kTried[3] = {Representation::L1, Representation::Zh3, Representation::L2};
+  std::vector<std::array<double, 3>> errors;
   uint8_t record[kMaxRecordBytes];
   float decoded[kProbeFloats];
   for (uint32_t p = 0; p < grid.count(); ++p) {
     if (!v.active[p]) continue;
-    ++r.probes;
     const float* probe = &v.probes[static_cast<size_t>(p) * kProbeFloats];
-    Representation chosen = Representation::Fp16;
-    for (Representation repr : {Representation::L1, Representation::Zh3, Representation::L2}) {
-      encodeProbeRecord(repr, probe, record);
-      decodeProbeRecord(repr, record, decoded);
-      if (irradianceRmseRel(decoded, probe, nullptr, 1) <= maxError) {
-        chosen = repr;
-        break;
-      }
+    std::array<double, 3>& e = errors.emplace_back();
+    for (int k = 0; k < 3; ++k) {
+      encodeProbeRecord(kTried[k], probe, record);
+      decodeProbeRecord(kTried[k], record, decoded);
+      e[static_cast<size_t>(k)] = irradianceRmseRel(decoded, probe, nullptr, 1);
     }
-    r.needL1 += chosen == Representation::L1;
-    r.needZh3 += chosen == Representation::Zh3;
-    r.needL2 += chosen == Representation::L2;
-    r.needMore += chosen == Representation::Fp16;
-    r.bytesSmallest += static_cast<double>(recordSize(chosen));
-    r.bytesAllL2 += static_cast<double>(recordSize(Representation::L2));
   }
+  SceneNeeds r;
   StreamLayout layout;
   for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(grid.dims[a]);
   layout.repr = Representation::L2;
@@ -460,7 +453,26 @@ SceneNeeds measureSceneNeeds(renderer::VulkanContext& context, double maxError) 
     }
     (moving ? r.liveMovingBytesPerProbe : r.liveStillBytesPerProbe) = bytes / frames / grid.count();
   }
-  return r;
+  // The smallest record under each error bound.
+  std::vector<SceneNeeds> out;
+  for (double maxError : maxErrors) {
+    SceneNeeds n = r;
+    n.maxError = maxError;
+    n.probes = static_cast<uint32_t>(errors.size());
+    for (const std::array<double, 3>& e : errors) {
+      const auto k =
+          static_cast<size_t>(std::find_if(e.begin(), e.end(), [&](double x) { return x <= maxError; }) - e.begin());
+      const Representation chosen = k < 3 ? kTried[k] : Representation::Fp16;
+      n.needL1 += chosen == Representation::L1;
+      n.needZh3 += chosen == Representation::Zh3;
+      n.needL2 += chosen == Representation::L2;
+      n.needMore += chosen == Representation::Fp16;
+      n.bytesSmallest += static_cast<double>(recordSize(chosen));
+      n.bytesAllL2 += static_cast<double>(recordSize(Representation::L2));
+    }
+    out.push_back(n);
+  }
+  return out;
 }
 
 StabilityResult runStabilitySuite(const StabilityOptions& o) {
@@ -545,7 +557,8 @@ StabilityResult runStabilitySuite(const StabilityOptions& o) {
                          {"slow_link_budget", nf.slowLinkBudget},
                          {"slow_link_seconds_to_bit_exact", nf.slowLinkSecondsToBitExact},
                          {"fast_seconds_to_bit_exact", nf.fastSecondsToBitExact},
-                         {"latency_ms_p50", nf.latencyP50Ms}, {"latency_ms_p99", nf.latencyP99Ms},
+                         {"latency_ms_p50", nf.latencyP50Ms},
+                         {"latency_ms_p99", nf.latencyP99Ms},
                          {"slow_link_latency_ms_p50", nf.slowLinkLatencyP50Ms}};
   md += fmt::format(
       "\n### Network faults (loopback gRPC, 32×8×32 probes, zh3)\n\n"
@@ -577,8 +590,8 @@ StabilityResult runStabilitySuite(const StabilityOptions& o) {
       ex.blackMaxAbs, ex.nanDecodedMaxAbs, ex.allFinite ? "yes" : "no", bright);
 
   say("stability: what the scene needs");
-  for (double maxError : {0.05, 0.10}) {
-    const SceneNeeds sn = measureSceneNeeds(context, maxError);
+  for (const SceneNeeds& sn : measureSceneNeeds(context, {0.05, 0.10})) {
+    const double maxError = sn.maxError;
     j["scene_needs"].push_back({{"max_error", sn.maxError},
                                 {"probes", sn.probes},
                                 {"need_l1", sn.needL1},

@@ -97,7 +97,8 @@ struct SceneNeeds {
   // headers included: the light still (the updater keeps refining: Monte Carlo noise) and moving.
   double liveStillBytesPerProbe = 0, liveMovingBytesPerProbe = 0;
 };
-SceneNeeds measureSceneNeeds(renderer::VulkanContext& context, double maxError);
+// One entry per error bound, all from one traced volume.
+std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, const std::vector<double>& maxErrors);
 
 struct StabilityOptions {
   std::string command;

@@ -101,7 +101,7 @@ TEST(Stability, ExtremeInputsDecodeFiniteWithBoundedError) {
 
 TEST(Stability, StaticLightingCostsNoBytesAndMostProbesNeedLessThanL2AtTenPercent) {
   renderer::VulkanContext context(test::validatedContext());
-  const SceneNeeds r = measureSceneNeeds(context, 0.10);
+  const SceneNeeds r = measureSceneNeeds(context, {0.10}).front();
   std::printf("at 10%%: l1 %u, zh3 %u, l2 %u, more %u of %u; static frame %.0f bytes, first %.0f\n", r.needL1,
               r.needZh3, r.needL2, r.needMore, r.probes, r.staticFrameBytes, r.firstFrameBytes);
   EXPECT_EQ(r.needL1 + r.needZh3 + r.needL2 + r.needMore, r.probes);
