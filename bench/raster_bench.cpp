@@ -135,6 +135,36 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
     say(fmt::format("raster bench: {} done", name));
   }
   table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
+
+  // What one volume update costs the client (validate, fill inactive probes, upload), for the
+  // volume sizes of the demo and of a large hall; one probe in eight inactive.
+  table += fmt::format("\n{:<10} {:>8} {:>16}\n", "volume", "probes", "ms per update");
+  for (const auto& dims : o.uploadGrids) {
+    renderer::ProbeVolumeData v;
+    v.dims = dims;
+    v.min = o.scene.boundsMin;
+    v.max = o.scene.boundsMax;
+    const size_t n = static_cast<size_t>(dims.x) * dims.y * dims.z;
+    const size_t f = kProbeFloats;
+    v.probes.resize(n * f);
+    v.active.resize(n);
+    for (size_t p = 0; p < n; ++p) {
+      v.active[p] = p % 8 != 3;
+      for (size_t c = 0; c < f; ++c)
+        v.probes[p * f + c] = (c % 9 == 0 ? 1.0f : 0.1f) * static_cast<float>((p * 31 + c * 7) % 17) / 17.0f;
+    }
+    raster.setProbes(v);  // warm-up (first allocation)
+    std::vector<double> ms;
+    for (uint32_t k = 0; k < 4 * o.repeats; ++k) {
+      v.probes[(k % n) * f] += 0.01f;  // a new volume each time
+      const auto t0 = Clock::now();
+      raster.setProbes(v);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    }
+    const std::string name = fmt::format("{}x{}x{}", dims.x, dims.y, dims.z);
+    json["volume_upload"].push_back({{"grid", {dims.x, dims.y, dims.z}}, {"probes", n}, {"ms_median", median(ms)}});
+    table += fmt::format("{:<10} {:>8} {:>16.3f}\n", name, n, median(ms));
+  }
   json["validation_messages"] = context.validationMessages();
 
   ChartSpec spec;

@@ -24,6 +24,8 @@ struct RasterBenchOptions {
   uint32_t width = 320, height = 200;
   std::vector<std::string> viewSets = {"mono", "stereo", "lf:2x2", "lf:4x4", "lf:5x5", "lf:8x6"};
   uint32_t repeats = 5;            // timed renders per case (the median is reported)
+  // Probe volumes whose update (setProbes) is timed, 4 × repeats times each.
+  std::vector<glm::uvec3> uploadGrids = {{8, 8, 8}, {32, 8, 32}};
   uint32_t referenceSpp = 256;
   std::string command;
   std::function<void(const std::string&)> progress;
