@@ -19,30 +19,20 @@ void addBakeCommand(CLI::App& app, int& exitCode) {
   bake->callback([=, &exitCode] {
     const scene::Scene s = tr->scene.load();
     renderer::VulkanContext context(tr->gpu.context());
-    const renderer::ProbeGrid g = tr->grid.resolve(s);
+    const ProbeGrid g = tr->grid.resolve(s);
     renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
     fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe\n", s.name, s.triangleCount(),
-               context.deviceName(), g.dims.x, g.dims.y, g.dims.z, tr->tracer.spp);
+               context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp);
     uint32_t active = 0;
-    for (uint32_t p = 0; p < g.count(); ++p) active += updater.activeMask()[p];
+    for (uint8_t a : updater.volume().active) active += a;
     fmt::print("bake: {} of {} probes active ({} inside geometry)\n", active, g.count(), g.count() - active);
     for (uint32_t u = 0; u < *updates; ++u) {
       const renderer::UpdateStats st = updater.update();
       fmt::print("bake: update {}/{}: {:.1f} ms, {} paths, {:.2f} M rays/s\n", u + 1, *updates, st.milliseconds, st.paths,
                  static_cast<double>(st.closestHitRays + st.shadowRays) / st.milliseconds / 1e3);
     }
-    ProbeVolume volume;
-    for (int a = 0; a < 3; ++a) {
-      volume.dims[a] = g.dims[a];
-      volume.boundsMin[a] = g.min[a];
-      volume.boundsMax[a] = g.max[a];
-    }
-    volume.updates = *updates;
-    volume.samplesPerProbe = tr->tracer.spp;
-    volume.probes.assign(updater.probes(), updater.probes() + g.count() * 27);
-    volume.active.assign(updater.activeMask(), updater.activeMask() + g.count());
     std::string error;
-    if (!writeProbeFile(*out, volume, error)) throw std::runtime_error(error);
+    if (!writeProbeFile(*out, updater.volume(), error)) throw std::runtime_error(error);
     if (context.validationMessages() > 0)
       fmt::print(stderr, "bake: {} Vulkan validation messages\n", context.validationMessages());
     fmt::print("wrote {}\n", *out);

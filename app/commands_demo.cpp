@@ -79,17 +79,6 @@ scene::Scene sceneAt(const std::string& spec, float t) {
   return s;
 }
 
-renderer::ProbeVolumeData volumeOf(const service::VolumeSnapshot& snap) {
-  renderer::ProbeVolumeData v;
-  v.dims = {snap.layout.grid[0], snap.layout.grid[1], snap.layout.grid[2]};
-  v.min = {snap.bounds.min[0], snap.bounds.min[1], snap.bounds.min[2]};
-  v.max = {snap.bounds.max[0], snap.bounds.max[1], snap.bounds.max[2]};
-  v.probes = snap.probes;
-  v.active = snap.active;
-  v.hallucinateZh3 = snap.l1Only;
-  return v;
-}
-
 void writePng(const std::string& path, const renderer::Image& img) {
   std::string error;
   if (!bench::writePngPreview(path, img.rgb, static_cast<int>(img.width), static_cast<int>(img.height), 1.0f, error))
@@ -110,7 +99,7 @@ std::string progressBar(double fraction) {
 // The pipeline benchmark (small) and the stability suite, written next to the report; returns
 // their report sections.
 std::string runSuites(const DemoOptions& o, const std::string& dir, const scene::Scene& finalScene, float finalT,
-                      const renderer::ProbeGrid& grid, nlohmann::json& phases) {
+                      const ProbeGrid& grid, nlohmann::json& phases) {
   const auto status = [](const std::string& s) { fmt::print(stderr, "\rdemo: {:<90}", s.substr(0, 90)); };
   auto phaseStart = Clock::now();
   bench::PipelineBenchOptions po;
@@ -239,20 +228,13 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     const bool animated = o->scene.rfind("builtin:", 0) == 0;  // built-in scenes move their light with t
     GridOptions gridOptions;
     gridOptions.dims = o->grid;
-    const renderer::ProbeGrid grid = gridOptions.resolve(scene0);
+    const ProbeGrid grid = gridOptions.resolve(scene0);
     renderer::VulkanContext serverContext{renderer::ContextOptions{}};
     renderer::UpdaterOptions uo;
     uo.samplesPerProbe = o->spp;
     renderer::ProbeUpdater updater(serverContext, scene0, grid, uo);
-    service::HubConfig hc;
-    hc.layout.repr = *parseRepresentation(o->repr);
-    hc.layout.brickDim = 4;
+    service::HubConfig hc = service::hubConfigFor(grid, *parseRepresentation(o->repr), 4);
     hc.encoder.deadzone = 1;
-    for (int a = 0; a < 3; ++a) {
-      hc.layout.grid[a] = static_cast<uint16_t>(grid.dims[a]);
-      hc.bounds.min[a] = grid.min[a];
-      hc.bounds.max[a] = grid.max[a];
-    }
     service::ProbeHub hub(hc);
     service::ServerConfig sc;
     sc.plaintext = true;  // loopback only
@@ -261,7 +243,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     service::ProbeServer server(sc, hub);
     fmt::print(
         "demo: server on 127.0.0.1:{} lighting {} ({}x{}x{} probes, {} spp/update, {}), light moving for {:.0f} s\n",
-        server.port(), scene0.name, grid.dims.x, grid.dims.y, grid.dims.z, o->spp, o->repr, o->seconds);
+        server.port(), scene0.name, grid.dims[0], grid.dims[1], grid.dims[2], o->spp, o->repr, o->seconds);
 
     // Animation: t follows wall time while streaming, then freezes for the comparison.
     const auto animStart = Clock::now();
@@ -280,7 +262,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
           const bool wasFrozen = frozen;
           if (animated) updater.setScene(sceneAt(o->scene, tNow()));
           const renderer::UpdateStats st = updater.update();
-          hub.publish(updater.probes(), updater.activeMask());
+          hub.publish(updater.volume());
           ++updates;
           if (wasFrozen) ++settled;
           std::lock_guard<std::mutex> lock(updateMsMutex);
@@ -314,7 +296,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       cc.token = sc.token;
       cc.name = v.name;
       cc.budgetBytesPerSecond = v.budget;
-      cc.interpolateThenHallucinate = true;
+      cc.zh3PerPixel = true;
       v.client = std::make_unique<service::ProbeClient>(cc);
       v.client->setViews(priorityViews(v.views));
       v.client->start();
@@ -327,7 +309,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       if (!v.client->snapshot(snap)) return false;
       v.framesSeen = snap.framesApplied;
       if (animated) v.raster->setShading(sceneAt(o->scene, tNow()));  // direct light is local: the light now
-      v.raster->setProbes(volumeOf(snap));
+      v.raster->setProbes(snap.volume);
       v.images = v.raster->renderViews(v.views);
       v.renderMsPerView.push_back(v.raster->timings().viewsMs / static_cast<double>(v.views.size()));
       ++v.renders;
@@ -394,9 +376,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     fmt::print(stderr, "\n");
     phases["settling"] = secondsSince(phaseStart);
     phaseStart = Clock::now();
-    std::vector<float> serverProbes;
-    std::vector<uint8_t> serverActive;
-    hub.reconstruction(serverProbes, serverActive);
+    const ProbeVolume serverVolume = hub.reconstruction();
     std::vector<bool> converged(viewers.size(), false);
     const auto waitStart = Clock::now();
     while (secondsSince(waitStart) < 30.0 &&
@@ -404,10 +384,11 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       for (size_t k = 0; k < viewers.size(); ++k) {
         service::VolumeSnapshot snap;
         if (!viewers[k].client->snapshot(snap)) continue;
-        converged[k] = snap.active == serverActive && snap.probes.size() == serverProbes.size();
+        const ProbeVolume& held = snap.volume;
+        converged[k] = held.active == serverVolume.active && held.probes.size() == serverVolume.probes.size();
         // A zh3h viewer holds L1 only (it hallucinates per pixel): compare the 12 floats it holds.
-        for (size_t i = 0; converged[k] && i < snap.probes.size(); ++i)
-          converged[k] = (snap.l1Only && i % kProbeFloats >= 12) || snap.probes[i] == serverProbes[i];
+        for (size_t i = 0; converged[k] && i < held.probes.size(); ++i)
+          converged[k] = (held.zh3PerPixel && i % kProbeFloats >= 12) || held.probes[i] == serverVolume.probes[i];
         if (!converged[k]) std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
     }
@@ -419,7 +400,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     nlohmann::json report;
     report["command"] = commandLine();
     report["scene"] = scene0.name;
-    report["grid"] = {grid.dims.x, grid.dims.y, grid.dims.z};
+    report["grid"] = {grid.dims[0], grid.dims[1], grid.dims[2]};
     report["representation"] = o->repr;
     report["spp_per_update"] = o->spp;
     report["stream_seconds"] = streamSeconds;

@@ -88,28 +88,23 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     hc.layout.repr = parseRepr(o->repr);
     hc.encoder.deadzone = o->deadzone;
     ProbeVolume volume;
+    ProbeGrid grid;
     std::unique_ptr<renderer::VulkanContext> context;
     std::unique_ptr<renderer::ProbeUpdater> updater;
     scene::Scene s;
     if (!o->probes.empty()) {
       std::string error;
       if (!readProbeFile(o->probes, volume, error)) throw std::runtime_error(error);
-      for (int a = 0; a < 3; ++a) {
-        hc.layout.grid[a] = static_cast<uint16_t>(volume.dims[a]);
-        hc.bounds.min[a] = volume.boundsMin[a];
-        hc.bounds.max[a] = volume.boundsMax[a];
-      }
+      grid = volume.grid;
     } else {
       s = tr->scene.load();
-      const renderer::ProbeGrid g = tr->grid.resolve(s);
-      for (int a = 0; a < 3; ++a) {
-        hc.layout.grid[a] = static_cast<uint16_t>(g.dims[a]);
-        hc.bounds.min[a] = g.min[a];
-        hc.bounds.max[a] = g.max[a];
-      }
+      grid = tr->grid.resolve(s);
       context = std::make_unique<renderer::VulkanContext>(tr->gpu.context());
-      updater = std::make_unique<renderer::ProbeUpdater>(*context, s, g, tr->tracer.options());
+      updater = std::make_unique<renderer::ProbeUpdater>(*context, s, grid, tr->tracer.options());
     }
+    const service::HubConfig base = service::hubConfigFor(grid, hc.layout.repr, hc.layout.brickDim);
+    hc.layout = base.layout;
+    hc.bounds = base.bounds;
     if (!isValidLayout(hc.layout)) throw std::runtime_error("grid too large for the stream format");
     service::ProbeHub hub(hc);
     service::ProbeServer server(sc, hub);
@@ -120,7 +115,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     std::fflush(stdout);
     std::signal(SIGINT, [](int) { gInterrupted = true; });
     std::signal(SIGTERM, [](int) { gInterrupted = true; });
-    if (!o->probes.empty()) hub.publish(volume.probes.data(), volume.active.data());
+    if (!o->probes.empty()) hub.publish(volume);
     const auto start = std::chrono::steady_clock::now();
     const auto period = std::chrono::duration<double>(1.0 / o->hz);
     auto next = start;
@@ -138,7 +133,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
           if (scene::loadScene(tr->scene.scene, t, moved, error)) updater->setScene(moved);
         }
         updater->update();
-        hub.publish(updater->probes(), updater->activeMask());
+        hub.publish(updater->volume());
         ++frames;
       } else {
         hub.tick();
@@ -198,16 +193,8 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     service::VolumeSnapshot snap;
     if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connect);
     if (!so->out.empty()) {
-      ProbeVolume v;
-      for (int a = 0; a < 3; ++a) {
-        v.dims[a] = snap.layout.grid[a];
-        v.boundsMin[a] = snap.bounds.min[a];
-        v.boundsMax[a] = snap.bounds.max[a];
-      }
-      v.probes = snap.probes;
-      v.active = snap.active;
       std::string error;
-      if (!writeProbeFile(so->out, v, error)) throw std::runtime_error(error);
+      if (!writeProbeFile(so->out, snap.volume, error)) throw std::runtime_error(error);
       fmt::print("wrote {}\n", so->out);
     }
     exitCode = 0;

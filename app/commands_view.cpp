@@ -78,7 +78,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
     const std::vector<renderer::ViewInfo> viewSet =
         renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, viewSetOptions(s, o->size[0], o->size[1]));
     renderer::VulkanContext context(tr->gpu.context());
-    renderer::ProbeVolumeData volume;
+    ProbeVolume volume;
     if (!o->connect.empty()) {
       service::ClientConfig cc;
       cc.address = o->connect;
@@ -92,7 +92,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
         cc.rootCertPem = ss.str();
         cc.tlsServerName = o->tlsName;
       }
-      cc.interpolateThenHallucinate = true;
+      cc.zh3PerPixel = true;
       service::ProbeClient client(cc);
       client.setViews(priorityViews(viewSet));
       client.start();
@@ -104,35 +104,24 @@ void addViewCommand(CLI::App& app, int& exitCode) {
       service::VolumeSnapshot snap;
       if (!client.snapshot(snap))
         throw std::runtime_error("no probe volume from " + o->connect + ": " + client.stats().lastError);
-      volume.dims = {snap.layout.grid[0], snap.layout.grid[1], snap.layout.grid[2]};
-      volume.min = {snap.bounds.min[0], snap.bounds.min[1], snap.bounds.min[2]};
-      volume.max = {snap.bounds.max[0], snap.bounds.max[1], snap.bounds.max[2]};
-      volume.probes = std::move(snap.probes);
-      volume.active = std::move(snap.active);
-      volume.hallucinateZh3 = snap.l1Only;
+      volume = std::move(snap.volume);
       fmt::print("view: {} frames ({} bytes) from {}\n", client.stats().framesApplied, client.stats().bytesReceived,
                  o->connect);
     } else if (o->probes == "live") {
-      const renderer::ProbeGrid g = tr->grid.resolve(s);
+      const ProbeGrid g = tr->grid.resolve(s);
       renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
       for (uint32_t u = 0; u < o->updates; ++u) {
         updater.update();
         fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);
       }
       fmt::print(stderr, "\n");
-      volume = renderer::volumeFromUpdater(updater);
+      volume = updater.volume();
     } else {
-      ProbeVolume file;
-      if (!readProbeFile(o->probes, file, error)) throw std::runtime_error(error);
-      volume.dims = {file.dims[0], file.dims[1], file.dims[2]};
-      volume.min = {file.boundsMin[0], file.boundsMin[1], file.boundsMin[2]};
-      volume.max = {file.boundsMax[0], file.boundsMax[1], file.boundsMax[2]};
-      volume.probes = std::move(file.probes);
-      volume.active = std::move(file.active);
+      if (!readProbeFile(o->probes, volume, error)) throw std::runtime_error(error);
     }
     if (o->repr != "float") {
       if (!o->connect.empty()) throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
-      volume = renderer::decodeAs(volume, *parseRepresentation(o->repr));
+      volume = decodeAs(volume, *parseRepresentation(o->repr));
     }
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;

@@ -52,22 +52,12 @@ struct GridOptions {
         ->delimiter(',')
         ->expected(6);
   }
-  renderer::ProbeGrid resolve(const scene::Scene& s) const {
-    renderer::ProbeGrid g;
-    g.dims = {dims[0], dims[1], dims[2]};
+  ProbeGrid resolve(const scene::Scene& s) const {
     if (static_cast<uint64_t>(dims[0]) * dims[1] * dims[2] > (1u << 24)) throw std::runtime_error("grid too large");
-    if (bounds.size() == 6) {
-      g.min = {bounds[0], bounds[1], bounds[2]};
-      g.max = {bounds[3], bounds[4], bounds[5]};
-      for (float b : bounds)
-        if (!std::isfinite(b)) throw std::runtime_error("--bounds must be finite");
-    } else {  // probes at the centres of the grid's cells over the scene bounds
-      const glm::vec3 extent = s.boundsMax - s.boundsMin;
-      const glm::vec3 cell = extent / glm::vec3(g.dims);
-      g.min = s.boundsMin + 0.5f * cell;
-      g.max = s.boundsMax - 0.5f * cell;
-    }
-    return g;
+    if (bounds.size() != 6) return renderer::sceneGrid(s, dims.data());
+    for (float b : bounds)
+      if (!std::isfinite(b)) throw std::runtime_error("--bounds must be finite");
+    return ProbeGrid{{dims[0], dims[1], dims[2]}, {{bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}}};
   }
 };
 

@@ -93,7 +93,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   say(fmt::format("pipeline bench: reference ({} spp)", o.referenceSpp));
   const renderer::Image reference = renderer::renderReference(context, finalScene, camera, ro);
   renderer::RasterRenderer raster(context, finalScene, o.width, o.height);
-  const auto score = [&](const renderer::ProbeVolumeData& v, Point& p) {
+  const auto score = [&](const ProbeVolume& v, Point& p) {
     raster.setProbes(v);
     const renderer::Image img = raster.render(raster.viewProjection(camera), camera.position);
     const ImageMetrics m =
@@ -108,12 +108,12 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   j["scene"] = finalScene.name;
   j["device"] = context.deviceName();
   j["size"] = {o.width, o.height};
-  j["grid"] = {o.grid.dims.x, o.grid.dims.y, o.grid.dims.z};
+  j["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
   j["reference_spp"] = o.referenceSpp;
   j["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
   std::string& table = r.table;
   table = fmt::format("pipeline bench: {} at {}x{}, {}x{}x{} probes, on {}\n", finalScene.name, o.width, o.height,
-                      o.grid.dims.x, o.grid.dims.y, o.grid.dims.z, context.deviceName());
+                      o.grid.dims[0], o.grid.dims[1], o.grid.dims[2], context.deviceName());
 
   // (b) Update cost: samples per probe × bounces, the light still at t.
   std::vector<Point> updatePoints;
@@ -126,7 +126,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
       std::vector<double> ms;
       for (uint32_t k = 0; k < o.updates; ++k) ms.push_back(u.update().milliseconds);
       Point p{fmt::format("{} spp, {} bounce{}", spp, b, b == 1 ? "" : "s"), median(ms)};
-      score(renderer::volumeFromUpdater(u), p);
+      score(u.volume(), p);
       updatePoints.push_back(p);
       say(fmt::format("pipeline bench: {}: {:.1f} ms/update, {:.2f} dB", p.label, p.cost, p.psnr));
     }
@@ -138,11 +138,11 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   good.samplesPerProbe = 128;
   renderer::ProbeUpdater converged(context, finalScene, o.grid, good);
   for (int k = 0; k < 8; ++k) converged.update();
-  const renderer::ProbeVolumeData volume = renderer::volumeFromUpdater(converged);
+  const ProbeVolume volume = converged.volume();
   std::vector<Point> reprPoints;
   for (Representation repr : kAllRepresentations) {
     Point p{representationName(repr), static_cast<double>(recordSize(repr))};
-    score(renderer::decodeAs(volume, repr), p);
+    score(decodeAs(volume, repr), p);
     reprPoints.push_back(p);
   }
   Point floatPoint{"float", 108.0};
@@ -153,7 +153,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
 
   // (a) Wire bytes: a moving-light sequence ending at t, encoded per representation × dead-zone;
   // bytes per second at `hz`, quality of what a subscriber holds at the end.
-  std::vector<renderer::ProbeVolumeData> frames;
+  std::vector<ProbeVolume> frames;
   {
     renderer::UpdaterOptions uo;
     uo.samplesPerProbe = 64;
@@ -163,7 +163,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
       const float t = o.t - 0.004f * static_cast<float>(o.streamFrames - 1 - f);
       u.setScene(sceneAt(t - std::floor(t)));
       u.update();
-      frames.push_back(renderer::volumeFromUpdater(u));
+      frames.push_back(u.volume());
     }
     say(fmt::format("pipeline bench: {} moving-light frames traced", o.streamFrames));
   }
@@ -177,7 +177,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
       eo.deadzone = dz;
       StreamEncoder encoder(layout, eo);
       StreamDecoder decoder(layout);
-      decoder.setHallucinate(false);
+      decoder.setZh3PerPixel(true);
       std::vector<uint8_t> bytes;
       uint64_t total = 0;
       for (size_t f = 0; f < frames.size(); ++f) {
@@ -188,11 +188,12 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
         if (decoder.apply(bytes.data(), bytes.size()) != CodecStatus::Ok)
           throw std::runtime_error("pipeline bench: decoder refused its own stream");
       }
-      renderer::ProbeVolumeData held = frames.back();
+      ProbeVolume held = frames.back();
       const size_t n = held.probes.size();
       held.probes.assign(decoder.probes(), decoder.probes() + n);
       held.active.assign(decoder.activeMask(), decoder.activeMask() + held.active.size());
-      held.hallucinateZh3 = repr == Representation::Zh3Hallucinated;
+      held.decodedFrom = repr;
+      held.zh3PerPixel = repr == Representation::Zh3Hallucinated;
       Point p{fmt::format("{} dz{}", representationName(repr), dz),
               static_cast<double>(total) / static_cast<double>(frames.size() - 1) * o.hz};
       score(held, p);

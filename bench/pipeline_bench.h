@@ -17,7 +17,7 @@ namespace probecast::bench {
 struct PipelineBenchOptions {
   scene::Scene scene;          // an animated built-in scene moves its light with t
   std::string sceneSpec;       // to re-load the scene at other t
-  renderer::ProbeGrid grid;
+  ProbeGrid grid;
   renderer::ContextOptions context;
   uint32_t width = 160, height = 100;
   uint32_t referenceSpp = 128;

@@ -35,7 +35,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   renderer::VulkanContext context(o.context);
   renderer::ProbeUpdater updater(context, o.scene, o.grid, o.updater);
   for (uint32_t u = 0; u < o.updates; ++u) updater.update();
-  const renderer::ProbeVolumeData volume = renderer::volumeFromUpdater(updater);
+  const ProbeVolume volume = updater.volume();
   say(fmt::format("raster bench: {} probe updates of {} probes done", o.updates, o.grid.count()));
 
   const renderer::CameraView camera = renderer::CameraView::fromScene(o.scene);
@@ -53,7 +53,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["scene"] = o.scene.name;
   json["device"] = context.deviceName();
   json["size"] = {o.width, o.height};
-  json["grid"] = {o.grid.dims.x, o.grid.dims.y, o.grid.dims.z};
+  json["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
   json["probe_updates"] = o.updates;
   json["reference_spp"] = o.referenceSpp;
   json["shadow_map_size"] = o.raster.shadowMapSize;
@@ -74,7 +74,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   ChartSeries qualitySeries{"representations (mono view)", {}, false};
   table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
   for (const Representation& r : reprs) {
-    raster.setProbes(r.viaCodec ? renderer::decodeAs(volume, r.repr) : volume);
+    raster.setProbes(r.viaCodec ? decodeAs(volume, r.repr) : volume);
     const glm::mat4 vp = raster.viewProjection(camera);
     renderer::Image image = raster.render(vp, camera.position);  // warm-up (and shadow maps)
     std::vector<double> ms;
@@ -97,7 +97,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   }
 
   // Speed per view set, both ways of drawing several views.
-  const renderer::ProbeVolumeData l2 = renderer::decodeAs(volume, probecast::Representation::L2);
+  const ProbeVolume l2 = decodeAs(volume, probecast::Representation::L2);
   raster.setProbes(l2);
   renderer::RasterOptions multi = o.raster;
   multi.passes = renderer::ViewPasses::Multiview;
@@ -140,11 +140,10 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   // volume sizes of the demo and of a large hall; one probe in eight inactive.
   table += fmt::format("\n{:<10} {:>8} {:>16}\n", "volume", "probes", "ms per update");
   for (const auto& dims : o.uploadGrids) {
-    renderer::ProbeVolumeData v;
-    v.dims = dims;
-    v.min = o.scene.boundsMin;
-    v.max = o.scene.boundsMax;
-    const size_t n = static_cast<size_t>(dims.x) * dims.y * dims.z;
+    const glm::vec3 lo = o.scene.boundsMin, hi = o.scene.boundsMax;
+    ProbeVolume v;
+    v.grid = ProbeGrid{{dims.x, dims.y, dims.z}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}};
+    const size_t n = v.count();
     const size_t f = kProbeFloats;
     v.probes.resize(n * f);
     v.active.resize(n);

@@ -16,7 +16,7 @@ namespace probecast::bench {
 
 struct RasterBenchOptions {
   scene::Scene scene;
-  renderer::ProbeGrid grid;
+  ProbeGrid grid;
   renderer::UpdaterOptions updater;
   renderer::ContextOptions context;
   renderer::RasterOptions raster;  // shadow map size; `passes` is measured both ways

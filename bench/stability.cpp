@@ -33,13 +33,9 @@ scene::Scene builtin(const std::string& name, float t) {
   return s;
 }
 
-renderer::ProbeGrid cellCentred(const scene::Scene& s, glm::uvec3 dims) {
-  renderer::ProbeGrid g;
-  g.dims = dims;
-  const glm::vec3 cell = (s.boundsMax - s.boundsMin) / glm::vec3(dims);
-  g.min = s.boundsMin + 0.5f * cell;
-  g.max = s.boundsMax - 0.5f * cell;
-  return g;
+ProbeGrid cellCentred(const scene::Scene& s, glm::uvec3 dims) {
+  const uint32_t n[3] = {dims.x, dims.y, dims.z};
+  return renderer::sceneGrid(s, n);
 }
 
 double median(std::vector<double> v) {
@@ -111,10 +107,8 @@ double waitSeconds(Pred done, double limit) {
 bool holdsServerVolume(const service::ProbeClient& client, const service::ProbeHub& hub) {
   service::VolumeSnapshot snap;
   if (!client.snapshot(snap)) return false;
-  std::vector<float> probes;
-  std::vector<uint8_t> active;
-  hub.reconstruction(probes, active);
-  return snap.probes == probes && snap.active == active;
+  const ProbeVolume server = hub.reconstruction();
+  return snap.volume.probes == server.probes && snap.volume.active == server.active;
 }
 
 }  // namespace
@@ -122,7 +116,7 @@ bool holdsServerVolume(const service::ProbeClient& client, const service::ProbeH
 std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, const std::vector<float>& wMins,
                                           uint32_t samplesPerProbe, uint32_t updatesAfterJump) {
   const scene::Scene before = builtin("cornell", 0.0f), after = builtin("cornell", 0.5f);
-  const renderer::ProbeGrid grid = cellCentred(before, {4, 4, 4});
+  const ProbeGrid grid = cellCentred(before, {4, 4, 4});
   const uint32_t n = grid.count();
   const auto converged = [&](const scene::Scene& s) {
     renderer::UpdaterOptions o;
@@ -131,8 +125,8 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
     o.seed = 99;
     renderer::ProbeUpdater u(context, s, grid, o);
     for (int k = 0; k < 16; ++k) u.update();
-    return std::make_pair(std::vector<float>(u.probes(), u.probes() + n * 27),
-                          std::vector<uint8_t>(u.activeMask(), u.activeMask() + n));
+    return std::make_pair(std::vector<float>(u.volume().probes.data(), u.volume().probes.data() + n * 27),
+                          std::vector<uint8_t>(u.volume().active.data(), u.volume().active.data() + n));
   };
   const auto [ref0, active] = converged(before);
   const auto ref1 = converged(after).first;
@@ -149,15 +143,15 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
     const uint32_t settle = 48;
     for (uint32_t k = 0; k < settle; ++k) {
       u.update();
-      if (k >= settle / 2) changes.push_back(irradianceRmseRel(u.probes(), previous.data(), active.data(), n));
-      previous.assign(u.probes(), u.probes() + n * 27);
+      if (k >= settle / 2) changes.push_back(irradianceRmseRel(u.volume().probes.data(), previous.data(), active.data(), n));
+      previous.assign(u.volume().probes.data(), u.volume().probes.data() + n * 27);
     }
     r.flickerRel = median(changes);
-    r.errorBeforeJump = irradianceRmseRel(u.probes(), ref0.data(), active.data(), n);
+    r.errorBeforeJump = irradianceRmseRel(u.volume().probes.data(), ref0.data(), active.data(), n);
     u.setScene(after);
     for (uint32_t k = 1; k <= updatesAfterJump; ++k) {
       u.update();
-      r.errorAfterJump.push_back(irradianceRmseRel(u.probes(), ref1.data(), active.data(), n));
+      r.errorAfterJump.push_back(irradianceRmseRel(u.volume().probes.data(), ref1.data(), active.data(), n));
       if (r.updatesToRecover < 0 && r.errorAfterJump.back() <= 1.5 * r.errorBeforeJump)
         r.updatesToRecover = static_cast<int>(k);
     }
@@ -246,7 +240,7 @@ Ringing measureRinging(double capDeg) {
 
 WallLeak measureWallLeak(renderer::VulkanContext& context) {
   const scene::Scene s = builtin("thin-wall", 0.0f);
-  const renderer::ProbeGrid grid = cellCentred(s, {9, 5, 5});  // 9 along x: one plane inside the wall
+  const ProbeGrid grid = cellCentred(s, {9, 5, 5});  // 9 along x: one plane inside the wall
   const auto traced = [&](bool classify) {
     renderer::UpdaterOptions o;
     o.samplesPerProbe = 128;
@@ -254,9 +248,9 @@ WallLeak measureWallLeak(renderer::VulkanContext& context) {
     renderer::ProbeUpdater u(context, s, grid, o);
     u.update();
     u.update();
-    return renderer::volumeFromUpdater(u);
+    return u.volume();
   };
-  const renderer::ProbeVolumeData on = traced(true), off = traced(false);
+  const ProbeVolume on = traced(true), off = traced(false);
   WallLeak r;
   r.probes = grid.count();
   for (uint8_t a : on.active) r.inactiveProbes += a == 0;
@@ -337,8 +331,8 @@ NetworkFaults measureNetworkFaults() {
   std::this_thread::sleep_for(std::chrono::seconds(2));
   client.snapshot(during);
   double energy = 0;
-  for (float v : during.probes) energy += std::fabs(v);
-  r.lightingKeptDuringOutage = during.probes == before.probes && energy > 0;
+  for (float v : during.volume.probes) energy += std::fabs(v);
+  r.lightingKeptDuringOutage = during.volume.probes == before.volume.probes && energy > 0;
   const uint64_t bytesBefore = client.stats().bytesReceived;
   moving = false;  // freeze so both clients can finish; the hub holds the lighting of the outage
   client.start();
@@ -399,12 +393,12 @@ ExtremeInputs measureExtremeInputs() {
 
 std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, const std::vector<double>& maxErrors) {
   const scene::Scene s = builtin("cornell", 0.0f);
-  const renderer::ProbeGrid grid = cellCentred(s, {8, 8, 8});
+  const ProbeGrid grid = cellCentred(s, {8, 8, 8});
   renderer::UpdaterOptions o;
   o.samplesPerProbe = 128;
   renderer::ProbeUpdater u(context, s, grid, o);
   for (int k = 0; k < 4; ++k) u.update();
-  const renderer::ProbeVolumeData v = renderer::volumeFromUpdater(u);
+  const ProbeVolume v = u.volume();
   // Per active probe, the irradiance error of its l1, zh3 and l2 records.
   constexpr Representation kTried[3] = {Representation::L1, Representation::Zh3, Representation::L2};
   std::vector<std::array<double, 3>> errors;
@@ -441,13 +435,13 @@ std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, cons
   eo.deadzone = 1;
   for (int moving = 0; moving < 2; ++moving) {
     StreamEncoder stream(live, eo);
-    stream.update(u.probes(), u.activeMask());
+    stream.update(u.volume().probes.data(), u.volume().active.data());
     double bytes = 0;
     const int frames = 8;
     for (int f = 1; f <= frames; ++f) {
       if (moving) u.setScene(builtin("cornell", 0.004f * static_cast<float>(f)));
       u.update();
-      stream.update(u.probes(), u.activeMask());
+      stream.update(u.volume().probes.data(), u.volume().active.data());
       stream.writeChangedFrame(frame);
       bytes += static_cast<double>(frame.size());
     }

@@ -62,8 +62,8 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
     say(fmt::format("reference: update {}/{} ({} samples/probe)", u + 1, refUpdates, refOptions.samplesPerProbe));
     reference.update();
   }
-  const std::vector<float> ref(reference.probes(), reference.probes() + count * 27);
-  const std::vector<uint8_t> active(reference.activeMask(), reference.activeMask() + count);
+  const std::vector<float> ref(reference.volume().probes.data(), reference.volume().probes.data() + count * 27);
+  const std::vector<uint8_t> active(reference.volume().active.data(), reference.volume().active.data() + count);
   uint32_t activeCount = 0;
   for (uint8_t a : active) activeCount += a;
 
@@ -81,7 +81,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
     raysPerS.push_back(static_cast<double>(st.closestHitRays + st.shadowRays) / seconds);
     closestPerS.push_back(static_cast<double>(st.closestHitRays) / seconds);
     shadowPerS.push_back(static_cast<double>(st.shadowRays) / seconds);
-    rmse.push_back(irradianceRmseRel(updater.probes(), ref.data(), active.data(), count));
+    rmse.push_back(irradianceRmseRel(updater.volume().probes.data(), ref.data(), active.data(), count));
     cumulativeMs.push_back(elapsed);
     say(fmt::format("update {}/{}: {:.1f} ms, {:.2f} M rays/s, error {:.2f}%", u + 1, opt.updates, st.milliseconds,
                     raysPerS.back() / 1e6, 100 * rmse.back()));
@@ -100,11 +100,11 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
     for (uint32_t k = 0; k < opt.updates; ++k) {
       u.update();
       if (!previous.empty() && k >= opt.updates / 2)
-        changes.push_back(irradianceRmseRel(u.probes(), previous.data(), active.data(), count));
-      previous.assign(u.probes(), u.probes() + count * 27);
+        changes.push_back(irradianceRmseRel(u.volume().probes.data(), previous.data(), active.data(), count));
+      previous.assign(u.volume().probes.data(), u.volume().probes.data() + count * 27);
     }
     const double f = changes.empty() ? 0.0 : median(changes);
-    const double e = irradianceRmseRel(u.probes(), ref.data(), active.data(), count);
+    const double e = irradianceRmseRel(u.volume().probes.data(), ref.data(), active.data(), count);
     say(fmt::format("w_min {:.3f}: flicker {:.2f}% per update, error {:.2f}%", w, 100 * f, 100 * e));
     flicker.push_back({{"w_min", w}, {"flicker_rel", f}, {"rmse_rel", e}});
     flickerSeries.points.push_back({elapsed, e, fmt::format("w_min {:g}", w)});
@@ -115,7 +115,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
             {"scene", opt.scene.name},
             {"triangles", opt.scene.triangleCount()},
             {"device", context.deviceName()},
-            {"grid", {opt.grid.dims.x, opt.grid.dims.y, opt.grid.dims.z}},
+            {"grid", {opt.grid.dims[0], opt.grid.dims[1], opt.grid.dims[2]}},
             {"active_probes", activeCount},
             {"spp", convOptions.samplesPerProbe},
             {"bounces", convOptions.maxBounces},
@@ -135,7 +135,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
       "scene {} ({} triangles), grid {}x{}x{} ({} active), {} spp, {} bounces on {}\n"
       "ms/update {:.1f} | rays/s {:.2f} M (closest-hit {:.2f} M, shadow {:.2f} M) | device memory {:.1f} MiB | peak RSS "
       "{:.0f} MiB\n",
-      opt.scene.name, opt.scene.triangleCount(), opt.grid.dims.x, opt.grid.dims.y, opt.grid.dims.z, activeCount,
+      opt.scene.name, opt.scene.triangleCount(), opt.grid.dims[0], opt.grid.dims[1], opt.grid.dims[2], activeCount,
       convOptions.samplesPerProbe, convOptions.maxBounces, context.deviceName(), median(ms), median(raysPerS) / 1e6,
       median(closestPerS) / 1e6, median(shadowPerS) / 1e6, static_cast<double>(deviceBytes) / (1 << 20), peakRssMiB());
   r.table += "error after updates:";

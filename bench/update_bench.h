@@ -14,7 +14,7 @@ namespace probecast::bench {
 
 struct UpdateBenchOptions {
   scene::Scene scene;
-  renderer::ProbeGrid grid;
+  ProbeGrid grid;
   renderer::UpdaterOptions updater;     // samplesPerProbe, bounces, seed, clamp
   renderer::ContextOptions context;
   uint32_t updates = 16;                // convergence and flicker runs

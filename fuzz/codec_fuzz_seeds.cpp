@@ -54,9 +54,9 @@ int main(int argc, char** argv) {
     write(dir, name + "-floats", control(fuzz::kEncodeFloats, false), raw);
   }
   ProbeVolume volume;
-  volume.dims[0] = 2;
-  volume.dims[1] = 1;
-  volume.dims[2] = 2;
+  volume.grid.dims[0] = 2;
+  volume.grid.dims[1] = 1;
+  volume.grid.dims[2] = 2;
   volume.probes.assign(4 * 27, 0.5f);
   volume.active = {1, 0, 1, 1};
   std::vector<uint8_t> bytes;

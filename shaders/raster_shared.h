@@ -46,7 +46,7 @@ struct RsShadowLayer {
 struct RsPushConstants {
   vec4 volumeMin;      // xyz position of probe (0,0,0); w = 1 if a probe volume is bound
   vec4 volumeMax;      // xyz position of the last probe
-  vec4 volumeDims;     // xyz probes per axis (as floats); w = 1: L1 only, hallucinate ZH3 per pixel
+  vec4 volumeDims;     // xyz probes per axis (as floats); w = 1: zh3PerPixel (L1 only, hallucinate ZH3 per pixel)
   vec4 lobeBand1;      // GGX zonal lobe fit of band 1: p1, p2, q1, q2 (glossy_sh.h)
   vec4 lobeBand2;      // band 2
   uint lightCount;

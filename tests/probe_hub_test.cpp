@@ -114,9 +114,7 @@ TEST(ProbeHub, StaleVersionsAreSkippedNotQueued) {
   EXPECT_EQ(frame->keyframes, 4u);
   EXPECT_EQ(frame->deltas, 0u);
   bricksIn(*frame, dec);
-  std::vector<float> probes;
-  std::vector<uint8_t> active;
-  hub.reconstruction(probes, active);
+  const std::vector<float> probes = hub.reconstruction().probes;
   EXPECT_EQ(0, std::memcmp(probes.data(), dec.probes(), probes.size() * sizeof(float)));
 }
 

@@ -57,8 +57,7 @@ Scene halfSplitBox(Pick material) {
 
 ProbeGrid singleProbe(glm::vec3 p) {
   ProbeGrid g;
-  g.min = g.max = p;
-  g.dims = glm::uvec3(1);
+  g = ProbeGrid{{1, 1, 1}, {{p.x, p.y, p.z}, {p.x, p.y, p.z}}};
   return g;
 }
 
@@ -74,9 +73,9 @@ TEST_F(Updater, ClosedEmissiveBoxGivesConstantRadiance) {
   o.samplesPerProbe = 256;
   o.maxBounces = 1;  // the emission the probe sees, no reflections of it (GGX reflects even black)
   ProbeUpdater updater(*context_, s, singleProbe({0.1f, -0.2f, 0.05f}), o);
-  ASSERT_EQ(updater.activeMask()[0], 1);
+  ASSERT_EQ(updater.volume().active.data()[0], 1);
   for (int u = 0; u < 3; ++u) updater.update();
-  const float* p = updater.probes();
+  const float* p = updater.volume().probes.data();
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(p[c], 3.5449077f * L[c], 1e-4f * L[c]);  // every ray sees L exactly
     for (int i = 1; i < kShCoeffs; ++i) EXPECT_NEAR(p[i * 3 + c], 0.0f, 0.02f * p[c]) << "coefficient " << i;
@@ -100,7 +99,7 @@ TEST_F(Updater, EmissionTextureIsDecodedFromSrgb) {
   o.maxBounces = 1;
   ProbeUpdater updater(*context_, s, singleProbe({0.2f, 0.1f, -0.3f}), o);
   updater.update();
-  EXPECT_NEAR(updater.probes()[0], 3.5449077f * 0.2158605f, 1e-4f);
+  EXPECT_NEAR(updater.volume().probes.data()[0], 3.5449077f * 0.2158605f, 1e-4f);
 }
 
 TEST_F(Updater, HalfEmissiveBoxGivesHemisphereAnswer) {
@@ -115,7 +114,7 @@ TEST_F(Updater, HalfEmissiveBoxGivesHemisphereAnswer) {
   o.maxBounces = 1;
   ProbeUpdater updater(*context_, s, singleProbe({0.0f, 0.0f, 0.0f}), o);
   for (int u = 0; u < 8; ++u) updater.update();
-  const float* p = updater.probes();
+  const float* p = updater.volume().probes.data();
   EXPECT_NEAR(p[0], 1.7724539f, 0.01f);
   EXPECT_NEAR(p[2 * 3], 1.5349900f, 0.015f);
   EXPECT_NEAR(p[6 * 3], 0.0f, 0.015f);
@@ -178,7 +177,7 @@ TEST_F(Updater, PointLightOnFloorMatchesNumericalIntegral) {
       for (int c = 0; c < kShCoeffs; ++c) ref[c] += radiance * y[c] * domega;
     }
   }
-  const float* p = updater.probes();
+  const float* p = updater.volume().probes.data();
   for (int c = 0; c < kShCoeffs; ++c)
     EXPECT_NEAR(p[c * 3], ref[c], 0.03 * ref[0]) << "coefficient " << c;
 }
@@ -188,9 +187,7 @@ TEST_F(Updater, SameSeedIsBitIdenticalOtherSeedIsNot) {
   std::string error;
   ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error)) << error;
   ProbeGrid g;
-  g.min = {-0.8f, 0.2f, -0.8f};
-  g.max = {0.8f, 1.8f, 0.8f};
-  g.dims = glm::uvec3(3);
+  g = ProbeGrid{{3, 3, 3}, {{-0.8f, 0.2f, -0.8f}, {0.8f, 1.8f, 0.8f}}};
   UpdaterOptions o;
   o.samplesPerProbe = 64;
   std::vector<float> results[3];
@@ -199,7 +196,7 @@ TEST_F(Updater, SameSeedIsBitIdenticalOtherSeedIsNot) {
     ProbeUpdater updater(*context_, s, g, o);
     updater.update();
     updater.update();
-    results[run].assign(updater.probes(), updater.probes() + g.count() * 27);
+    results[run].assign(updater.volume().probes.data(), updater.volume().probes.data() + g.count() * 27);
   }
   EXPECT_EQ(results[0], results[1]);
   EXPECT_NE(results[0], results[2]);
@@ -213,21 +210,19 @@ TEST_F(Updater, ProbeInsideClosedWallIsInactive) {
   std::string error;
   ASSERT_TRUE(scene::makeBuiltinScene("closed-box", 0.0f, s, error)) << error;
   ProbeGrid g;
-  g.min = {0.0f, 0.0f, 0.0f};
-  g.max = {1.6f, 0.0f, 0.0f};
-  g.dims = {5, 1, 1};  // x = 0, 0.4, 0.8, 1.2 (on the outer face: skip), 1.6
+  g = ProbeGrid{{5, 1, 1}, {{0.0f, 0.0f, 0.0f}, {1.6f, 0.0f, 0.0f}}};  // x = 0, 0.4, 0.8, 1.2 (on the outer face: skip), 1.6
   UpdaterOptions o;
   o.samplesPerProbe = 64;
   ProbeUpdater updater(*context_, s, g, o);
-  EXPECT_EQ(updater.activeMask()[0], 1);  // room centre
-  EXPECT_EQ(updater.activeMask()[2], 1);  // inside the room near the wall
-  EXPECT_EQ(updater.activeMask()[4], 1);  // outside the box
+  EXPECT_EQ(updater.volume().active.data()[0], 1);  // room centre
+  EXPECT_EQ(updater.volume().active.data()[2], 1);  // inside the room near the wall
+  EXPECT_EQ(updater.volume().active.data()[4], 1);  // outside the box
   ProbeGrid wall = singleProbe({1.1f, 0.3f, -0.2f});
   ProbeUpdater inWall(*context_, s, wall, o);
-  EXPECT_EQ(inWall.activeMask()[0], 0);
+  EXPECT_EQ(inWall.volume().active.data()[0], 0);
   const UpdateStats stats = inWall.update();
   EXPECT_EQ(stats.paths, 0u);  // inactive probes get no rays
-  for (int i = 0; i < 27; ++i) EXPECT_EQ(inWall.probes()[i], 0.0f);
+  for (int i = 0; i < 27; ++i) EXPECT_EQ(inWall.volume().probes.data()[i], 0.0f);
 }
 
 TEST_F(Updater, MovingLightIsFollowed) {
@@ -238,19 +233,17 @@ TEST_F(Updater, MovingLightIsFollowed) {
   ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, a, error));   // light at +x
   ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.5f, b, error));   // light at −x
   ProbeGrid g;
-  g.min = {-0.7f, 1.5f, 0.5f};
-  g.max = {0.7f, 1.5f, 0.5f};
-  g.dims = {2, 1, 1};
+  g = ProbeGrid{{2, 1, 1}, {{-0.7f, 1.5f, 0.5f}, {0.7f, 1.5f, 0.5f}}};
   UpdaterOptions o;
   o.samplesPerProbe = 256;
   o.minBlendWeight = 0.5f;
   ProbeUpdater updater(*context_, a, g, o);
   for (int u = 0; u < 4; ++u) updater.update();
-  const float leftBefore = updater.probes()[0], rightBefore = updater.probes()[27];
+  const float leftBefore = updater.volume().probes.data()[0], rightBefore = updater.volume().probes.data()[27];
   EXPECT_GT(rightBefore, leftBefore);
   updater.setScene(b);
   for (int u = 0; u < 6; ++u) updater.update();
-  const float leftAfter = updater.probes()[0], rightAfter = updater.probes()[27];
+  const float leftAfter = updater.volume().probes.data()[0], rightAfter = updater.volume().probes.data()[27];
   EXPECT_GT(leftAfter, rightAfter);
   EXPECT_GT(leftAfter, leftBefore);
 }
@@ -272,9 +265,7 @@ TEST_F(Updater, CornellProbesMatchCpuReference) {
   std::string error;
   ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
   ProbeGrid g;
-  g.min = {-0.7f, 1.3f, -0.6f};  // above both boxes (the tall one ends at y = 1.2)
-  g.max = {0.7f, 1.8f, 0.7f};
-  g.dims = {2, 1, 2};
+  g = ProbeGrid{{2, 1, 2}, {{-0.7f, 1.3f, -0.6f}, {0.7f, 1.8f, 0.7f}}};  // above both boxes (the tall one ends at y = 1.2)
   UpdaterOptions o;
   o.samplesPerProbe = 2048;
   o.minBlendWeight = 0.0f;
@@ -282,12 +273,14 @@ TEST_F(Updater, CornellProbesMatchCpuReference) {
   ProbeUpdater updater(*context_, s, g, o);
   for (int u = 0; u < 32; ++u) updater.update();
   for (uint32_t p = 0; p < g.count(); ++p) {
-    ASSERT_EQ(updater.activeMask()[p], 1) << p;
+    ASSERT_EQ(updater.volume().active.data()[p], 1) << p;
     test::CpuTraceOptions co;
     co.samples = 65536;
     co.seed = 100 + p;
-    const auto ref = test::cpuTraceProbe(s, g.position(p), co);
-    const float* gpu = updater.probes() + p * 27;
+    float pos[3];
+    g.position(p, pos);
+    const auto ref = test::cpuTraceProbe(s, glm::vec3(pos[0], pos[1], pos[2]), co);
+    const float* gpu = updater.volume().probes.data() + p * 27;
     for (int c = 0; c < 3; ++c) {
       const double dc = ref[c];
       ASSERT_GT(dc, 0.0);

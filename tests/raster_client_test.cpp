@@ -27,11 +27,7 @@ TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
   scene::finalizeScene(s);
   RasterRenderer raster(context, s, 32, 24);
   const glm::vec3 L(0.5f, 0.25f, 0.125f);
-  ProbeVolumeData v;
-  v.dims = {3, 2, 3};
-  v.min = {-4, -1, -4};
-  v.max = {4, 1, 4};
-  v.probes.assign(18 * 27, 0.0f);
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{3, 2, 3}, {{-4, -1, -4}, {4, 1, 4}}});
   for (int p = 0; p < 18; ++p)
     for (int c = 0; c < 3; ++c) v.probes[p * 27 + c] = 3.5449077f * L[c];  // c00 = 2√π L
   raster.setProbes(v);
@@ -54,9 +50,7 @@ TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
 }
 
 TEST(RasterClient, InactiveProbesAreFilledFromActiveNeighbours) {
-  ProbeVolumeData v;
-  v.dims = {3, 1, 1};
-  v.probes.assign(3 * 27, 0.0f);
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{3, 1, 1}, {{0, 0, 0}, {2, 0, 0}}});
   v.probes[0] = 2.0f;   // probe 0 active, c00 R = 2
   v.probes[54] = 4.0f;  // probe 2 active, c00 R = 4
   v.active = {1, 0, 1};
@@ -72,15 +66,14 @@ TEST(RasterClient, InactiveProbesAreFilledFromActiveNeighbours) {
 TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
-  ProbeGrid g;
-  g.dims = {4, 4, 4};
-  g.min = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
-  g.max = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
+  const glm::vec3 lo = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
+  const glm::vec3 hi = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
+  const ProbeGrid g{{4, 4, 4}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}};
   UpdaterOptions uo;
   uo.samplesPerProbe = 64;
   ProbeUpdater updater(context, s, g, uo);
   updater.update();
-  const ProbeVolumeData v = volumeFromUpdater(updater);
+  const ProbeVolume v = updater.volume();
   RasterRenderer raster(context, s, 48, 36);
   raster.setProbes(v);
   const CameraView cam = CameraView::fromScene(s);
@@ -138,28 +131,25 @@ TEST(RasterClient, BadProbeVolumesAreRefusedAndTheLastGoodOneKept) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
   RasterRenderer raster(context, s, 24, 16);
-  ProbeVolumeData good;
-  good.dims = {2, 2, 2};
-  good.min = s.boundsMin;
-  good.max = s.boundsMax;
-  good.probes.assign(8 * 27, 0.0f);
+  const glm::vec3 lo = s.boundsMin, hi = s.boundsMax;
+  ProbeVolume good = makeProbeVolume(ProbeGrid{{2, 2, 2}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}});
   for (int p = 0; p < 8; ++p) good.probes[p * 27] = 1.0f;
   raster.setProbes(good);
   const CameraView cam = CameraView::fromScene(s);
   const Image before = raster.render(raster.viewProjection(cam), cam.position);
-  ProbeVolumeData nan = good;
+  ProbeVolume nan = good;
   nan.probes[5 * 27 + 4] = std::nanf("");
   EXPECT_THROW(raster.setProbes(nan), std::invalid_argument);
-  ProbeVolumeData inf = good;
+  ProbeVolume inf = good;
   inf.probes[3] = std::numeric_limits<float>::infinity();
   EXPECT_THROW(raster.setProbes(inf), std::invalid_argument);
-  ProbeVolumeData flat = good;
-  flat.max.x = flat.min.x;
+  ProbeVolume flat = good;
+  flat.grid.bounds.max[0] = flat.grid.bounds.min[0];
   EXPECT_THROW(raster.setProbes(flat), std::invalid_argument);
-  ProbeVolumeData mask = good;
+  ProbeVolume mask = good;
   mask.active.assign(7, 1);
   EXPECT_THROW(raster.setProbes(mask), std::invalid_argument);
-  ProbeVolumeData small = good;
+  ProbeVolume small = good;
   small.probes.pop_back();
   EXPECT_THROW(raster.setProbes(small), std::invalid_argument);
   EXPECT_EQ(raster.render(raster.viewProjection(cam), cam.position).rgb, before.rgb);  // nothing lost

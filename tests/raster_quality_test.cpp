@@ -27,19 +27,16 @@ double rmse(const Image& a, const Image& b) {
   return std::sqrt(sum / static_cast<double>(a.rgb.size()));
 }
 
-ProbeVolumeData tracedVolume(VulkanContext& context, const scene::Scene& s, glm::uvec3 dims, uint32_t updates,
+ProbeVolume tracedVolume(VulkanContext& context, const scene::Scene& s, glm::uvec3 dims, uint32_t updates,
                              bool classify = true) {
-  ProbeGrid g;
-  g.dims = dims;
-  const glm::vec3 cell = (s.boundsMax - s.boundsMin) / glm::vec3(dims);
-  g.min = s.boundsMin + 0.5f * cell;
-  g.max = s.boundsMax - 0.5f * cell;
+  const uint32_t n[3] = {dims.x, dims.y, dims.z};
+  const ProbeGrid g = sceneGrid(s, n);
   UpdaterOptions uo;
   uo.samplesPerProbe = 128;
   uo.classify = classify;
   ProbeUpdater updater(context, s, g, uo);
   for (uint32_t u = 0; u < updates; ++u) updater.update();
-  return volumeFromUpdater(updater);
+  return updater.volume();
 }
 
 TEST(RasterQuality, ShadowMapDarkensExactlyTheOccludedFloor) {
@@ -85,10 +82,10 @@ TEST(RasterQuality, ShadowMapDarkensExactlyTheOccludedFloor) {
 TEST(RasterQuality, L2AndStoredZh3AreCloserToTheFloatRenderThanL1) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
-  const ProbeVolumeData volume = tracedVolume(context, s, {4, 4, 4}, 2);
+  const ProbeVolume volume = tracedVolume(context, s, {4, 4, 4}, 2);
   RasterRenderer raster(context, s, 64, 48);
   const CameraView cam = CameraView::fromScene(s);
-  const auto renderAs = [&](const ProbeVolumeData& v) {
+  const auto renderAs = [&](const ProbeVolume& v) {
     raster.setProbes(v);
     return raster.render(raster.viewProjection(cam), cam.position);
   };
@@ -103,8 +100,8 @@ TEST(RasterQuality, L2AndStoredZh3AreCloserToTheFloatRenderThanL1) {
   EXPECT_NE(zh3h, l1);  // the per-pixel hallucination did something
   EXPECT_GT(l1, 0.0);
   // zh3h decodes L1 only and leaves the L2 band to the shader.
-  const ProbeVolumeData h = decodeAs(volume, Representation::Zh3Hallucinated);
-  EXPECT_TRUE(h.hallucinateZh3);
+  const ProbeVolume h = decodeAs(volume, Representation::Zh3Hallucinated);
+  EXPECT_TRUE(h.zh3PerPixel);
   for (size_t p = 0; p < h.probes.size(); p += 27)
     for (int k = 12; k < 27; ++k) ASSERT_EQ(h.probes[p + k], 0.0f);
   EXPECT_EQ(context.validationMessages(), 0u);
@@ -114,7 +111,7 @@ TEST(RasterQuality, MultiviewChunksMatchOnePassPerView) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.25f);
   std::string error;
-  const ProbeVolumeData volume = tracedVolume(context, s, {4, 4, 4}, 1);
+  const ProbeVolume volume = tracedVolume(context, s, {4, 4, 4}, 1);
   RasterOptions perView, multi;
   perView.passes = ViewPasses::PerView;
   multi.passes = ViewPasses::Multiview;
@@ -144,7 +141,7 @@ TEST(RasterQuality, OffAxisViewsMatchTheReferenceOfTheSameShearedCamera) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
   std::string error;
-  const ProbeVolumeData volume = tracedVolume(context, s, {4, 4, 4}, 2);
+  const ProbeVolume volume = tracedVolume(context, s, {4, 4, 4}, 2);
   RasterRenderer raster(context, s, 64, 40);
   raster.setProbes(volume);
   ViewSetSpec spec;
@@ -175,7 +172,7 @@ TEST(RasterQuality, OffAxisViewsMatchTheReferenceOfTheSameShearedCamera) {
 TEST(RasterQuality, CornellAgainstTheReferenceAboveTheRecordedFloor) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
-  const ProbeVolumeData volume = tracedVolume(context, s, {8, 8, 8}, 4);
+  const ProbeVolume volume = tracedVolume(context, s, {8, 8, 8}, 4);
   const CameraView cam = CameraView::fromScene(s);
   RasterRenderer raster(context, s, 80, 50);
   raster.setProbes(decodeAs(volume, Representation::L2));
@@ -190,7 +187,8 @@ TEST(RasterQuality, CornellAgainstTheReferenceAboveTheRecordedFloor) {
   EXPECT_GT(m.psnrDb, FLOOR_PSNR);
   EXPECT_GT(m.ssim, FLOOR_SSIM);
   // Without probes the indirect light is missing: the floor must catch that.
-  raster.setProbes(ProbeVolumeData{{1, 1, 1}, s.boundsMin, s.boundsMax, std::vector<float>(27, 0.0f), {}, false});
+  const glm::vec3 lo = s.boundsMin, hi = s.boundsMax;
+  raster.setProbes(makeProbeVolume(ProbeGrid{{1, 1, 1}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}}));
   const Image direct = raster.render(raster.viewProjection(cam), cam.position);
   EXPECT_LT(bench::compareImages(direct.rgb, reference.rgb, 80, 50).psnrDb, FLOOR_PSNR);
   EXPECT_EQ(context.validationMessages(), 0u);

@@ -141,7 +141,7 @@ TEST_P(RecordRoundTrip, EncodeDecodeEncodeIsEncode) {
     uint8_t a[kMaxRecordBytes], b[kMaxRecordBytes];
     encodeProbeRecord(repr, p.data(), a);
     Probe q{};
-    ASSERT_TRUE(decodeProbeRecord(repr, a, q.data(), false));
+    ASSERT_TRUE(decodeProbeRecord(repr, a, q.data(), /*zh3PerPixel=*/true));
     encodeProbeRecord(repr, q.data(), b);
     ASSERT_EQ(0, std::memcmp(a, b, recordSize(repr))) << "trial " << trial;
   }

@@ -92,11 +92,11 @@ ClientConfig clientFor(int port, uint64_t budget = 0) {
 bool matchesServer(const ProbeClient& client, const ProbeHub& hub) {
   VolumeSnapshot snap;
   if (!client.snapshot(snap)) return false;
-  std::vector<float> probes;
-  std::vector<uint8_t> active;
-  hub.reconstruction(probes, active);
-  return snap.probes.size() == probes.size() &&
-         std::memcmp(snap.probes.data(), probes.data(), probes.size() * sizeof(float)) == 0 && snap.active == active;
+  const ProbeVolume server = hub.reconstruction();
+  const std::vector<float>& probes = server.probes;
+  return snap.volume.probes.size() == probes.size() &&
+         std::memcmp(snap.volume.probes.data(), probes.data(), probes.size() * sizeof(float)) == 0 &&
+         snap.volume.active == server.active;
 }
 
 template <typename Pred>
@@ -192,12 +192,12 @@ TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {
   VolumeSnapshot during;
   ASSERT_TRUE(client.snapshot(during));
   double energy = 0;
-  for (float v : during.probes) energy += std::fabs(v);
+  for (float v : during.volume.probes) energy += std::fabs(v);
   EXPECT_GT(energy, 0.0);
   std::this_thread::sleep_for(300ms);  // a few reconnect attempts fail meanwhile
   VolumeSnapshot later;
   ASSERT_TRUE(client.snapshot(later));
-  EXPECT_EQ(later.probes, during.probes);
+  EXPECT_EQ(later.volume.probes, during.volume.probes);
 
   // It comes back on the same port with the same hub (epoch): the client resumes.
   ServerConfig again = plaintextConfig();

@@ -304,11 +304,11 @@ namespace {
 
 TEST(ProbeFile, RoundTripAndRejections) {
   ProbeVolume v;
-  v.dims[0] = 3;
-  v.dims[1] = 2;
-  v.dims[2] = 1;
-  v.boundsMin[0] = -1;
-  v.boundsMax[0] = 1;
+  v.grid.dims[0] = 3;
+  v.grid.dims[1] = 2;
+  v.grid.dims[2] = 1;
+  v.grid.bounds.min[0] = -1;
+  v.grid.bounds.max[0] = 1;
   v.updates = 4;
   v.samplesPerProbe = 128;
   v.probes.resize(6 * 27);

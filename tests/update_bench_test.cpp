@@ -11,9 +11,7 @@ TEST(UpdateBench, ReportsConvergingErrorAndRays) {
   UpdateBenchOptions o;
   std::string error;
   ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, o.scene, error));
-  o.grid.min = {-0.7f, 0.8f, -0.7f};
-  o.grid.max = {0.7f, 1.8f, 0.7f};
-  o.grid.dims = {3, 2, 3};
+  o.grid = ProbeGrid{{3, 2, 3}, {{-0.7f, 0.8f, -0.7f}, {0.7f, 1.8f, 0.7f}}};
   o.updater.samplesPerProbe = 128;
   o.updates = 6;
   o.referenceSamples = 4096;
@@ -40,10 +38,8 @@ TEST(UpdateBench, DeviceMemoryDoesNotGrowWithSamples) {
   scene::Scene s;
   std::string error;
   ASSERT_TRUE(scene::makeBuiltinScene("cornell", 0.0f, s, error));
-  renderer::ProbeGrid g;
-  g.min = {-0.8f, 0.2f, -0.8f};
-  g.max = {0.8f, 1.8f, 0.8f};
-  g.dims = {8, 8, 8};
+  ProbeGrid g;
+  g = ProbeGrid{{8, 8, 8}, {{-0.8f, 0.2f, -0.8f}, {0.8f, 1.8f, 0.8f}}};
   renderer::UpdaterOptions a, b;
   a.samplesPerProbe = 64;
   b.samplesPerProbe = 2048;

@@ -55,6 +55,22 @@ bool isValidLayout(const StreamLayout& layout) {
          isValidRepresentation(static_cast<uint8_t>(layout.repr));
 }
 
+StreamLayout streamLayoutFor(const ProbeGrid& grid, Representation repr, uint8_t brickDim) {
+  StreamLayout layout;
+  for (int a = 0; a < 3; ++a)  // too many probes along an axis: 0, which isValidLayout refuses
+    layout.grid[a] = grid.dims[a] <= static_cast<uint32_t>(kMaxGridDim) ? static_cast<uint16_t>(grid.dims[a]) : 0;
+  layout.brickDim = brickDim;
+  layout.repr = repr;
+  return layout;
+}
+
+ProbeGrid gridOf(const StreamLayout& layout, const GridBounds& bounds) {
+  ProbeGrid grid;
+  for (int a = 0; a < 3; ++a) grid.dims[a] = layout.grid[a];
+  grid.bounds = bounds;
+  return grid;
+}
+
 uint32_t probeCount(const StreamLayout& layout) {
   return static_cast<uint32_t>(layout.grid[0]) * layout.grid[1] * layout.grid[2];
 }

@@ -35,9 +35,9 @@ void serializeProbeVolume(const ProbeVolume& v, std::vector<uint8_t>& out) {
   out.assign(std::begin(kMagic), std::end(kMagic));
   out.reserve(kHeaderBytes + v.probes.size() * 4 + v.active.size() + 4);
   putU32(out, kVersion);
-  for (uint32_t d : v.dims) putU32(out, d);
-  for (float f : v.boundsMin) putF32(out, f);
-  for (float f : v.boundsMax) putF32(out, f);
+  for (uint32_t d : v.grid.dims) putU32(out, d);
+  for (float f : v.grid.bounds.min) putF32(out, f);
+  for (float f : v.grid.bounds.max) putF32(out, f);
   putU32(out, v.updates);
   putU32(out, v.samplesPerProbe);
   for (float f : v.probes) putF32(out, f);
@@ -52,15 +52,15 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
   ProbeVolume out;
   uint64_t count = 1;
   for (int a = 0; a < 3; ++a) {
-    out.dims[a] = getU32(data + 8 + 4 * a);
-    if (out.dims[a] < 1 || out.dims[a] > kMaxGridDim) return error = "probe grid dimension out of range", false;
-    count *= out.dims[a];
+    out.grid.dims[a] = getU32(data + 8 + 4 * a);
+    if (out.grid.dims[a] < 1 || out.grid.dims[a] > kMaxGridDim) return error = "probe grid dimension out of range", false;
+    count *= out.grid.dims[a];
   }
   if (count > kMaxProbes) return error = "probe grid too large", false;
   for (int a = 0; a < 3; ++a) {
-    out.boundsMin[a] = getF32(data + 20 + 4 * a);
-    out.boundsMax[a] = getF32(data + 32 + 4 * a);
-    if (!std::isfinite(out.boundsMin[a]) || !std::isfinite(out.boundsMax[a])) return error = "non-finite bounds", false;
+    out.grid.bounds.min[a] = getF32(data + 20 + 4 * a);
+    out.grid.bounds.max[a] = getF32(data + 32 + 4 * a);
+    if (!std::isfinite(out.grid.bounds.min[a]) || !std::isfinite(out.grid.bounds.max[a])) return error = "non-finite bounds", false;
   }
   out.updates = getU32(data + 44);
   out.samplesPerProbe = getU32(data + 48);
@@ -82,6 +82,8 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
 }
 
 bool writeProbeFile(const std::string& path, const ProbeVolume& volume, std::string& error) {
+  if (volume.zh3PerPixel)
+    return error = path + ": a zh3h volume decoded L1-only (zh3PerPixel) cannot be stored as L2 samples", false;
   std::vector<uint8_t> bytes;
   serializeProbeVolume(volume, bytes);
   std::ofstream out(path, std::ios::binary);

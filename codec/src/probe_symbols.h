@@ -36,7 +36,7 @@ void quantizeProbe(Representation repr, const float probe[kProbeFloats], const P
                    ProbeSymbols* out);
 
 // Reconstructs the probe. Returns false if a symbol is outside its domain.
-bool dequantizeProbe(Representation repr, const ProbeSymbols& symbols, float probe[kProbeFloats], bool hallucinate);
+bool dequantizeProbe(Representation repr, const ProbeSymbols& symbols, float probe[kProbeFloats], bool zh3PerPixel);
 
 void symbolsToRecord(Representation repr, const ProbeSymbols& symbols, uint8_t* record);
 void recordToSymbols(Representation repr, const uint8_t* record, ProbeSymbols* symbols);

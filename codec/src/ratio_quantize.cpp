@@ -166,7 +166,7 @@ void quantizeProbe(Representation repr, const float input[kProbeFloats], const P
   }
 }
 
-bool dequantizeProbe(Representation repr, const ProbeSymbols& s, float probe[kProbeFloats], bool hallucinate) {
+bool dequantizeProbe(Representation repr, const ProbeSymbols& s, float probe[kProbeFloats], bool zh3PerPixel) {
   std::fill(probe, probe + kProbeFloats, 0.0f);
   if (repr == Representation::Fp16) {
     for (int i = 0; i < kProbeFloats; ++i) {
@@ -184,7 +184,7 @@ bool dequantizeProbe(Representation repr, const ProbeSymbols& s, float probe[kPr
   switch (repr) {
     case Representation::L1: break;
     case Representation::Zh3Hallucinated:
-      if (hallucinate) zh3HallucinateInPlace(probe);
+      if (!zh3PerPixel) zh3HallucinateInPlace(probe);
       break;
     case Representation::Zh3: {
       float axis[3];
@@ -216,10 +216,10 @@ void encodeProbeRecord(Representation repr, const float probe[kProbeFloats], uin
   symbolsToRecord(repr, symbols, out);
 }
 
-bool decodeProbeRecord(Representation repr, const uint8_t* in, float probe[kProbeFloats], bool hallucinate) {
+bool decodeProbeRecord(Representation repr, const uint8_t* in, float probe[kProbeFloats], bool zh3PerPixel) {
   ProbeSymbols symbols;
   recordToSymbols(repr, in, &symbols);
-  return dequantizeProbe(repr, symbols, probe, hallucinate);
+  return dequantizeProbe(repr, symbols, probe, zh3PerPixel);
 }
 
 }  // namespace probecast

@@ -11,7 +11,7 @@ namespace probecast {
 
 struct StreamDecoder::Impl {
   StreamLayout layout;
-  bool hallucinate = true;
+  bool zh3PerPixel = false;
   uint32_t lastFrame = 0;
   std::vector<ProbeSymbols> symbols;
   std::vector<uint8_t> active;
@@ -110,7 +110,7 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
     st.probes.assign(static_cast<size_t>(n) * kProbeFloats, 0.0f);
     for (uint32_t k = 0; k < n; ++k)
       if (st.active[k] && !dequantizeProbe(s.layout.repr, st.symbols[k], st.probes.data() + k * kProbeFloats,
-                                           s.hallucinate))
+                                           s.zh3PerPixel))
         return CodecStatus::BadSymbol;
     s.staged.push_back(std::move(st));
   }
@@ -136,6 +136,6 @@ uint32_t StreamDecoder::brickVersion(uint32_t brick) const { return impl_->versi
 uint32_t StreamDecoder::lastFrameSequence() const { return impl_->lastFrame; }
 const float* StreamDecoder::probes() const { return impl_->probes.data(); }
 const uint8_t* StreamDecoder::activeMask() const { return impl_->active.data(); }
-void StreamDecoder::setHallucinate(bool hallucinate) { impl_->hallucinate = hallucinate; }
+void StreamDecoder::setZh3PerPixel(bool zh3PerPixel) { impl_->zh3PerPixel = zh3PerPixel; }
 
 }  // namespace probecast

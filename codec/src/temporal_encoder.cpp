@@ -99,7 +99,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
       s.active[p] = s.nextActive[k];
       float decoded[kProbeFloats] = {};
       if (s.active[p]) {
-        const bool ok = dequantizeProbe(repr, s.next[k], decoded, true);
+        const bool ok = dequantizeProbe(repr, s.next[k], decoded, /*zh3PerPixel=*/false);
         assert(ok && "the encoder only makes valid symbols");
         (void)ok;
       }

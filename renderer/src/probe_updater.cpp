@@ -87,21 +87,15 @@ shaders::mat4 identity() {
 
 }  // namespace
 
-glm::vec3 ProbeGrid::position(uint32_t index) const {
-  const glm::uvec3 c(index % dims.x, (index / dims.x) % dims.y, index / (dims.x * dims.y));
-  glm::vec3 t;
-  for (int a = 0; a < 3; ++a) t[a] = dims[a] > 1 ? static_cast<float>(c[a]) / static_cast<float>(dims[a] - 1) : 0.5f;
-  return min + (max - min) * t;
+ProbeGrid sceneGrid(const scene::Scene& scene, const uint32_t dims[3]) {
+  return cellCentredGrid(dims, &scene.boundsMin.x, &scene.boundsMax.x);
 }
 
 struct ProbeUpdater::Impl {
   VulkanDevice* d = nullptr;
-  ProbeGrid grid;
+  ProbeVolume volume;  // grid, samples, active mask, updates
   UpdaterOptions options;
   uint32_t samples = 0;
-  uint32_t updates = 0;
-  std::vector<float> probes;
-  std::vector<uint8_t> active;
   std::vector<uint32_t> activeList;
   std::vector<uint32_t> blendCount;
   size_t geometryVertices = 0, geometryTriangles = 0;
@@ -117,10 +111,11 @@ struct ProbeUpdater::Impl {
     destroyBuffer(*d, partials);
     std::vector<shaders::vec4> data(list.size());
     for (size_t i = 0; i < list.size(); ++i) {
-      const glm::vec3 p = grid.position(list[i]);
+      float p[3];
+      volume.grid.position(list[i], p);
       float key;
       std::memcpy(&key, &list[i], sizeof key);  // the grid index as bits: the shader's RNG stream
-      data[i] = {p.x, p.y, p.z, key};
+      data[i] = {p[0], p[1], p[2], key};
     }
     probeList = createBufferWithData(*d, data.data(), data.size() * sizeof(shaders::vec4), kStorage);
     partials = createBuffer(*d, list.size() * kLanes * PT_PARTIAL_FLOATS * sizeof(float), kStorage);
@@ -136,7 +131,7 @@ struct ProbeUpdater::Impl {
     push.emitterPower = gpu.emitterPower;
     push.maxBounces = std::clamp<uint32_t>(options.maxBounces, 1, PT_MAX_BOUNCES_LIMIT);
     push.seed = options.seed;
-    push.updateIndex = updates;
+    push.updateIndex = volume.updates;
     push.mode = mode;
     push.indirectClamp = options.indirectClamp;
     const RayTracingInputs in{&gpu, &dirs, &probeList, &partials};
@@ -144,24 +139,25 @@ struct ProbeUpdater::Impl {
   }
 
   void classify() {
-    std::vector<uint32_t> all(grid.count());
+    std::vector<uint32_t> all(volume.count());
     std::iota(all.begin(), all.end(), 0u);
+    std::vector<uint8_t>& active = volume.active;
     std::fill(active.begin(), active.end(), 1);
     if (options.classify) {
       uploadProbeList(all);
       const uint32_t n = roundUpLanes(options.classifySamples);
-      dispatch(grid.count(), n, classifyDirections, PT_MODE_CLASSIFY, identity());
+      dispatch(volume.count(), n, classifyDirections, PT_MODE_CLASSIFY, identity());
       const float* part = static_cast<const float*>(partials.mapped);
-      for (uint32_t p = 0; p < grid.count(); ++p) {
+      for (uint32_t p = 0; p < volume.count(); ++p) {
         float back = 0.0f;
         for (uint32_t lane = 0; lane < kLanes; ++lane) back += part[(p * kLanes + lane) * PT_PARTIAL_FLOATS + 27];
         active[p] = back / static_cast<float>(n) > options.backFaceThreshold ? 0 : 1;
       }
     }
     activeList.clear();
-    for (uint32_t p = 0; p < grid.count(); ++p) {
+    for (uint32_t p = 0; p < volume.count(); ++p) {
       if (active[p]) activeList.push_back(p);
-      else std::fill(probes.begin() + p * 27, probes.begin() + (p + 1) * 27, 0.0f);
+      else std::fill_n(volume.probes.begin() + p * 27, 27, 0.0f);
     }
     uploadProbeList(activeList);
   }
@@ -180,11 +176,10 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   if (grid.count() == 0) throw std::invalid_argument("probe grid has no probes");
   Impl& s = *impl_;
   s.d = &context.device();
-  s.grid = grid;
   s.options = options;
   s.samples = roundUpLanes(options.samplesPerProbe);
-  s.probes.assign(static_cast<size_t>(grid.count()) * 27, 0.0f);
-  s.active.assign(grid.count(), 1);
+  s.volume = makeProbeVolume(grid);
+  s.volume.samplesPerProbe = s.samples;
   s.blendCount.assign(grid.count(), 0);
   createRayTracingPass(*s.d, kProbeTraceRgen, sizeof kProbeTraceRgen, sizeof(PtPushConstants), s.pass);
   const auto dirs = coherentFibonacci(s.samples);
@@ -222,7 +217,7 @@ UpdateStats ProbeUpdater::update() {
   stats.activeProbes = static_cast<uint32_t>(s.activeList.size());
   if (!s.activeList.empty()) {
     s.dispatch(static_cast<uint32_t>(s.activeList.size()), s.samples, s.directions, PT_MODE_TRACE,
-               randomRotation(s.options.seed, s.updates));
+               randomRotation(s.options.seed, s.volume.updates));
     // ĉ = (4π/S) Σ lanes, summed in a fixed order (deterministic), then c ← (1−w) c + w ĉ.
     const float* part = static_cast<const float*>(s.partials.mapped);
     const float scale = 4.0f * 3.14159265358979f / static_cast<float>(s.samples);
@@ -237,7 +232,7 @@ UpdateStats ProbeUpdater::update() {
       }
       const uint32_t n = ++s.blendCount[p];
       const float w = std::max(1.0f / static_cast<float>(n), s.options.minBlendWeight);
-      float* c = &s.probes[static_cast<size_t>(p) * 27];
+      float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
       for (int k = 0; k < 27; ++k) {
         const float fresh = sum[k] * scale;
         c[k] = std::isfinite(fresh) ? (1.0f - w) * c[k] + w * fresh : c[k];
@@ -245,16 +240,15 @@ UpdateStats ProbeUpdater::update() {
     }
     stats.paths = static_cast<uint64_t>(s.activeList.size()) * s.samples;
   }
-  ++s.updates;
+  ++s.volume.updates;
   stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return stats;
 }
 
-uint32_t ProbeUpdater::probeCount() const { return impl_->grid.count(); }
-uint32_t ProbeUpdater::updates() const { return impl_->updates; }
-const float* ProbeUpdater::probes() const { return impl_->probes.data(); }
-const uint8_t* ProbeUpdater::activeMask() const { return impl_->active.data(); }
-const ProbeGrid& ProbeUpdater::grid() const { return impl_->grid; }
+uint32_t ProbeUpdater::probeCount() const { return impl_->volume.count(); }
+uint32_t ProbeUpdater::updates() const { return impl_->volume.updates; }
+const ProbeVolume& ProbeUpdater::volume() const { return impl_->volume; }
+const ProbeGrid& ProbeUpdater::grid() const { return impl_->volume.grid; }
 
 uint64_t ProbeUpdater::deviceBytes() const {
   const Impl& s = *impl_;

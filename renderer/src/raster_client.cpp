@@ -11,7 +11,6 @@
 
 #include "gpu_scene.h"
 #include "probecast/renderer/glossy_sh.h"
-#include "probecast/renderer/probe_updater.h"
 #include "raster.frag.h"
 #include "raster.vert.h"
 #include "raster_shared.h"
@@ -19,65 +18,53 @@
 #include "vk_pipeline.h"
 
 namespace probecast::renderer {
-void fillInactiveProbes(ProbeVolumeData& v) {
-  const glm::uvec3 n = v.dims;
-  const size_t count = static_cast<size_t>(n.x) * n.y * n.z;
-  if (v.active.size() != count) return;
-  std::vector<uint8_t> known(v.active);
-  bool anyKnown = std::any_of(known.begin(), known.end(), [](uint8_t k) { return k != 0; });
-  if (!anyKnown) return;
-  for (bool changed = true; changed;) {
-    changed = false;
-    std::vector<uint8_t> next = known;
-    for (uint32_t z = 0; z < n.z; ++z)
-      for (uint32_t y = 0; y < n.y; ++y)
-        for (uint32_t x = 0; x < n.x; ++x) {
-          const size_t i = (static_cast<size_t>(z) * n.y + y) * n.x + x;
-          if (known[i]) continue;
-          float sum[27] = {};
-          int m = 0;
-          const int dx[6] = {-1, 1, 0, 0, 0, 0}, dy[6] = {0, 0, -1, 1, 0, 0}, dz[6] = {0, 0, 0, 0, -1, 1};
-          for (int k = 0; k < 6; ++k) {
-            const int xx = static_cast<int>(x) + dx[k], yy = static_cast<int>(y) + dy[k], zz = static_cast<int>(z) + dz[k];
-            if (xx < 0 || yy < 0 || zz < 0 || xx >= static_cast<int>(n.x) || yy >= static_cast<int>(n.y) ||
-                zz >= static_cast<int>(n.z))
-              continue;
-            const size_t j = (static_cast<size_t>(zz) * n.y + yy) * n.x + xx;
-            if (!known[j]) continue;
-            for (int c = 0; c < 27; ++c) sum[c] += v.probes[j * 27 + c];
-            ++m;
-          }
-          if (m == 0) continue;
-          for (int c = 0; c < 27; ++c) v.probes[i * 27 + c] = sum[c] / static_cast<float>(m);
-          next[i] = 1;
-          changed = true;
+namespace {
+
+// One pass of the fill: every unknown probe with known neighbours takes their mean. Returns
+// whether any probe became known.
+bool fillStep(const uint32_t n[3], float* probes, std::vector<uint8_t>& known) {
+  std::vector<uint8_t> next = known;
+  bool changed = false;
+  for (uint32_t z = 0; z < n[2]; ++z)
+    for (uint32_t y = 0; y < n[1]; ++y)
+      for (uint32_t x = 0; x < n[0]; ++x) {
+        const size_t i = (static_cast<size_t>(z) * n[1] + y) * n[0] + x;
+        if (known[i]) continue;
+        float sum[27] = {};
+        int m = 0;
+        const int dx[6] = {-1, 1, 0, 0, 0, 0}, dy[6] = {0, 0, -1, 1, 0, 0}, dz[6] = {0, 0, 0, 0, -1, 1};
+        for (int k = 0; k < 6; ++k) {
+          const int xx = static_cast<int>(x) + dx[k], yy = static_cast<int>(y) + dy[k], zz = static_cast<int>(z) + dz[k];
+          if (xx < 0 || yy < 0 || zz < 0 || xx >= static_cast<int>(n[0]) || yy >= static_cast<int>(n[1]) ||
+              zz >= static_cast<int>(n[2]))
+            continue;
+          const size_t j = (static_cast<size_t>(zz) * n[1] + yy) * n[0] + xx;
+          if (!known[j]) continue;
+          for (int c = 0; c < 27; ++c) sum[c] += probes[j * 27 + c];
+          ++m;
         }
-    known.swap(next);
+        if (m == 0) continue;
+        for (int c = 0; c < 27; ++c) probes[i * 27 + c] = sum[c] / static_cast<float>(m);
+        next[i] = 1;
+        changed = true;
+      }
+  known.swap(next);
+  return changed;
+}
+
+// fillInactiveProbes on `probes` (27 floats per probe of grid `n`, modified in place).
+void fillInactive(const uint32_t n[3], float* probes, const std::vector<uint8_t>& active) {
+  std::vector<uint8_t> known(active);
+  if (std::none_of(known.begin(), known.end(), [](uint8_t k) { return k != 0; })) return;
+  while (fillStep(n, probes, known)) {
   }
 }
 
-ProbeVolumeData volumeFromUpdater(const ProbeUpdater& updater) {
-  const ProbeGrid& g = updater.grid();
-  ProbeVolumeData v;
-  v.dims = g.dims;
-  v.min = g.min;
-  v.max = g.max;
-  v.probes.assign(updater.probes(), updater.probes() + static_cast<size_t>(g.count()) * kProbeFloats);
-  v.active.assign(updater.activeMask(), updater.activeMask() + g.count());
-  return v;
-}
+}  // namespace
 
-ProbeVolumeData decodeAs(const ProbeVolumeData& volume, Representation repr) {
-  ProbeVolumeData out = volume;
-  const bool l1Only = repr == Representation::Zh3Hallucinated;
-  out.hallucinateZh3 = l1Only;
-  uint8_t record[kMaxRecordBytes];
-  for (size_t p = 0; p * kProbeFloats < volume.probes.size(); ++p) {
-    float* probe = out.probes.data() + p * kProbeFloats;
-    encodeProbeRecord(repr, probe, record);
-    if (!decodeProbeRecord(repr, record, probe, !l1Only)) std::fill(probe, probe + kProbeFloats, 0.0f);
-  }
-  return out;
+void fillInactiveProbes(ProbeVolume& v) {
+  if (v.active.size() != v.count() || v.probes.size() != static_cast<size_t>(v.count()) * 27) return;
+  fillInactive(v.grid.dims, v.probes.data(), v.active);
 }
 
 namespace {
@@ -167,36 +154,58 @@ struct RasterRenderer::Impl {
   // filtering, dividing by the filtered weight renormalises over active probes only. Inactive
   // probes weigh kInactiveWeight (their filled value only shows where no active probe is near).
   static constexpr float kInactiveWeight = 1e-3f;
-  void uploadVolume(const glm::uvec3 dims, const std::vector<float>& probes, const std::vector<uint8_t>& active) {
+  uint32_t volumeDims[3] = {0, 0, 0};  // size of the probe textures and of `staging`
+  Buffer staging;                       // mapped; RS_PROBE_TEXTURES texels per probe, texture-major
+  std::vector<float> filled;            // a volume with inactive probes, filled (capacity kept)
+
+  // Probe textures and staging memory for a grid, kept across updates of the same size.
+  void ensureVolumeStorage(const uint32_t dims[3]) {
+    if (staging.buffer && std::equal(dims, dims + 3, volumeDims)) return;
     for (GpuImage& img : probeTextures) destroyImage(*d, img);
-    const size_t count = static_cast<size_t>(dims.x) * dims.y * dims.z;
-    Buffer staging = createBuffer(*d, count * 4 * sizeof(float) * RS_PROBE_TEXTURES, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    destroyBuffer(*d, staging);
+    const size_t count = static_cast<size_t>(dims[0]) * dims[1] * dims[2];
+    staging = createBuffer(*d, count * 4 * sizeof(float) * RS_PROBE_TEXTURES, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    for (GpuImage& img : probeTextures)
+      img = createImage(*d, VK_FORMAT_R32G32B32A32_SFLOAT, {dims[0], dims[1], dims[2]},
+                        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, true);
+    std::copy(dims, dims + 3, volumeDims);
+    writeDescriptors();
+  }
+
+  // Writes the volume straight into the staging memory (through `filled` only when some probes
+  // are inactive) and copies it into the textures.
+  void uploadVolume(const ProbeVolume& v) {
+    ensureVolumeStorage(v.grid.dims);
+    const size_t count = v.count();
+    const float* probes = v.probes.data();
+    if (std::any_of(v.active.begin(), v.active.end(), [](uint8_t a) { return a == 0; })) {
+      filled.assign(v.probes.begin(), v.probes.end());
+      fillInactive(v.grid.dims, filled.data(), v.active);
+      probes = filled.data();
+    }
     float* dst = static_cast<float*>(staging.mapped);
-    for (int t = 0; t < RS_PROBE_TEXTURES; ++t)
-      for (size_t p = 0; p < count; ++p)
+    for (size_t p = 0; p < count; ++p) {
+      const float weight = v.active[p] ? 1.0f : kInactiveWeight;
+      const float* src = probes + p * 27;
+      for (int t = 0; t < RS_PROBE_TEXTURES; ++t)
         for (int c = 0; c < 4; ++c) {
           const int k = 4 * t + c;
-          const float weight = active.empty() || active[p] ? 1.0f : kInactiveWeight;
-          dst[(static_cast<size_t>(t) * count + p) * 4 + c] = k < 27 ? weight * probes[p * 27 + k] : weight;
+          dst[(static_cast<size_t>(t) * count + p) * 4 + c] = k < 27 ? weight * src[k] : weight;
         }
-    for (GpuImage& img : probeTextures)
-      img = createImage(*d, VK_FORMAT_R32G32B32A32_SFLOAT, {dims.x, dims.y, dims.z},
-                        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, true);
+    }
     submitAndWait(*d, [&](VkCommandBuffer cmd) {
       for (int t = 0; t < RS_PROBE_TEXTURES; ++t) {
         transitionImage(cmd, probeTextures[t], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
         VkBufferImageCopy region{};
         region.bufferOffset = static_cast<VkDeviceSize>(t) * count * 4 * sizeof(float);
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {dims.x, dims.y, dims.z};
+        region.imageExtent = {v.grid.dims[0], v.grid.dims[1], v.grid.dims[2]};
         vkCmdCopyBufferToImage(cmd, staging.buffer, probeTextures[t].image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
                                &region);
         transitionImage(cmd, probeTextures[t], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
       }
     });
-    destroyBuffer(*d, staging);
-    writeDescriptors();
   }
 
   void drawScene(VkCommandBuffer cmd) {
@@ -362,7 +371,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.push.shadowMapSize = options.shadowMapSize;
   s.push.lightCount = s.gpu.lightCount;
   // No volume yet: a 1³ black one keeps every descriptor valid (and writes them all).
-  s.uploadVolume(glm::uvec3(1), std::vector<float>(27, 0.0f), {});
+  ProbeGrid one;
+  one.dims[0] = one.dims[1] = one.dims[2] = 1;
+  s.uploadVolume(makeProbeVolume(one));
 }
 
 RasterRenderer::~RasterRenderer() {
@@ -370,6 +381,7 @@ RasterRenderer::~RasterRenderer() {
   VulkanDevice& d = *s.d;
   vkDeviceWaitIdle(d.device);
   for (GpuImage& img : s.probeTextures) destroyImage(d, img);
+  destroyBuffer(d, s.staging);
   for (GpuImage* img : {&s.envBrdf, &s.color, &s.depth}) destroyImage(d, *img);
   for (Buffer* b : {&s.readback, &s.views}) destroyBuffer(d, *b);
   destroyShadowMaps(d, s.shadows);
@@ -382,27 +394,16 @@ RasterRenderer::~RasterRenderer() {
   if (s.setLayout) vkDestroyDescriptorSetLayout(d.device, s.setLayout, nullptr);
 }
 
-void RasterRenderer::setProbes(const ProbeVolumeData& volume) {
-  const size_t count = static_cast<size_t>(volume.dims.x) * volume.dims.y * volume.dims.z;
-  if (count == 0 || volume.probes.size() != count * 27) throw std::invalid_argument("probe volume size mismatch");
-  if (!volume.active.empty() && volume.active.size() != count)
-    throw std::invalid_argument("probe volume: active mask of " + std::to_string(volume.active.size()) +
-                                " entries for " + std::to_string(count) + " probes");
-  for (int a = 0; a < 3; ++a)
-    if (!std::isfinite(volume.min[a]) || !std::isfinite(volume.max[a]) ||
-        (volume.dims[a] > 1 && !(volume.max[a] > volume.min[a])))
-      throw std::invalid_argument("probe volume bounds must be finite with max > min along every axis of 2+ probes");
-  for (size_t i = 0; i < volume.probes.size(); ++i)
-    if (!std::isfinite(volume.probes[i]))
-      throw std::invalid_argument("probe volume: non-finite coefficient at probe " + std::to_string(i / 27) +
-                                  " (the codec and probe files never produce one; sanitise first)");
-  ProbeVolumeData filled = volume;
-  fillInactiveProbes(filled);
-  impl_->uploadVolume(volume.dims, filled.probes, volume.active);
-  impl_->push.volumeMin = {volume.min.x, volume.min.y, volume.min.z, 1.0f};
-  impl_->push.volumeMax = {volume.max.x, volume.max.y, volume.max.z, 0.0f};
-  impl_->push.volumeDims = {static_cast<float>(volume.dims.x), static_cast<float>(volume.dims.y),
-                            static_cast<float>(volume.dims.z), volume.hallucinateZh3 ? 1.0f : 0.0f};
+void RasterRenderer::setProbes(const ProbeVolume& volume) {
+  std::string error;
+  if (!checkProbeVolume(volume, error)) throw std::invalid_argument(error);
+  impl_->uploadVolume(volume);
+  const GridBounds& b = volume.grid.bounds;
+  const uint32_t* n = volume.grid.dims;
+  impl_->push.volumeMin = {b.min[0], b.min[1], b.min[2], 1.0f};
+  impl_->push.volumeMax = {b.max[0], b.max[1], b.max[2], 0.0f};
+  impl_->push.volumeDims = {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2]),
+                            volume.zh3PerPixel ? 1.0f : 0.0f};
 }
 
 void RasterRenderer::setShading(const scene::Scene& scene) {

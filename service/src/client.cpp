@@ -73,7 +73,7 @@ struct ProbeClient::Impl {
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
     if (!same || v.stream_epoch() != epoch) {  // nothing held is valid
       decoder = std::make_unique<StreamDecoder>(l);
-      decoder->setHallucinate(!config.interpolateThenHallucinate);
+      decoder->setZh3PerPixel(config.zh3PerPixel);
     }
     layout = l;
     bounds = b;
@@ -236,10 +236,12 @@ bool ProbeClient::snapshot(VolumeSnapshot& out) const {
   if (!impl_->decoder) return false;
   const uint32_t n = probeCount(impl_->layout);
   out.layout = impl_->layout;
-  out.bounds = impl_->bounds;
-  out.probes.assign(impl_->decoder->probes(), impl_->decoder->probes() + static_cast<size_t>(n) * kProbeFloats);
-  out.active.assign(impl_->decoder->activeMask(), impl_->decoder->activeMask() + n);
-  out.l1Only = impl_->config.interpolateThenHallucinate && out.layout.repr == Representation::Zh3Hallucinated;
+  ProbeVolume& v = out.volume;
+  v.grid = gridOf(impl_->layout, impl_->bounds);
+  v.probes.assign(impl_->decoder->probes(), impl_->decoder->probes() + static_cast<size_t>(n) * kProbeFloats);
+  v.active.assign(impl_->decoder->activeMask(), impl_->decoder->activeMask() + n);
+  v.decodedFrom = impl_->layout.repr;
+  v.zh3PerPixel = impl_->config.zh3PerPixel && impl_->layout.repr == Representation::Zh3Hallucinated;
   out.framesApplied = impl_->stats.framesApplied;
   out.newestServerTimeUs = impl_->newestServerTimeUs;
   return true;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 
 namespace probecast::service {
 namespace {
@@ -20,6 +21,23 @@ uint64_t randomEpoch() {
 
 ProbeHub::ProbeHub(const HubConfig& config)
     : config_(config), epoch_(randomEpoch()), encoder_(config.layout, config.encoder) {}
+
+HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, uint8_t brickDim) {
+  HubConfig c;
+  c.layout = streamLayoutFor(grid, repr, brickDim);
+  c.bounds = grid.bounds;
+  return c;
+}
+
+void ProbeHub::publish(const ProbeVolume& volume) {
+  for (int a = 0; a < 3; ++a)
+    if (volume.grid.dims[a] != config_.layout.grid[a])
+      throw std::invalid_argument("published volume's grid differs from the hub's");
+  if (volume.probes.size() != static_cast<size_t>(probeCount(config_.layout)) * kProbeFloats ||
+      (!volume.active.empty() && volume.active.size() != probeCount(config_.layout)))
+    throw std::invalid_argument("published volume's sizes do not match its grid");
+  publish(volume.probes.data(), volume.active.empty() ? nullptr : volume.active.data());
+}
 
 void ProbeHub::publish(const float* probes, const uint8_t* active) {
   std::vector<std::function<void()>> wakes;
@@ -209,11 +227,15 @@ SubscriberStats ProbeHub::stats(uint64_t id) const {
   return it == subscribers_.end() ? SubscriberStats{} : it->second.stats;
 }
 
-void ProbeHub::reconstruction(std::vector<float>& probes, std::vector<uint8_t>& active) const {
+ProbeVolume ProbeHub::reconstruction() const {
   std::lock_guard<std::mutex> lock(mutex_);
   const uint32_t n = probeCount(config_.layout);
-  probes.assign(encoder_.reconstruction(), encoder_.reconstruction() + static_cast<size_t>(n) * kProbeFloats);
-  active.assign(encoder_.activeMask(), encoder_.activeMask() + n);
+  ProbeVolume v;
+  v.grid = gridOf(config_.layout, config_.bounds);
+  v.probes.assign(encoder_.reconstruction(), encoder_.reconstruction() + static_cast<size_t>(n) * kProbeFloats);
+  v.active.assign(encoder_.activeMask(), encoder_.activeMask() + n);
+  v.decodedFrom = config_.layout.repr;
+  return v;
 }
 
 }  // namespace probecast::service

@@ -12,11 +12,6 @@
 
 namespace probecast {
 
-struct GridBounds {
-  float min[3] = {0, 0, 0};  // position of probe (0, 0, 0)
-  float max[3] = {1, 1, 1};  // position of probe (nx-1, ny-1, nz-1)
-};
-
 struct View {
   float viewProj[16];
   float eye[3];

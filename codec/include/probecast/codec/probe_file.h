@@ -11,23 +11,15 @@
 #include <string>
 #include <vector>
 
-namespace probecast {
+#include "probecast/codec/probe_volume.h"
 
-struct ProbeVolume {
-  uint32_t dims[3] = {0, 0, 0};
-  float boundsMin[3] = {0, 0, 0};
-  float boundsMax[3] = {0, 0, 0};
-  uint32_t updates = 0;
-  uint32_t samplesPerProbe = 0;
-  std::vector<float> probes;    // 27 floats per probe
-  std::vector<uint8_t> active;  // 1 = active
-  uint32_t count() const { return dims[0] * dims[1] * dims[2]; }
-};
+namespace probecast {
 
 void serializeProbeVolume(const ProbeVolume& volume, std::vector<uint8_t>& out);
 // Checks magic, version, sizes, checksum and that every value is finite; `error` says what failed.
 bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& volume, std::string& error);
 
+// Refuses a zh3PerPixel volume (L1 only): a file's samples are read back as full L2.
 bool writeProbeFile(const std::string& path, const ProbeVolume& volume, std::string& error);
 bool readProbeFile(const std::string& path, ProbeVolume& volume, std::string& error);
 

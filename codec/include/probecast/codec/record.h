@@ -63,10 +63,11 @@ constexpr float kBoundL2ZeroHi = 2.2360680f;   // √5, m = 0 and ZH3 zonal uppe
 // Closed loop: ratios are taken against the DC the decoder will reconstruct.
 void encodeProbeRecord(Representation repr, const float probe[kProbeFloats], uint8_t* out);
 
-// Decodes one record into 27 floats. For zh3h, `hallucinate` chooses between the hallucinated
-// L2 band (true) and plain L1 with a zero L2 band (false, for interpolating before hallucination).
+// Decodes one record into 27 floats. For zh3h, `zh3PerPixel` chooses between the hallucinated
+// L2 band (false) and plain L1 with a zero L2 band (true, for a renderer that interpolates first
+// and hallucinates per pixel; ProbeVolume::zh3PerPixel).
 // Returns false only for fp16 records holding Inf or NaN (ratio records always decode).
-bool decodeProbeRecord(Representation repr, const uint8_t* in, float probe[kProbeFloats], bool hallucinate = true);
+bool decodeProbeRecord(Representation repr, const uint8_t* in, float probe[kProbeFloats], bool zh3PerPixel = false);
 
 // Replaces non-finite values as documented above (NaN -> 0, ±Inf -> ±FLT_MAX).
 void sanitizeProbe(float probe[kProbeFloats]);

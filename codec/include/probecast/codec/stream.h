@@ -30,6 +30,7 @@
 #include <span>
 #include <vector>
 
+#include "probecast/codec/probe_volume.h"
 #include "probecast/codec/record.h"
 #include "probecast/codec/status.h"
 
@@ -52,6 +53,10 @@ struct StreamLayout {
 };
 
 bool isValidLayout(const StreamLayout& layout);
+// The stream layout of a probe grid; check it with isValidLayout (a grid may be too large).
+StreamLayout streamLayoutFor(const ProbeGrid& grid, Representation repr, uint8_t brickDim);
+// The probe grid a stream layout and its bounds describe.
+ProbeGrid gridOf(const StreamLayout& layout, const GridBounds& bounds);
 uint32_t probeCount(const StreamLayout& layout);
 uint32_t brickCount(const StreamLayout& layout);
 void brickGridSize(const StreamLayout& layout, uint32_t counts[3]);
@@ -138,8 +143,9 @@ class StreamDecoder {
   uint32_t lastFrameSequence() const;
   const float* probes() const;      // 27 floats per probe, 0 for inactive probes
   const uint8_t* activeMask() const;  // 1 = active
-  // zh3h only: decode L1 without hallucination (for interpolate-then-hallucinate).
-  void setHallucinate(bool hallucinate);
+  // zh3h only: true decodes L1 with a zero L2 band, for a renderer that hallucinates ZH3 per
+  // pixel (ProbeVolume::zh3PerPixel); false (the default) hallucinates per probe.
+  void setZh3PerPixel(bool zh3PerPixel);
 
  private:
   struct Impl;

@@ -3,28 +3,22 @@
 // Per update, every active probe traces S paths over a spherical Fibonacci set rotated by a fresh
 // random rotation; path radiance is projected ĉ = (4π/S) Σ L(ω) Y(ω) and blended into the probe
 // with w = max(1/n, w_min). Probes whose rays see back faces too often are inside geometry: they
-// are inactive, get no rays and stay zero. Output uses the codec's probe layout (sh.h): 27 floats
-// per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
+// are inactive, get no rays and stay zero. Output is the codec's ProbeVolume (probe_volume.h): 27
+// floats per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include <glm/glm.hpp>
-
+#include "probecast/codec/probe_volume.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::renderer {
 
-struct ProbeGrid {
-  glm::vec3 min{-1.0f};  // position of probe (0, 0, 0), metres
-  glm::vec3 max{1.0f};   // position of probe (nx-1, ny-1, nz-1)
-  glm::uvec3 dims{4u};
-  uint32_t count() const { return dims.x * dims.y * dims.z; }
-  glm::vec3 position(uint32_t index) const;
-};
+// The default grid of a scene: dims probes at the centres of the cells of a grid over its bounds.
+ProbeGrid sceneGrid(const scene::Scene& scene, const uint32_t dims[3]);
 
 struct UpdaterOptions {
   uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32
@@ -60,8 +54,8 @@ class ProbeUpdater {
 
   uint32_t probeCount() const;
   uint32_t updates() const;
-  const float* probes() const;        // 27 floats per probe
-  const uint8_t* activeMask() const;  // 1 = active
+  // The probes as traced so far (float samples; `updates` and `samplesPerProbe` filled in).
+  const ProbeVolume& volume() const;
   const ProbeGrid& grid() const;
   // Device memory this updater holds (buffers and acceleration structures), bytes: it grows with
   // the probe count, not with probes × samples.

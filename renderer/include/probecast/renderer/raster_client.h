@@ -13,32 +13,13 @@
 
 #include <glm/glm.hpp>
 
-#include "probecast/codec/record.h"
+#include "probecast/codec/probe_volume.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::renderer {
-
-struct ProbeVolumeData {
-  glm::uvec3 dims{0};
-  glm::vec3 min{0.0f};            // position of probe (0,0,0), metres
-  glm::vec3 max{0.0f};            // position of the last probe
-  std::vector<float> probes;      // 27 floats per probe, sh.h layout (radiance)
-  std::vector<uint8_t> active;    // 1 = active; empty = all active
-  // zh3h decoded without hallucination: the L2 band is empty and the shader hallucinates ZH3 per
-  // pixel from the interpolated L1 (interpolate, then hallucinate).
-  bool hallucinateZh3 = false;
-};
-
-class ProbeUpdater;
-// The updater's current probes and active mask as a volume.
-ProbeVolumeData volumeFromUpdater(const ProbeUpdater& updater);
-
-// The volume as a viewer holds it after the codec: every probe through a `repr` record and back.
-// zh3h decodes L1 only and sets hallucinateZh3; zh3 expands to SH3 here, before upload.
-ProbeVolumeData decodeAs(const ProbeVolumeData& volume, Representation repr);
 
 enum class ViewPasses {
   PerView,    // one render pass per view (views of a chunk share one submission)
@@ -59,7 +40,7 @@ struct RasterTimings {
 
 // Replaces inactive probes by the mean of their active neighbours, growing outwards until every
 // probe has a value (so trilinear filtering never blends in zeros from inside walls).
-void fillInactiveProbes(ProbeVolumeData& volume);
+void fillInactiveProbes(ProbeVolume& volume);
 
 class RasterRenderer {
  public:
@@ -69,9 +50,11 @@ class RasterRenderer {
   RasterRenderer(const RasterRenderer&) = delete;
   RasterRenderer& operator=(const RasterRenderer&) = delete;
 
-  // Throws std::invalid_argument (and keeps the previous volume) for a volume whose size, mask or
-  // bounds do not add up, or that holds a non-finite coefficient.
-  void setProbes(const ProbeVolumeData& volume);
+  // Uploads a volume (checkProbeVolume's rules) into 3D textures kept across updates (re-created
+  // only when the grid's size changes). zh3PerPixel: the shader hallucinates ZH3 after
+  // interpolating; zh3 is expected expanded to SH3 already (as the codec decodes it).
+  // Throws std::invalid_argument (and keeps the previous volume) for a volume that fails the check.
+  void setProbes(const ProbeVolume& volume);
   // The same geometry with new lights or materials (an animated scene); shadows are redrawn.
   void setShading(const scene::Scene& scene);
   // Renders a view set; images in the order of `views`.

@@ -23,17 +23,14 @@ struct ClientConfig {
   std::string name = "probecast-client";
   int reconnectMinMs = 50;
   int reconnectMaxMs = 2000;
-  // zh3h streams: keep L1 only in the volume (VolumeSnapshot::l1Only) so a renderer can
-  // interpolate first and hallucinate per pixel; false: hallucinate per probe when decoding.
-  bool interpolateThenHallucinate = false;
+  // zh3h streams: decode L1 only (ProbeVolume::zh3PerPixel) so a renderer can interpolate first
+  // and hallucinate per pixel; false: hallucinate per probe when decoding.
+  bool zh3PerPixel = false;
 };
 
 struct VolumeSnapshot {
-  StreamLayout layout;
-  GridBounds bounds;
-  std::vector<float> probes;    // 27 floats per probe (sh.h layout), last good volume
-  std::vector<uint8_t> active;
-  bool l1Only = false;          // zh3h decoded without its hallucinated L2 band (see ClientConfig)
+  ProbeVolume volume;           // the last good volume (decodedFrom: the stream's representation)
+  StreamLayout layout;          // the stream's grid, brick edge and representation
   uint32_t framesApplied = 0;
   uint64_t newestServerTimeUs = 0;
 };
@@ -64,7 +61,7 @@ class ProbeClient {
   void stop();
   // Replaces the views sent to the server (now, and again after every reconnect).
   void setViews(std::vector<View> views);
-  // Copies the current volume; false until a volume description has arrived.
+  // Copies the current volume (into `out`'s storage); false until a volume description has arrived.
   bool snapshot(VolumeSnapshot& out) const;
   ClientStats stats() const;
   // Cuts the current connection (as a network fault would); the client reconnects and resumes.

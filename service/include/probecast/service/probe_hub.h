@@ -30,6 +30,10 @@ struct HubConfig {
   double burstSeconds = 1.0;  // a subscriber's budget bucket holds this many seconds of bytes
 };
 
+// The hub of a probe grid streamed as `repr` in bricks of brickDim³ probes; check the layout
+// with isValidLayout (a grid can be too large for the stream format).
+HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, uint8_t brickDim = 4);
+
 struct HeldBrick {
   uint32_t brick = 0;
   uint32_t version = 0;
@@ -62,6 +66,8 @@ class ProbeHub {
   // A new lighting frame (27 floats per probe, sh.h layout; active mask or null). Each changed
   // brick gets a new version, encoded once. Wakes subscribers that wait for data.
   void publish(const float* probes, const uint8_t* active);
+  // The same for a volume, which must have the hub's grid size (std::invalid_argument otherwise).
+  void publish(const ProbeVolume& volume);
   // Wakes subscribers whose budget has refilled (call at the producer's rate when nothing changes).
   void tick();
   uint32_t serverFrame() const;
@@ -82,8 +88,9 @@ class ProbeHub {
   // never sent or one that goes backwards: the client is broken and its stream should end.
   bool acknowledge(uint64_t id, uint32_t sequence, std::string& why);
 
-  // The volume every subscriber converges to (the encoder's reconstruction), for tests and tools.
-  void reconstruction(std::vector<float>& probes, std::vector<uint8_t>& active) const;
+  // The volume every subscriber converges to (the encoder's reconstruction, zh3h hallucinated per
+  // probe), for tests and tools.
+  ProbeVolume reconstruction() const;
 
  private:
   struct Subscriber {

@@ -1,0 +1,68 @@
+// One probe volume along the whole path: what the updater traces, the hub publishes, a client's
+// snapshot holds, the raster client uploads and probe files store.
+//
+// Grid: dims[0] × dims[1] × dims[2] probes, probe (x, y, z) at index x + nx (y + ny z), spaced
+// evenly from bounds.min (probe (0, 0, 0)) to bounds.max (probe (nx-1, ny-1, nz-1)), metres; an
+// axis of one probe puts it midway. Samples: 27 floats per probe in the sh.h layout (L2 SH of
+// incident radiance, coefficient-major RGB, no Condon-Shortley phase) and one active byte per
+// probe (1 = active, 0 = inside geometry: never sent, never interpolated from).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "probecast/codec/record.h"
+
+namespace probecast {
+
+struct GridBounds {
+  float min[3] = {0, 0, 0};  // position of probe (0, 0, 0), metres
+  float max[3] = {1, 1, 1};  // position of probe (nx-1, ny-1, nz-1)
+};
+
+struct ProbeGrid {
+  uint32_t dims[3] = {4, 4, 4};  // probes along x, y, z
+  GridBounds bounds{{-1, -1, -1}, {1, 1, 1}};
+  uint32_t count() const { return dims[0] * dims[1] * dims[2]; }
+  // Position of the probe at `index`, metres.
+  void position(uint32_t index, float out[3]) const;
+};
+
+// The default grid over a box [lo, hi] (a scene's bounds): the probes sit at the centres of the
+// cells of a dims[0] × dims[1] × dims[2] grid over the box, half a cell in from every face.
+ProbeGrid cellCentredGrid(const uint32_t dims[3], const float lo[3], const float hi[3]);
+
+struct ProbeVolume {
+  ProbeGrid grid;
+  std::vector<float> probes;    // 27 floats per probe
+  std::vector<uint8_t> active;  // one per probe, 1 = active
+  // What the samples are: float L2 as traced (nullopt), or what records of this representation
+  // decode to (decodeAs, a stream decoder).
+  std::optional<Representation> decodedFrom;
+  // zh3h only: the samples hold L1 with a zero L2 band, and the renderer hallucinates ZH3 per
+  // pixel after interpolating (interpolate, then hallucinate). False: the L2 band holds what the
+  // codec decoded (for zh3h, hallucinated per probe). Same name and meaning in ClientConfig,
+  // StreamDecoder and decodeProbeRecord.
+  bool zh3PerPixel = false;
+  uint32_t updates = 0;          // updates accumulated into the samples (0 = unknown)
+  uint32_t samplesPerProbe = 0;  // paths per probe per update (0 = unknown)
+
+  uint32_t count() const { return grid.count(); }
+};
+
+// An empty volume of `grid` (every probe zero and active).
+ProbeVolume makeProbeVolume(const ProbeGrid& grid);
+
+// Checks what every consumer relies on: 1 to kMaxGridDim probes per axis and at most kMaxProbes,
+// finite bounds with max > min along every axis of two or more probes, 27 floats and one active
+// byte (0 or 1) per probe, every coefficient finite. False with the reason in `error`.
+bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
+
+// The volume as a viewer holds it after the codec: every probe through a `repr` record and back
+// (inactive probes too, as the raster client fills them from neighbours anyway). For zh3h,
+// `zh3PerPixel` chooses L1 only (true, the raster client's default) or per-probe hallucination.
+ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel = true);
+
+}  // namespace probecast

@@ -1,0 +1,97 @@
+// The probe volume every module shares (probe_volume.h): the default grid rule, checks, and the
+// codec round trip with its one zh3h flag.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "probecast/codec/probe_volume.h"
+#include "probecast/codec/stream.h"
+#include "probecast/codec/zh3.h"
+#include "test_probes.h"
+
+namespace probecast {
+namespace {
+
+TEST(ProbeVolume, CellCentredGridPutsProbesHalfACellInsideTheBox) {
+  // A 4 m box split into 4 cells along x: centres at 0.5, 1.5, 2.5, 3.5; one probe on y sits at
+  // the box's middle; 2 cells on z over [-1, 1]: -0.5 and 0.5.
+  const uint32_t dims[3] = {4, 1, 2};
+  const float lo[3] = {0, 0, -1}, hi[3] = {4, 2, 1};
+  const ProbeGrid g = cellCentredGrid(dims, lo, hi);
+  EXPECT_FLOAT_EQ(g.bounds.min[0], 0.5f);
+  EXPECT_FLOAT_EQ(g.bounds.max[0], 3.5f);
+  EXPECT_FLOAT_EQ(g.bounds.min[1], 1.0f);
+  EXPECT_FLOAT_EQ(g.bounds.max[1], 1.0f);
+  EXPECT_FLOAT_EQ(g.bounds.min[2], -0.5f);
+  EXPECT_FLOAT_EQ(g.bounds.max[2], 0.5f);
+  float p[3];
+  g.position(1 + 4 * (0 + 1 * 1), p);  // probe (1, 0, 1)
+  EXPECT_FLOAT_EQ(p[0], 1.5f);
+  EXPECT_FLOAT_EQ(p[1], 1.0f);
+  EXPECT_FLOAT_EQ(p[2], 0.5f);
+}
+
+TEST(ProbeVolume, CheckRefusesWhatNoConsumerCanUse) {
+  const ProbeVolume good = makeProbeVolume(ProbeGrid{{2, 2, 1}, {{0, 0, 0}, {1, 1, 0}}});
+  std::string error;
+  EXPECT_TRUE(checkProbeVolume(good, error)) << error;
+  ProbeVolume v = good;
+  v.probes[5] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  EXPECT_NE(error.find("non-finite"), std::string::npos);
+  v = good;
+  v.active.pop_back();
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  v = good;
+  v.active[0] = 7;
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  v = good;
+  v.grid.bounds.max[0] = v.grid.bounds.min[0];  // two probes on one spot
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  v = good;
+  v.grid.bounds.min[1] = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  v = good;
+  v.probes.push_back(0.0f);
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  v = good;
+  v.grid.dims[2] = 0;
+  EXPECT_FALSE(checkProbeVolume(v, error));
+}
+
+TEST(ProbeVolume, StreamLayoutOfAHugeGridIsInvalidNotWrapped) {
+  ProbeGrid g{{65536 + 4, 4, 4}, {{0, 0, 0}, {1, 1, 1}}};  // 65540 would wrap to 4 in 16 bits
+  EXPECT_FALSE(isValidLayout(streamLayoutFor(g, Representation::L1, 4)));
+  g.dims[0] = 4;
+  const StreamLayout layout = streamLayoutFor(g, Representation::Zh3, 2);
+  EXPECT_TRUE(isValidLayout(layout));
+  const ProbeGrid back = gridOf(layout, g.bounds);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(back.dims[a], g.dims[a]);
+}
+
+TEST(ProbeVolume, DecodeAsZh3hChoosesPerPixelOrPerProbeHallucination) {
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{1, 1, 1}, {{0, 0, 0}, {0, 0, 0}}});
+  std::mt19937 rng(5);
+  const test::Probe probe = test::randomNonNegativeProbe(rng, 3, 0.2f);
+  std::copy(probe.begin(), probe.end(), v.probes.begin());
+  const ProbeVolume perPixel = decodeAs(v, Representation::Zh3Hallucinated);
+  EXPECT_TRUE(perPixel.zh3PerPixel);
+  ASSERT_TRUE(perPixel.decodedFrom.has_value());
+  EXPECT_EQ(*perPixel.decodedFrom, Representation::Zh3Hallucinated);
+  for (int k = 12; k < kProbeFloats; ++k) EXPECT_EQ(perPixel.probes[k], 0.0f) << k;  // L2 band left to the shader
+  const ProbeVolume perProbe = decodeAs(v, Representation::Zh3Hallucinated, false);
+  EXPECT_FALSE(perProbe.zh3PerPixel);
+  // Per probe: the hallucinated L2 band of the decoded L1, exactly as zh3.h makes it.
+  std::vector<float> expected(perPixel.probes);
+  zh3HallucinateInPlace(expected.data());
+  for (int k = 0; k < kProbeFloats; ++k) EXPECT_EQ(perProbe.probes[k], expected[k]) << k;
+  double l2 = 0;
+  for (int k = 12; k < kProbeFloats; ++k) l2 += std::fabs(perProbe.probes[k]);
+  EXPECT_GT(l2, 0.0);
+  // Other representations never take the flag.
+  EXPECT_FALSE(decodeAs(v, Representation::L2).zh3PerPixel);
+}
+
+}  // namespace
+}  // namespace probecast
