@@ -2,7 +2,7 @@
 # One entry point for a new machine: installs what is missing (Debian 12), builds, and runs.
 #   scripts/dev.sh demo          build, then run `probecast demo` (writes out/)
 #   scripts/dev.sh test          build, then run the whole test suite (ctest)
-#   scripts/dev.sh core-test     the Vulkan-free build (codec, service, their tests) in build-core, and its tests
+#   scripts/dev.sh core-test     the Vulkan-free build (codec, imaging, service, their tests) in build-core, and its tests
 #   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec tests under it
 #   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec
 set -euo pipefail
