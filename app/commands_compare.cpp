@@ -2,8 +2,8 @@
 #include <fmt/format.h>
 
 #include "commands.h"
-#include "image_io.h"
-#include "image_metrics.h"
+#include "probecast/imaging/image_io.h"
+#include "probecast/imaging/image_metrics.h"
 
 namespace probecast::app {
 
@@ -23,15 +23,15 @@ void addCompareCommand(CLI::App& app, int& exitCode) {
     std::vector<float> a, b;
     int wa = 0, ha = 0, wb = 0, hb = 0;
     std::string error;
-    if (!bench::readExr(o->test, a, wa, ha, error) || !bench::readExr(o->reference, b, wb, hb, error))
+    if (!imaging::readExr(o->test, a, wa, ha, error) || !imaging::readExr(o->reference, b, wb, hb, error))
       throw std::runtime_error(error);
     if (wa != wb || ha != hb)
       throw std::runtime_error(fmt::format("sizes differ: {}x{} against {}x{}", wa, ha, wb, hb));
-    const bench::ImageMetrics m = bench::compareImages(a, b, wa, ha);
+    const imaging::ImageMetrics m = imaging::compareImages(a, b, wa, ha);
     fmt::print("PSNR {:.2f} dB, SSIM {:.4f} (both after plain gamma 2.2, no clamping; SSIM on luminance)\n", m.psnrDb,
                m.ssim);
     if (!o->diff.empty()) {
-      if (!bench::writeDifferencePng(o->diff, a, b, wa, ha, o->scale, error)) throw std::runtime_error(error);
+      if (!imaging::writeDifferencePng(o->diff, a, b, wa, ha, o->scale, error)) throw std::runtime_error(error);
       fmt::print("wrote {}\n", o->diff);
     }
     if (!o->json.empty()) {

@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "commands.h"
-#include "image_io.h"
-#include "image_metrics.h"
+#include "probecast/imaging/image_io.h"
+#include "probecast/imaging/image_metrics.h"
 #include "pipeline_bench.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/reference_camera.h"
@@ -25,7 +25,7 @@
 #include "probecast/service/server.h"
 #include "scene_options.h"
 #include "stability.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 #include "view_support.h"
 
 namespace probecast::app {
@@ -59,7 +59,7 @@ struct Viewer {
   std::vector<renderer::Image> images;
   uint32_t framesSeen = 0, renders = 0;
   std::vector<double> renderMsPerView;
-  std::vector<bench::ChartPoint> bandwidth;  // (seconds, bytes/s over the last interval)
+  std::vector<imaging::ChartPoint> bandwidth;  // (seconds, bytes/s over the last interval)
   std::vector<size_t> referenceViews;        // the views compared with the reference tracer
   uint64_t lastBytes = 0;
 };
@@ -81,7 +81,7 @@ scene::Scene sceneAt(const std::string& spec, float t) {
 
 void writePng(const std::string& path, const renderer::Image& img) {
   std::string error;
-  if (!bench::writePngPreview(path, img.rgb, static_cast<int>(img.width), static_cast<int>(img.height), 1.0f, error))
+  if (!imaging::writePngPreview(path, img.rgb, static_cast<int>(img.width), static_cast<int>(img.height), 1.0f, error))
     throw std::runtime_error(error);
 }
 
@@ -413,7 +413,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
     report["moments"] = moments;
     report["server_device"] = serverContext.deviceName();
     report["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
-    std::vector<bench::ChartSeries> bandwidthSeries, psnrSeries;
+    std::vector<imaging::ChartSeries> bandwidthSeries, psnrSeries;
     // Every view of the headset; the corners and the centre of a light field (a reference costs
     // seconds per view here). Views without a reference stay black in the reference quilt.
     uint32_t referencesDone = 0, referencesTotal = 1;  // + the noise floor
@@ -446,14 +446,14 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
         img.rgb.assign(static_cast<size_t>(v.width) * v.height * 3, 0.0f);
       }
       std::vector<double> psnr, ssim;
-      bench::ChartSeries series{v.name + " (" + v.viewSet + ")", {}, true};
+      imaging::ChartSeries series{v.name + " (" + v.viewSet + ")", {}, true};
       renderer::ReferenceOptions ro;
       ro.width = v.width;
       ro.height = v.height;
       ro.samplesPerPixel = o->referenceSpp;
       for (size_t i : v.referenceViews) {
         references[i] = renderer::renderReference(viewerContext, finalScene, v.views[i].camera, ro);
-        const bench::ImageMetrics m = bench::compareImages(v.images[i].rgb, references[i].rgb,
+        const imaging::ImageMetrics m = imaging::compareImages(v.images[i].rgb, references[i].rgb,
                                                            static_cast<int>(v.width), static_cast<int>(v.height));
         psnr.push_back(m.psnrDb);
         ssim.push_back(m.ssim);
@@ -463,8 +463,8 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       if (k == 0) {  // how far the reference itself is from converged: two seeds of view 0
         ro.seed = 7;
         const renderer::Image second = renderer::renderReference(viewerContext, finalScene, v.views[0].camera, ro);
-        const bench::ImageMetrics floor =
-            bench::compareImages(second.rgb, references[0].rgb, static_cast<int>(v.width), static_cast<int>(v.height));
+        const imaging::ImageMetrics floor =
+            imaging::compareImages(second.rgb, references[0].rgb, static_cast<int>(v.width), static_cast<int>(v.height));
         report["reference_noise_floor"] = {{"psnr_db", floor.psnrDb}, {"ssim", floor.ssim}};
         progressReferences();
       }
@@ -472,7 +472,7 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
       writeViewerImages(dir + "/final_" + tag, v, v.images);
       writeViewerImages(dir + "/reference_" + tag, v, references);
       std::string error;
-      if (!bench::writeDifferencePng(dir + "/difference_" + tag + "_view0.png", v.images[0].rgb, references[0].rgb,
+      if (!imaging::writeDifferencePng(dir + "/difference_" + tag + "_view0.png", v.images[0].rgb, references[0].rgb,
                                      static_cast<int>(v.width), static_cast<int>(v.height), 0.25, error))
         throw std::runtime_error(error);
       double meanPsnr = 0, meanSsim = 0;
@@ -511,19 +511,19 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
 
     phases["references"] = secondsSince(phaseStart);
     report["phase_seconds"] = phases;
-    bench::ChartSpec bw;
+    imaging::ChartSpec bw;
     bw.title = "Bytes per second received by each viewer while the light moves";
     bw.xLabel = "seconds";
     bw.yLabel = "bytes/s";
     bw.footnote = commandLine();
-    writeTextFile(dir + "/bandwidth.svg", bench::renderSvgChart(bw, bandwidthSeries));
-    bench::ChartSpec q;
+    writeTextFile(dir + "/bandwidth.svg", imaging::renderSvgChart(bw, bandwidthSeries));
+    imaging::ChartSpec q;
     q.title = "Each view against its reference (light frozen, probes settled)";
     q.xLabel = "view index (quilt order)";
     q.yLabel = "PSNR, dB";
     q.yFromZero = false;
     q.footnote = commandLine();
-    writeTextFile(dir + "/psnr_per_view.svg", bench::renderSvgChart(q, psnrSeries));
+    writeTextFile(dir + "/psnr_per_view.svg", imaging::renderSvgChart(q, psnrSeries));
     // Speed against accuracy across the pipeline, and the stability suite.
     std::string suites;
     if (!o->skipSuites) {

@@ -2,7 +2,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
-#include "image_io.h"
+#include "probecast/imaging/image_io.h"
 #include "probecast/renderer/reference_camera.h"
 #include "scene_options.h"
 
@@ -58,11 +58,11 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
     fmt::print("render-reference: {} on {}, {}x{}, {} spp\n", s.name, context.deviceName(), ro.width, ro.height, ro.samplesPerPixel);
     const renderer::Image image = renderer::renderReference(context, s, camera, ro);
     std::string error;
-    if (!bench::writeExr(o->out, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), error))
+    if (!imaging::writeExr(o->out, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), error))
       throw std::runtime_error(error);
     fmt::print("wrote {}\n", o->out);
     if (!o->png.empty()) {
-      if (!bench::writePngPreview(o->png, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), o->exposure,
+      if (!imaging::writePngPreview(o->png, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), o->exposure,
                                   error))
         throw std::runtime_error(error);
       fmt::print("wrote {}\n", o->png);

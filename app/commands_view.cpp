@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
-#include "image_io.h"
+#include "probecast/imaging/image_io.h"
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
@@ -134,14 +134,14 @@ void addViewCommand(CLI::App& app, int& exitCode) {
     std::filesystem::create_directories(o->out);
     const renderer::Image quilt = renderer::composeQuilt(images, views, spec.columns, spec.rows);
     const auto w = static_cast<int>(quilt.width), h = static_cast<int>(quilt.height);
-    bench::ToneMap toneMap = bench::ToneMap::Filmic;
-    bench::parseToneMap(o->toneMap, toneMap);
-    if (!bench::writePngPreview(o->out + "/quilt.png", quilt.rgb, w, h, o->exposure, error, toneMap) ||
-        !bench::writeExr(o->out + "/quilt.exr", quilt.rgb, w, h, error))
+    imaging::ToneMap toneMap = imaging::ToneMap::Filmic;
+    imaging::parseToneMap(o->toneMap, toneMap);
+    if (!imaging::writePngPreview(o->out + "/quilt.png", quilt.rgb, w, h, o->exposure, error, toneMap) ||
+        !imaging::writeExr(o->out + "/quilt.exr", quilt.rgb, w, h, error))
       throw std::runtime_error(error);
     if (o->exr)
       for (size_t k = 0; k < images.size(); ++k)
-        if (!bench::writeExr(fmt::format("{}/view_{:02}.exr", o->out, k), images[k].rgb, static_cast<int>(o->size[0]),
+        if (!imaging::writeExr(fmt::format("{}/view_{:02}.exr", o->out, k), images[k].rgb, static_cast<int>(o->size[0]),
                              static_cast<int>(o->size[1]), error))
           throw std::runtime_error(error);
     fmt::print("view: {} {} views of {}x{} on {}: {:.1f} ms per view; wrote {}/quilt.png and quilt.exr\n", o->views,

@@ -13,7 +13,7 @@
 #include "probecast/codec/record.h"
 #include "probecast/codec/stream.h"
 #include "probecast/codec/zh3.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
@@ -216,7 +216,7 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   // 3. Temporal: the first map rotating about +Y, 0.5°/frame, on a 16×4×16 grid with per-probe
   // intensity and phase, plus 1 % Gaussian noise per coefficient (relative to the DC).
   nlohmann::json temporal = nlohmann::json::array();
-  std::vector<ChartSeries> temporalSeries;
+  std::vector<imaging::ChartSeries> temporalSeries;
   if (!opt.maps.empty() && opt.frames > 1) {
     const EnvMap small = downsample(opt.maps[0], std::max(1, opt.maps[0].width / 128));
     StreamLayout layout;
@@ -251,7 +251,7 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
     }
     for (Representation repr : kAllRepresentations) {
       const std::string name = representationName(repr);
-      ChartSeries series{name + " stream", {}, true};
+      imaging::ChartSeries series{name + " stream", {}, true};
       for (int dz : opt.deadzones) {
         if (repr == Representation::Fp16 && dz > 0) continue;  // fp16 steps are not ratio steps
         layout.repr = repr;
@@ -329,20 +329,20 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   }
 
   // Chart: error against bytes.
-  ChartSeries keyframes{"records (static maps)", {}, false};
+  imaging::ChartSeries keyframes{"records (static maps)", {}, false};
   for (Representation repr : kAllRepresentations)
     keyframes.points.push_back({static_cast<double>(recordSize(repr)), results[representationName(repr)].rmseTrue,
                                 representationName(repr)});
-  std::vector<ChartSeries> all{keyframes};
+  std::vector<imaging::ChartSeries> all{keyframes};
   all.insert(all.end(), temporalSeries.begin(), temporalSeries.end());
-  ChartSpec spec;
+  imaging::ChartSpec spec;
   spec.title = "probecast codec: irradiance error against bytes per probe";
   spec.xLabel = "bytes per probe (records) / per probe per frame (streams)";
   spec.yLabel = "irradiance relative RMSE";
   spec.logX = true;
   spec.logY = true;
   spec.footnote = opt.command;
-  return {json, table, renderSvgChart(spec, all)};
+  return {json, table, imaging::renderSvgChart(spec, all)};
 }
 
 }  // namespace probecast::bench

@@ -5,11 +5,11 @@
 
 #include <fmt/format.h>
 
-#include "image_metrics.h"
+#include "probecast/imaging/image_metrics.h"
 #include "probecast/codec/record.h"
 #include "probecast/codec/stream.h"
 #include "probecast/renderer/raster_client.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 
@@ -50,7 +50,7 @@ std::string paretoChart(const std::string& title, const std::string& xLabel, boo
   std::vector<ParetoPoint> pp;
   for (const Point& p : pts) pp.push_back({p.cost, p.psnr});
   const std::vector<size_t> front = paretoFront(pp);
-  ChartSeries all{"configurations", {}, false}, best{"Pareto front", {}, true};
+  imaging::ChartSeries all{"configurations", {}, false}, best{"Pareto front", {}, true};
   for (size_t i = 0; i < pts.size(); ++i) {
     const bool onFront = std::find(front.begin(), front.end(), i) != front.end();
     all.points.push_back({pts[i].cost, pts[i].psnr, onFront ? "" : pts[i].label});
@@ -61,14 +61,14 @@ std::string paretoChart(const std::string& title, const std::string& xLabel, boo
                     {"pareto", onFront}});
   }
   for (size_t i : front) best.points.push_back({pts[i].cost, pts[i].psnr, pts[i].label});
-  ChartSpec spec;
+  imaging::ChartSpec spec;
   spec.title = title;
   spec.xLabel = xLabel;
   spec.yLabel = "PSNR against the reference, dB";
   spec.logX = logX;
   spec.yFromZero = false;
   spec.footnote = command;
-  return renderSvgChart(spec, {all, best});
+  return imaging::renderSvgChart(spec, {all, best});
 }
 
 }  // namespace
@@ -96,8 +96,8 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   const auto score = [&](const ProbeVolume& v, Point& p) {
     raster.setProbes(v);
     const renderer::Image img = raster.render(raster.viewProjection(camera), camera.position);
-    const ImageMetrics m =
-        compareImages(img.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    const imaging::ImageMetrics m =
+        imaging::compareImages(img.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
     p.psnr = m.psnrDb;
     p.ssim = m.ssim;
   };

@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <chrono>
 
-#include "image_metrics.h"
+#include "probecast/imaging/image_metrics.h"
 #include "probecast/codec/record.h"
 #include "probecast/renderer/view_sets.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
@@ -71,7 +71,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   renderer::RasterOptions perView = o.raster;
   perView.passes = renderer::ViewPasses::PerView;
   renderer::RasterRenderer raster(context, o.scene, o.width, o.height, perView);
-  ChartSeries qualitySeries{"representations (mono view)", {}, false};
+  imaging::ChartSeries qualitySeries{"representations (mono view)", {}, false};
   table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
   for (const Representation& r : reprs) {
     raster.setProbes(r.viaCodec ? decodeAs(volume, r.repr) : volume);
@@ -83,8 +83,8 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
       image = raster.render(vp, camera.position);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     }
-    const ImageMetrics m =
-        compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    const imaging::ImageMetrics m =
+        imaging::compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
     const double msPerView = median(ms);
     json["representations"].push_back({{"representation", r.name},
                                        {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},
@@ -104,7 +104,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   renderer::RasterRenderer multiview(context, o.scene, o.width, o.height, multi);
   multiview.setProbes(l2);
   json["multiview_chunk"] = multiview.chunkSize();
-  std::vector<ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
+  std::vector<imaging::ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
   table += fmt::format("\n{:<8} {:>6} {:>16} {:>16}\n", "views", "count", "per-view ms/view", "multiview ms/view");
   renderer::ViewSetOptions vo;
   vo.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
@@ -166,7 +166,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   }
   json["validation_messages"] = context.validationMessages();
 
-  ChartSpec spec;
+  imaging::ChartSpec spec;
   spec.title =
       fmt::format("Raster client, {} at {}x{}: image quality against time per view", o.scene.name, o.width, o.height);
   spec.xLabel = "ms per view (mono, median)";
@@ -174,15 +174,15 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   spec.yFromZero = false;
   spec.footnote = o.command;
   RasterBenchResult result;
-  result.svg = renderSvgChart(spec, {qualitySeries});
-  ChartSpec views;
+  result.svg = imaging::renderSvgChart(spec, {qualitySeries});
+  imaging::ChartSpec views;
   views.title =
       fmt::format("Raster client, {} at {}x{}: time per view against views per set", o.scene.name, o.width, o.height);
   views.xLabel = "views in the set";
   views.yLabel = "ms per view (median)";
   views.logX = true;
   views.footnote = o.command;
-  result.svgViews = renderSvgChart(views, speedSeries);
+  result.svgViews = imaging::renderSvgChart(views, speedSeries);
   result.json = std::move(json);
   result.table = std::move(table);
   return result;

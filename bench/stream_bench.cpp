@@ -16,7 +16,7 @@
 
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
@@ -146,8 +146,8 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
     if (o.progress) o.progress(s);
   };
   nlohmann::json runs = nlohmann::json::array();
-  ChartSeries bytesSeries{"bytes/s per subscriber (mean)", {}, true};
-  ChartSeries cpuSeries{"server CPU ms/s per subscriber", {}, true};
+  imaging::ChartSeries bytesSeries{"bytes/s per subscriber (mean)", {}, true};
+  imaging::ChartSeries cpuSeries{"server CPU ms/s per subscriber", {}, true};
   std::string table = fmt::format("{:>6} {:>16} {:>16} {:>12} {:>12} {:>16} {:>14}\n", "subs", "B/s/sub mean",
                                   "B/s/sub p99", "lat p50 ms", "lat p99 ms", "server CPU %/sub", "encode ms/frm");
   for (int n : o.subscribers) {
@@ -244,14 +244,14 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
             {"notes", "loopback, server in a child process; latency = client decode time minus the server time of "
                       "the frame's lighting; CPU as a fraction of one core"}};
   r.table = table;
-  ChartSpec spec;
+  imaging::ChartSpec spec;
   spec.title = "probe stream: per-subscriber cost against subscribers";
   spec.xLabel = "subscribers";
   spec.yLabel = "bytes/s per subscriber; server CPU ms/s per subscriber";
   spec.logX = true;
   spec.logY = true;
   spec.footnote = o.command;
-  r.svg = renderSvgChart(spec, {bytesSeries, cpuSeries});
+  r.svg = imaging::renderSvgChart(spec, {bytesSeries, cpuSeries});
   return r;
 }
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "probecast/codec/sh.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
@@ -90,7 +90,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
 
   // Flicker against w_min: relative irradiance change per update once the mean has settled.
   nlohmann::json flicker = nlohmann::json::array();
-  ChartSeries flickerSeries{"final error per w_min", {}, false};
+  imaging::ChartSeries flickerSeries{"final error per w_min", {}, false};
   for (float w : opt.minBlendWeights) {
     renderer::UpdaterOptions o = opt.updater;
     o.minBlendWeight = w;
@@ -145,16 +145,16 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
     r.table += fmt::format("{:<7g} {:>13.2f}% {:>9.2f}%\n", f["w_min"].get<float>(), 100 * f["flicker_rel"].get<double>(),
                            100 * f["rmse_rel"].get<double>());
 
-  ChartSeries conv{"accumulating (w_min = 0)", {}, true};
+  imaging::ChartSeries conv{"accumulating (w_min = 0)", {}, true};
   for (size_t i = 0; i < rmse.size(); ++i) conv.points.push_back({cumulativeMs[i], rmse[i], ""});
-  ChartSpec spec;
+  imaging::ChartSpec spec;
   spec.title = "probe updater: error against time spent (" + opt.scene.name + ")";
   spec.xLabel = "update time spent, ms";
   spec.yLabel = "irradiance relative RMSE vs reference";
   spec.logX = true;
   spec.logY = true;
   spec.footnote = opt.command;
-  r.svg = renderSvgChart(spec, {conv, flickerSeries});
+  r.svg = imaging::renderSvgChart(spec, {conv, flickerSeries});
   return r;
 }
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "brick_section.h"
+#include "probecast/codec/internal/frame_checksums.h"
 #include "probecast/codec/sh.h"
 
 namespace probecast::fuzz {

@@ -2,6 +2,7 @@
 # One entry point for a new machine: installs what is missing (Debian 12), builds, and runs.
 #   scripts/dev.sh demo          build, then run `probecast demo` (writes out/)
 #   scripts/dev.sh test          build, then run the whole test suite (ctest)
+#   scripts/dev.sh core-test     the Vulkan-free build (codec, imaging, service, their tests) in build-core, and its tests
 #   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec tests under it
 #   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec
 set -euo pipefail
@@ -36,6 +37,16 @@ case "$cmd" in
     configure_and_build build
     ctest --test-dir build --output-on-failure -j "$JOBS" "$@"
     ;;
+  core-test)
+    # What an engine embedding the decoder side builds: no Vulkan SDK, no glslang. Vulkan is
+    # disabled outright, so a find_package(Vulkan) creeping into this configuration fails it.
+    configure_and_build build-core -DPROBECAST_RENDERER=OFF -DCMAKE_DISABLE_FIND_PACKAGE_Vulkan=ON
+    if grep -E '^(Vulkan|glslang|PROBECAST_SPIRV_VAL)' build-core/CMakeCache.txt; then
+      echo "core-test: the Vulkan-free configuration looked up Vulkan or glslang" >&2
+      exit 1
+    fi
+    ctest --test-dir build-core --output-on-failure -j "$JOBS" "$@"
+    ;;
   memsafe)
     configure_and_build build-asan -DPROBECAST_SANITIZE=ON -DPROBECAST_APP=OFF
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
@@ -61,7 +72,7 @@ case "$cmd" in
     echo "fuzz: clean after ${secs}s" 
     ;;
   *)
-    echo "usage: scripts/dev.sh demo|test|memsafe|fuzz [args]" >&2
+    echo "usage: scripts/dev.sh demo|test|core-test|memsafe|fuzz [args]" >&2
     exit 2
     ;;
 esac

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "../codec/src/brick_section.h"
+#include "probecast/codec/internal/frame_checksums.h"
 #include "probecast/codec/stream.h"
 #include "test_probes.h"
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <random>
 
-#include "image_metrics.h"
+#include "probecast/imaging/image_metrics.h"
 
-namespace probecast::bench {
+namespace probecast::imaging {
 namespace {
 
 std::vector<float> constant(int w, int h, float v) { return std::vector<float>(static_cast<size_t>(w) * h * 3, v); }
@@ -58,4 +58,4 @@ TEST(ImageMetrics, MoreNoiseScoresWorse) {
 }
 
 }  // namespace
-}  // namespace probecast::bench
+}  // namespace probecast::imaging

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline_bench.h"
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
@@ -17,11 +17,11 @@ TEST(PipelineBench, ParetoFrontKeepsOnlyPointsNothingBeatsOnBothCostAndQuality) 
 }
 
 TEST(PipelineBench, ChartsOfPsnrFitTheirDataInsteadOfStartingAtZero) {
-  ChartSpec spec;
+  imaging::ChartSpec spec;
   spec.yFromZero = false;
-  const std::string fitted = renderSvgChart(spec, {{"s", {{1, 26.0, ""}, {2, 28.0, ""}}, false}});
+  const std::string fitted = imaging::renderSvgChart(spec, {{"s", {{1, 26.0, ""}, {2, 28.0, ""}}, false}});
   spec.yFromZero = true;
-  const std::string zero = renderSvgChart(spec, {{"s", {{1, 26.0, ""}, {2, 28.0, ""}}, false}});
+  const std::string zero = imaging::renderSvgChart(spec, {{"s", {{1, 26.0, ""}, {2, 28.0, ""}}, false}});
   const std::string yZeroTick = "text-anchor=\"end\">0<";  // y tick labels are right-aligned
   EXPECT_EQ(fitted.find(yZeroTick), std::string::npos);
   EXPECT_NE(zero.find(yZeroTick), std::string::npos);

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "image_metrics.h"
+#include "probecast/imaging/image_metrics.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
@@ -160,8 +160,8 @@ TEST(RasterQuality, OffAxisViewsMatchTheReferenceOfTheSameShearedCamera) {
   CameraView centred = views[3].camera;
   centred.shift = glm::vec2(0.0f);
   const Image unsheared = renderReference(context, s, centred, ro);
-  const double good = bench::compareImages(image.rgb, sheared.rgb, 64, 40).psnrDb;
-  const double bad = bench::compareImages(image.rgb, unsheared.rgb, 64, 40).psnrDb;
+  const double good = imaging::compareImages(image.rgb, sheared.rgb, 64, 40).psnrDb;
+  const double bad = imaging::compareImages(image.rgb, unsheared.rgb, 64, 40).psnrDb;
   std::printf("off-axis view: PSNR %.2f dB against the sheared reference, %.2f dB against the centred one\n", good,
               bad);
   EXPECT_GT(good, bad + 3.0);
@@ -182,7 +182,7 @@ TEST(RasterQuality, CornellAgainstTheReferenceAboveTheRecordedFloor) {
   ro.height = 50;
   ro.samplesPerPixel = 256;
   const Image reference = renderReference(context, s, cam, ro);
-  const bench::ImageMetrics m = bench::compareImages(image.rgb, reference.rgb, 80, 50);
+  const imaging::ImageMetrics m = imaging::compareImages(image.rgb, reference.rgb, 80, 50);
   std::printf("cornell 80x50, l2 probes 8^3: PSNR %.2f dB, SSIM %.4f\n", m.psnrDb, m.ssim);
   EXPECT_GT(m.psnrDb, FLOOR_PSNR);
   EXPECT_GT(m.ssim, FLOOR_SSIM);
@@ -190,7 +190,7 @@ TEST(RasterQuality, CornellAgainstTheReferenceAboveTheRecordedFloor) {
   const glm::vec3 lo = s.boundsMin, hi = s.boundsMax;
   raster.setProbes(makeProbeVolume(ProbeGrid{{1, 1, 1}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}}));
   const Image direct = raster.render(raster.viewProjection(cam), cam.position);
-  EXPECT_LT(bench::compareImages(direct.rgb, reference.rgb, 80, 50).psnrDb, FLOOR_PSNR);
+  EXPECT_LT(imaging::compareImages(direct.rgb, reference.rgb, 80, 50).psnrDb, FLOOR_PSNR);
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "probe_symbols.h"
+#include "probecast/codec/internal/frame_checksums.h"
 #include "probecast/codec/status.h"
 #include "probecast/codec/stream.h"
 
@@ -53,10 +54,6 @@ struct SectionView {
 // On success *consumed is the section's full length.
 CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
                          size_t* consumed);
-
-// Recomputes the header CRC and every section CRC of a (possibly corrupted) frame in place, so
-// tests and the fuzzer can reach the parsers behind the checksums. Not for production use.
-void rewriteFrameChecksums(std::vector<uint8_t>& frame);
 
 // Applies a decompressed payload to a brick's symbols. `active`/`symbols` hold the brick's state
 // on entry (the base) and the new state on success. `scratch` avoids allocation.

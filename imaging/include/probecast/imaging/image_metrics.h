@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace probecast::bench {
+namespace probecast::imaging {
 
 struct ImageMetrics {
   double psnrDb = 0;  // over RGB, peak 1 after gamma; +inf for identical images
@@ -21,4 +21,4 @@ ImageMetrics compareImages(const std::vector<float>& a, const std::vector<float>
 bool writeDifferencePng(const std::string& path, const std::vector<float>& a, const std::vector<float>& b, int width,
                         int height, double scale, std::string& error);
 
-}  // namespace probecast::bench
+}  // namespace probecast::imaging

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace probecast::bench {
+namespace probecast::imaging {
 
 // rgb: width × height × 3 floats, row-major from the top.
 bool writeExr(const std::string& path, const std::vector<float>& rgb, int width, int height, std::string& error);
@@ -19,4 +19,4 @@ bool writePngPreview(const std::string& path, const std::vector<float>& rgb, int
 // "filmic" or "gamma".
 bool parseToneMap(const std::string& name, ToneMap& out);
 
-}  // namespace probecast::bench
+}  // namespace probecast::imaging

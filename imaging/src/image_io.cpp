@@ -1,4 +1,4 @@
-#include "image_io.h"
+#include "probecast/imaging/image_io.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <stb_image_write.h>
 #include <tinyexr.h>
 
-namespace probecast::bench {
+namespace probecast::imaging {
 
 bool writeExr(const std::string& path, const std::vector<float>& rgb, int width, int height, std::string& error) {
   if (rgb.size() != static_cast<size_t>(width) * height * 3) return error = path + ": image size mismatch", false;
@@ -56,4 +56,4 @@ bool writePngPreview(const std::string& path, const std::vector<float>& rgb, int
   return true;
 }
 
-}  // namespace probecast::bench
+}  // namespace probecast::imaging

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace probecast::bench {
+namespace probecast::imaging {
 
 struct ChartPoint {
   double x = 0;
@@ -30,4 +30,4 @@ struct ChartSpec {
 
 std::string renderSvgChart(const ChartSpec& spec, const std::vector<ChartSeries>& series);
 
-}  // namespace probecast::bench
+}  // namespace probecast::imaging

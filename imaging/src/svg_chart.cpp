@@ -1,4 +1,4 @@
-#include "svg_chart.h"
+#include "probecast/imaging/svg_chart.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-namespace probecast::bench {
+namespace probecast::imaging {
 namespace {
 
 constexpr const char* kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"};
@@ -135,4 +135,4 @@ std::string renderSvgChart(const ChartSpec& spec, const std::vector<ChartSeries>
   return svg;
 }
 
-}  // namespace probecast::bench
+}  // namespace probecast::imaging

@@ -1,4 +1,4 @@
-#include "image_metrics.h"
+#include "probecast/imaging/image_metrics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include <stb_image_write.h>
 
-namespace probecast::bench {
+namespace probecast::imaging {
 namespace {
 
 double gammaOf(float v) { return std::isfinite(v) && v > 0 ? std::pow(static_cast<double>(v), 1.0 / 2.2) : 0.0; }
@@ -103,4 +103,4 @@ bool writeDifferencePng(const std::string& path, const std::vector<float>& a, co
   return true;
 }
 
-}  // namespace probecast::bench
+}  // namespace probecast::imaging
