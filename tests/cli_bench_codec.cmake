@@ -1,8 +1,8 @@
-# Runs `probecast bench codec` on two shared maps and checks the JSON and the chart.
+# Runs `probecast bench codec` on the project's two maps (tests/data/envmaps) and checks the JSON and the chart.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK}/maps)
-file(CREATE_LINK ${DATA}/envmaps/grace.hdr ${WORK}/maps/grace.hdr SYMBOLIC)
-file(CREATE_LINK ${DATA}/envmaps/pisa.hdr ${WORK}/maps/pisa.hdr SYMBOLIC)
+file(CREATE_LINK ${DATA}/envmaps/venice_sunset_1k.hdr ${WORK}/maps/venice_sunset_1k.hdr SYMBOLIC)
+file(CREATE_LINK ${DATA}/envmaps/kiara_1_dawn_1k.hdr ${WORK}/maps/kiara_1_dawn_1k.hdr SYMBOLIC)
 execute_process(COMMAND ${PROBECAST} bench codec --envmaps ${WORK}/maps --json ${WORK}/codec.json
                         --chart ${WORK}/codec.svg --frames 4 --normals 256
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

@@ -1,4 +1,4 @@
-// Scene loading: the shared Cornell glTF, built-in scenes, and broken files.
+// Scene loading: the Cornell glTF (tests/data), built-in scenes, and broken files.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -8,7 +8,7 @@
 namespace probecast::scene {
 namespace {
 
-const std::string kCornell = std::string(PROBECAST_SHARED_DATA) + "/scenes/cornell-box/CornellBox-Original.gltf";
+const std::string kCornell = std::string(PROBECAST_TEST_DATA) + "/scenes/cornell-box/CornellBox-Original.gltf";
 
 std::string writeTemp(const std::string& name, const std::string& text) {
   const std::string path = std::string(PROBECAST_TEST_TMP) + "/" + name;
@@ -141,7 +141,7 @@ namespace {
 TEST(Scene, TexturedGltfLoadsTexturesUvsAndNormals) {
   Scene s;
   std::string error;
-  ASSERT_TRUE(loadGltf(std::string(PROBECAST_SHARED_DATA) + "/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf", s,
+  ASSERT_TRUE(loadGltf(std::string(PROBECAST_TEST_DATA) + "/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf", s,
                        error))
       << error;
   EXPECT_EQ(s.textures.size(), 2u);  // checkerBJS.png and checker-meter.png
