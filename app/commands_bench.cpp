@@ -261,15 +261,6 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
       ->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
   stream->add_option("--json", so->json, "write the results as JSON here")->required();
   stream->add_option("--chart", so->chart, "write an SVG chart here");
-  CLI::App* streamServer = bench->add_subcommand("stream-server", "");  // internal: bench stream's server process
-  streamServer->group("");
-  auto ss = std::make_shared<std::tuple<double, double, std::string>>(10.0, 5.0, "zh3");
-  streamServer->add_option("--hz", std::get<0>(*ss))->check(CLI::Range(0.5, 240.0));
-  streamServer->add_option("--seconds", std::get<1>(*ss))->check(CLI::Range(1.0, 3600.0));
-  streamServer->add_option("--repr", std::get<2>(*ss));
-  streamServer->callback([ss, &exitCode] {
-    exitCode = bench::runStreamBenchServer(std::get<0>(*ss), std::get<1>(*ss), std::get<2>(*ss));
-  });
   stream->callback([so, &exitCode] {
     so->bench.command = commandLine();
     so->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };

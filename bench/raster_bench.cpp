@@ -8,16 +8,12 @@
 #include "image_metrics.h"
 #include "probecast/codec/record.h"
 #include "probecast/renderer/view_sets.h"
+#include "probecast/session/stats.h"
+#include "probecast/session/viewer.h"
 #include "svg_chart.h"
 
 namespace probecast::bench {
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Representation {
   std::string name;
@@ -85,7 +81,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
     }
     const ImageMetrics m =
         compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
-    const double msPerView = median(ms);
+    const double msPerView = session::medianMidpoint(ms);
     json["representations"].push_back({{"representation", r.name},
                                        {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},
                                        {"psnr_db", m.psnrDb},
@@ -106,9 +102,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["multiview_chunk"] = multiview.chunkSize();
   std::vector<ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
   table += fmt::format("\n{:<8} {:>6} {:>16} {:>16}\n", "views", "count", "per-view ms/view", "multiview ms/view");
-  renderer::ViewSetOptions vo;
-  vo.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
-  vo.displayDistance = std::max(0.1f, glm::length(0.5f * (o.scene.boundsMin + o.scene.boundsMax) - camera.position));
+  const renderer::ViewSetOptions vo = session::viewSetOptions(o.scene, o.width, o.height);
   for (const std::string& name : o.viewSets) {
     renderer::ViewSetSpec spec;
     std::string error;
@@ -124,7 +118,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
         r.renderViews(views);
         ms.push_back(r.timings().viewsMs);
       }
-      const double set = median(ms);
+      const double set = session::medianMidpoint(ms);
       perViewMs[way] = set / static_cast<double>(views.size());
       row[way == 0 ? "per_view_pass" : "multiview"] = {{"ms_per_view_set", set}, {"ms_per_view", perViewMs[way]}};
       speedSeries[static_cast<size_t>(way)].points.push_back({static_cast<double>(views.size()), perViewMs[way], ""});
