@@ -13,6 +13,8 @@ void addServeCommands(CLI::App& app, int& exitCode);
 void addCompareCommand(CLI::App& app, int& exitCode);
 void addViewCommand(CLI::App& app, int& exitCode);
 
+// The contents of a text file; throws std::runtime_error with the path when it cannot be read.
+std::string readTextFile(const std::string& path);
 // Writes text to a file, creating parent folders; throws std::runtime_error with the path on failure.
 void writeTextFile(const std::string& path, const std::string& text);
 // Prints a benchmark's table, writes its JSON and (when a path is given) its SVG chart.

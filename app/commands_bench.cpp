@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -51,6 +52,14 @@ void setCommandLine(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) gCommandLine += std::string(" ") + argv[i];
 }
 const std::string& commandLine() { return gCommandLine; }
+
+std::string readTextFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
 
 void writeTextFile(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
@@ -257,8 +266,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   stream->add_option("--hz", so->bench.hz, "lighting updates per second")->check(CLI::Range(0.5, 240.0));
   stream->add_option("--seconds", so->bench.seconds, "measured time per subscriber count")->check(CLI::Range(2.0, 3600.0));
   stream->add_option("--budget", so->bench.budgetBytesPerSecond, "bytes per second per subscriber (0 = unlimited)");
-  stream->add_option("--repr", so->bench.repr, "l1, zh3h, zh3, l2 or fp16")
-      ->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
+  addRepresentationOption(stream, so->bench.repr, "l1, zh3h, zh3, l2 or fp16");
   stream->add_option("--json", so->json, "write the results as JSON here")->required();
   stream->add_option("--chart", so->chart, "write an SVG chart here");
   stream->callback([so, &exitCode] {

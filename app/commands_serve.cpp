@@ -2,8 +2,6 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -12,6 +10,8 @@
 #include "probecast/codec/probe_file.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
+#include "probecast/session/probe_producer.h"
+#include "probecast/session/volumes.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -19,27 +19,19 @@ namespace {
 
 std::atomic<bool> gInterrupted{false};
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string tokenFrom(const std::string& token, const std::string& file) {
   if (!file.empty()) {
-    std::string t = readText(file);
+    std::string t = readTextFile(file);
     while (!t.empty() && (t.back() == '\n' || t.back() == '\r' || t.back() == ' ')) t.pop_back();
     return t;
   }
   return token;
 }
 
-Representation parseRepr(const std::string& name) {
-  const auto r = parseRepresentation(name);
-  if (!r) throw std::runtime_error("unknown representation '" + name + "' (l1, zh3h, zh3, l2, fp16)");
-  return *r;
+// A producer for the hub, once its layout is known to fit the stream format.
+std::unique_ptr<session::ProbeProducer> makeProducer(const service::HubConfig& hc) {
+  if (!isValidLayout(hc.layout)) throw std::runtime_error("grid too large for the stream format");
+  return std::make_unique<session::ProbeProducer>(hc);
 }
 
 }  // namespace
@@ -56,7 +48,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
   auto o = std::make_shared<Options>();
   tr->add(serve);
   serve->add_option("--probes", o->probes, "serve a baked probe volume file instead of tracing live");
-  serve->add_option("--repr", o->repr, "l1, zh3h, zh3, l2 or fp16");
+  addRepresentationOption(serve, o->repr, "l1, zh3h, zh3, l2 or fp16");
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
   serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
       ->check(CLI::Range(0, 127));
@@ -76,83 +68,59 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     sc.plaintext = o->plaintext;
     if (!o->tlsCert.empty() || !o->tlsKey.empty()) {
       if (o->tlsCert.empty() || o->tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
-      sc.tlsCertPem = readText(o->tlsCert);
-      sc.tlsKeyPem = readText(o->tlsKey);
+      sc.tlsCertPem = readTextFile(o->tlsCert);
+      sc.tlsKeyPem = readTextFile(o->tlsKey);
     }
     if (sc.tlsCertPem.empty() && !sc.plaintext)
       throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
     if (sc.token.empty()) fmt::print(stderr, "serve: warning: no --token, anyone who reaches the port may subscribe\n");
 
-    service::HubConfig hc;
-    hc.layout.brickDim = static_cast<uint8_t>(o->brick);
-    hc.layout.repr = parseRepr(o->repr);
-    hc.encoder.deadzone = o->deadzone;
+    const Representation repr = session::parseRepresentationOrThrow(o->repr);
     ProbeVolume volume;
+    service::HubConfig hc;
     std::unique_ptr<renderer::VulkanContext> context;
-    std::unique_ptr<renderer::ProbeUpdater> updater;
+    std::unique_ptr<session::ProbeProducer> producer;
     scene::Scene s;
     if (!o->probes.empty()) {
       std::string error;
       if (!readProbeFile(o->probes, volume, error)) throw std::runtime_error(error);
-      for (int a = 0; a < 3; ++a) {
-        hc.layout.grid[a] = static_cast<uint16_t>(volume.dims[a]);
-        hc.bounds.min[a] = volume.boundsMin[a];
-        hc.bounds.max[a] = volume.boundsMax[a];
-      }
+      hc = session::hubConfigFor(volume, repr, o->brick, o->deadzone);
+      producer = makeProducer(hc);
     } else {
       s = tr->scene.load();
       const renderer::ProbeGrid g = tr->grid.resolve(s);
-      for (int a = 0; a < 3; ++a) {
-        hc.layout.grid[a] = static_cast<uint16_t>(g.dims[a]);
-        hc.bounds.min[a] = g.min[a];
-        hc.bounds.max[a] = g.max[a];
-      }
+      hc = session::hubConfigFor(g, repr, o->brick, o->deadzone);
+      producer = makeProducer(hc);
       context = std::make_unique<renderer::VulkanContext>(tr->gpu.context());
-      updater = std::make_unique<renderer::ProbeUpdater>(*context, s, g, tr->tracer.options());
+      session::Animation animation;  // --animate: t advances per update, so per second at --hz
+      animation.mode = o->animate > 0 ? session::Animation::Mode::PerStep : session::Animation::Mode::Still;
+      animation.start = tr->scene.t;
+      animation.perStep = static_cast<float>(o->animate / o->hz);
+      producer->traceScene(*context, tr->scene.scene, s, g, tr->tracer.options(), animation);
     }
-    if (!isValidLayout(hc.layout)) throw std::runtime_error("grid too large for the stream format");
-    service::ProbeHub hub(hc);
-    service::ProbeServer server(sc, hub);
+    const int port = producer->serve(sc);
     fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}\n",
-               o->probes.empty() ? s.name : o->probes, server.port(), sc.tlsCertPem.empty() ? "plaintext" : "TLS",
+               o->probes.empty() ? s.name : o->probes, port, sc.tlsCertPem.empty() ? "plaintext" : "TLS",
                representationName(hc.layout.repr), hc.layout.grid[0], hc.layout.grid[1], hc.layout.grid[2],
                hc.layout.brickDim, o->probes.empty() ? "live" : "from file");
     std::fflush(stdout);
     std::signal(SIGINT, [](int) { gInterrupted = true; });
     std::signal(SIGTERM, [](int) { gInterrupted = true; });
-    if (!o->probes.empty()) hub.publish(volume.probes.data(), volume.active.data());
-    const auto start = std::chrono::steady_clock::now();
-    const auto period = std::chrono::duration<double>(1.0 / o->hz);
-    auto next = start;
-    float t = tr->scene.t;
-    uint32_t frames = 0;
-    auto lastReport = start;
-    while (!gInterrupted) {
-      const auto now = std::chrono::steady_clock::now();
-      if (o->seconds > 0 && now - start >= std::chrono::duration<double>(o->seconds)) break;
-      if (updater) {
-        if (o->animate > 0) {
-          t = std::fmod(t + static_cast<float>(o->animate / o->hz), 1.0f);
-          scene::Scene moved;
-          std::string error;
-          if (scene::loadScene(tr->scene.scene, t, moved, error)) updater->setScene(moved);
-        }
-        updater->update();
-        hub.publish(updater->probes(), updater->activeMask());
-        ++frames;
-      } else {
-        hub.tick();
-      }
-      if (now - lastReport >= std::chrono::seconds(5)) {
-        fmt::print("serve: {:.0f} s, {} updates, {} subscribers\n", std::chrono::duration<double>(now - start).count(),
-                   frames, hub.subscriberCount());
-        std::fflush(stdout);
-        lastReport = now;
-      }
-      next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
-      std::this_thread::sleep_until(std::max(next, std::chrono::steady_clock::now()));
-    }
-    server.shutdown();
+    if (!o->probes.empty()) producer->serveVolume(volume.probes, volume.active);
+    session::Pacing pacing;
+    pacing.mode = session::Pacing::Mode::FixedRate;
+    pacing.hz = o->hz;
+    pacing.seconds = o->seconds;
+    double lastReport = 0.0;
+    producer->run(pacing, &gInterrupted, [&](double seconds) {
+      if (seconds - lastReport < 5.0) return;
+      fmt::print("serve: {:.0f} s, {} updates, {} subscribers\n", seconds, producer->stats().updates,
+                 producer->hub().subscriberCount());
+      std::fflush(stdout);
+      lastReport = seconds;
+    });
+    const uint32_t frames = producer->stats().updates;
+    producer->shutdownServer();
     fmt::print("serve: stopped after {} updates\n", frames);
     exitCode = 0;
   });
@@ -180,7 +148,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     cc.name = "probecast-subscribe";
     if (!so->tlsCa.empty()) {
       cc.tls = true;
-      cc.rootCertPem = readText(so->tlsCa);
+      cc.rootCertPem = readTextFile(so->tlsCa);
       cc.tlsServerName = so->tlsName;
     }
     service::ProbeClient client(cc);
@@ -198,14 +166,7 @@ void addServeCommands(CLI::App& app, int& exitCode) {
     service::VolumeSnapshot snap;
     if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connect);
     if (!so->out.empty()) {
-      ProbeVolume v;
-      for (int a = 0; a < 3; ++a) {
-        v.dims[a] = snap.layout.grid[a];
-        v.boundsMin[a] = snap.bounds.min[a];
-        v.boundsMax[a] = snap.bounds.max[a];
-      }
-      v.probes = snap.probes;
-      v.active = snap.active;
+      const ProbeVolume v = session::fileFromSnapshot(snap);
       std::string error;
       if (!writeProbeFile(so->out, v, error)) throw std::runtime_error(error);
       fmt::print("wrote {}\n", so->out);

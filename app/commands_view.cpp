@@ -1,9 +1,4 @@
 // `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
-#include <chrono>
-#include <cstring>
-#include <fstream>
-#include <sstream>
-#include <thread>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -14,27 +9,10 @@
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/service/client.h"
+#include "probecast/session/viewer.h"
 #include "scene_options.h"
-#include "view_support.h"
 
 namespace probecast::app {
-
-renderer::ViewSetOptions viewSetOptions(const scene::Scene& s, uint32_t width, uint32_t height) {
-  const renderer::CameraView camera = renderer::CameraView::fromScene(s);
-  renderer::ViewSetOptions vo;
-  vo.aspect = static_cast<float>(width) / static_cast<float>(height);
-  vo.displayDistance = std::max(0.1f, glm::length(0.5f * (s.boundsMin + s.boundsMax) - camera.position));
-  return vo;
-}
-
-std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views) {
-  std::vector<View> out(views.size());
-  for (size_t k = 0; k < views.size(); ++k) {
-    std::memcpy(out[k].viewProj, &views[k].viewProj[0][0], sizeof out[k].viewProj);
-    for (int i = 0; i < 3; ++i) out[k].eye[i] = views[k].eye[i];
-  }
-  return out;
-}
 
 void addViewCommand(CLI::App& app, int& exitCode) {
   CLI::App* cmd = app.add_subcommand("view", "render views (mono, stereo, lf:NxM quilt) lit by probes");
@@ -64,8 +42,7 @@ void addViewCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
-  cmd->add_option("--repr", o->repr, "local probes: pass them through the codec first (float = as traced)")
-      ->check(CLI::IsMember({"float", "l1", "zh3h", "zh3", "l2", "fp16"}));
+  addRepresentationOption(cmd, o->repr, "local probes: pass them through the codec first (float = as traced)", true);
   cmd->add_option("--passes", o->passes, "per-view (one pass per view) or multiview (chunks of views per pass)")
       ->check(CLI::IsMember({"per-view", "multiview"}));
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
@@ -76,72 +53,62 @@ void addViewCommand(CLI::App& app, int& exitCode) {
     if (!renderer::parseViewSet(o->views, spec, error)) throw std::runtime_error(error);
     const scene::Scene s = tr->scene.load();
     const std::vector<renderer::ViewInfo> viewSet =
-        renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, viewSetOptions(s, o->size[0], o->size[1]));
+        renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
     renderer::VulkanContext context(tr->gpu.context());
-    renderer::ProbeVolumeData volume;
-    if (!o->connect.empty()) {
-      service::ClientConfig cc;
-      cc.address = o->connect;
-      cc.token = o->token;
-      cc.name = "probecast-view";
-      if (!o->tlsCa.empty()) {
-        std::ifstream in(o->tlsCa);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        cc.tls = true;
-        cc.rootCertPem = ss.str();
-        cc.tlsServerName = o->tlsName;
-      }
-      cc.interpolateThenHallucinate = true;
-      service::ProbeClient client(cc);
-      client.setViews(priorityViews(viewSet));
-      client.start();
-      const auto start = std::chrono::steady_clock::now();
-      while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o->waitSeconds) &&
-             !client.stats().fatal)
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      client.stop();
-      service::VolumeSnapshot snap;
-      if (!client.snapshot(snap))
-        throw std::runtime_error("no probe volume from " + o->connect + ": " + client.stats().lastError);
-      volume.dims = {snap.layout.grid[0], snap.layout.grid[1], snap.layout.grid[2]};
-      volume.min = {snap.bounds.min[0], snap.bounds.min[1], snap.bounds.min[2]};
-      volume.max = {snap.bounds.max[0], snap.bounds.max[1], snap.bounds.max[2]};
-      volume.probes = std::move(snap.probes);
-      volume.active = std::move(snap.active);
-      volume.hallucinateZh3 = snap.l1Only;
-      fmt::print("view: {} frames ({} bytes) from {}\n", client.stats().framesApplied, client.stats().bytesReceived,
-                 o->connect);
-    } else if (o->probes == "live") {
-      const renderer::ProbeGrid g = tr->grid.resolve(s);
-      renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
-      for (uint32_t u = 0; u < o->updates; ++u) {
-        updater.update();
-        fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);
-      }
-      fmt::print(stderr, "\n");
-      volume = renderer::volumeFromUpdater(updater);
-    } else {
-      ProbeVolume file;
-      if (!readProbeFile(o->probes, file, error)) throw std::runtime_error(error);
-      volume.dims = {file.dims[0], file.dims[1], file.dims[2]};
-      volume.min = {file.boundsMin[0], file.boundsMin[1], file.boundsMin[2]};
-      volume.max = {file.boundsMax[0], file.boundsMax[1], file.boundsMax[2]};
-      volume.probes = std::move(file.probes);
-      volume.active = std::move(file.active);
-    }
-    if (o->repr != "float") {
-      if (!o->connect.empty()) throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
-      volume = renderer::decodeAs(volume, *parseRepresentation(o->repr));
-    }
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
-    renderer::RasterRenderer raster(context, s, o->size[0], o->size[1], ro);
-    raster.setProbes(volume);
+    std::vector<renderer::Image> images;
+    double ms = 0.0;
+    if (!o->connect.empty()) {  // a viewer of a server's stream: subscribe, wait, render what it holds
+      session::ViewerConfig vc;
+      vc.width = o->size[0];
+      vc.height = o->size[1];
+      vc.raster = ro;
+      vc.client.address = o->connect;
+      vc.client.token = o->token;
+      vc.client.name = "probecast-view";
+      if (!o->tlsCa.empty()) {
+        vc.client.tls = true;
+        vc.client.rootCertPem = readTextFile(o->tlsCa);
+        vc.client.tlsServerName = o->tlsName;
+      }
+      vc.client.interpolateThenHallucinate = true;
+      session::Viewer viewer(context, s, viewSet, vc);
+      viewer.start();
+      viewer.waitFor(o->waitSeconds);
+      viewer.stop();
+      const service::ClientStats st = viewer.clientStats();
+      service::VolumeSnapshot held;
+      if (!viewer.snapshot(held)) throw std::runtime_error("no probe volume from " + o->connect + ": " + st.lastError);
+      fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o->connect);
+      if (o->repr != "float") throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
+      viewer.render();
+      images = viewer.images();
+      ms = viewer.timings().viewsMs;
+    } else {
+      renderer::ProbeVolumeData volume;
+      if (o->probes == "live") {
+        const renderer::ProbeGrid g = tr->grid.resolve(s);
+        renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
+        for (uint32_t u = 0; u < o->updates; ++u) {
+          updater.update();
+          fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);
+        }
+        fmt::print(stderr, "\n");
+        volume = renderer::volumeFromUpdater(updater);
+      } else {
+        ProbeVolume file;
+        if (!readProbeFile(o->probes, file, error)) throw std::runtime_error(error);
+        volume = session::volumeFromFile(std::move(file));
+      }
+      if (o->repr != "float") volume = renderer::decodeAs(volume, session::parseRepresentationOrThrow(o->repr));
+      renderer::RasterRenderer raster(context, s, o->size[0], o->size[1], ro);
+      raster.setProbes(volume);
+      images = raster.renderViews(viewSet);
+      ms = raster.timings().viewsMs;
+    }
     const auto& views = viewSet;
-    std::vector<renderer::Image> images = raster.renderViews(views);
-    const double ms = raster.timings().viewsMs;
     std::filesystem::create_directories(o->out);
     const renderer::Image quilt = renderer::composeQuilt(images, views, spec.columns, spec.rows);
     const auto w = static_cast<int>(quilt.width), h = static_cast<int>(quilt.height);

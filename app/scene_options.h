@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -10,6 +11,9 @@
 
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/scene/scene.h"
+#include "probecast/session/representation.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
 
 namespace probecast::app {
 
@@ -20,12 +24,7 @@ struct SceneOptions {
     cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
     cmd->add_option("--t", t, "animation parameter of built-in scenes")->check(CLI::Range(0.0f, 1.0f));
   }
-  scene::Scene load() const {
-    scene::Scene s;
-    std::string error;
-    if (!scene::loadScene(scene, t, s, error)) throw std::runtime_error(error);
-    return s;
-  }
+  scene::Scene load() const { return session::loadSceneOrThrow(scene, t); }
 };
 
 struct GpuOptions {
@@ -46,8 +45,10 @@ struct GpuOptions {
 struct GridOptions {
   std::vector<uint32_t> dims{8, 8, 8};
   std::vector<float> bounds;  // empty: cell-centred in the scene bounds
-  void add(CLI::App* cmd) {
-    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(1, 1024));
+  // --grid (each count in [minDim, maxDim]) and, when withBounds, --bounds.
+  void add(CLI::App* cmd, bool withBounds = true, uint32_t minDim = 1, uint32_t maxDim = 1024) {
+    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(minDim, maxDim));
+    if (!withBounds) return;
     cmd->add_option("--bounds", bounds, "minX,minY,minZ,maxX,maxY,maxZ of the first and last probe (metres)")
         ->delimiter(',')
         ->expected(6);
@@ -62,14 +63,24 @@ struct GridOptions {
       for (float b : bounds)
         if (!std::isfinite(b)) throw std::runtime_error("--bounds must be finite");
     } else {  // probes at the centres of the grid's cells over the scene bounds
-      const glm::vec3 extent = s.boundsMax - s.boundsMin;
-      const glm::vec3 cell = extent / glm::vec3(g.dims);
-      g.min = s.boundsMin + 0.5f * cell;
-      g.max = s.boundsMax - 0.5f * cell;
+      g = session::cellCentredGrid(s, g.dims);
     }
     return g;
   }
 };
+
+// --spp, with each command's own default.
+inline CLI::Option* addSppOption(CLI::App* cmd, uint32_t& spp, const std::string& what = "samples (paths) per probe per update") {
+  return cmd->add_option("--spp", spp, what)->check(CLI::Range(1, 1 << 16));
+}
+
+// --repr (or another name) checked by the one representation parser; `allowFloat` admits "float"
+// (probes as traced).
+inline CLI::Option* addRepresentationOption(CLI::App* cmd, std::string& repr, const std::string& what,
+                                            bool allowFloat = false, const std::string& name = "--repr") {
+  return cmd->add_option(name, repr, what)->check(CLI::Validator(
+      [allowFloat](std::string& value) { return session::checkRepresentation(value, allowFloat); }, "REPR"));
+}
 
 struct TracerOptions {
   uint32_t spp = 128;
@@ -78,7 +89,7 @@ struct TracerOptions {
   float wMin = 0.05f;
   float clamp = 16.0f;
   void add(CLI::App* cmd) {
-    cmd->add_option("--spp", spp, "samples (paths) per probe per update")->check(CLI::Range(1, 1 << 16));
+    addSppOption(cmd, spp);
     cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
     cmd->add_option("--seed", seed, "random seed (same seed, same result)");
     cmd->add_option("--w-min", wMin, "minimum temporal blend weight")->check(CLI::Range(0.0f, 1.0f));
