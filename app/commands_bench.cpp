@@ -1,8 +1,6 @@
-// `probecast bench codec`.
+// `probecast bench codec|update|raster|pipeline|stability|stream`.
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -19,8 +17,6 @@
 
 namespace probecast::app {
 namespace {
-
-std::string gCommandLine;
 
 std::vector<bench::EnvMap> loadEnvMapDir(const std::string& dir) {
   namespace fs = std::filesystem;
@@ -39,52 +35,14 @@ std::vector<bench::EnvMap> loadEnvMapDir(const std::string& dir) {
   for (const std::string& p : paths) {
     bench::EnvMap map;
     std::string error;
-    if (!bench::loadEnvMap(p, map, error)) throw std::runtime_error(error);
+    orThrow(bench::loadEnvMap(p, map, error), error);
     maps.push_back(std::move(map));
   }
   return maps;
 }
 
-}  // namespace
-
-void setCommandLine(int argc, char** argv) {
-  gCommandLine = "probecast";
-  for (int i = 1; i < argc; ++i) gCommandLine += std::string(" ") + argv[i];
-}
-const std::string& commandLine() { return gCommandLine; }
-
-std::string readTextFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void writeTextFile(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path p(path);
-  std::error_code ec;
-  if (p.has_parent_path()) fs::create_directories(p.parent_path(), ec);
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-  if (!out) throw std::runtime_error(path + ": cannot write");
-}
-
-void writeBenchOutputs(const std::string& table, const std::string& json, const std::string& jsonPath,
-                       const std::string& svg, const std::string& chartPath) {
-  fmt::print("{}", table);
-  writeTextFile(jsonPath, json);
-  fmt::print("wrote {}\n", jsonPath);
-  if (!chartPath.empty()) {
-    writeTextFile(chartPath, svg);
-    fmt::print("wrote {}\n", chartPath);
-  }
-}
-
-void addBenchCommands(CLI::App& app, int& exitCode) {
-  CLI::App* bench = app.add_subcommand("bench", "measured speed and accuracy, machine-readable");
-  bench->require_subcommand(1);
+// `probecast bench codec`: codec size against accuracy and speed.
+void addBenchCodec(CLI::App* bench) {
   CLI::App* codec = bench->add_subcommand("codec", "codec size against irradiance accuracy, speed, and temporal coding");
 
   struct Options {
@@ -108,7 +66,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   codec->add_option("--frames", opt->frames, "frames of the moving-light sequence")->check(CLI::Range(2, 100000));
   codec->add_option("--normals", opt->normals, "directions for the brute-force irradiance")->check(CLI::Range(16, 1 << 20));
 
-  codec->callback([opt, &exitCode] {
+  codec->callback([opt] {
     if (opt->envmaps.empty() && opt->probes.empty())
       throw std::runtime_error("give --envmaps DIR and/or --probes FILE");
     bench::CodecBenchOptions options;
@@ -116,7 +74,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     if (!opt->probes.empty()) {
       ProbeVolume volume;
       std::string error;
-      if (!readProbeFile(opt->probes, volume, error)) throw std::runtime_error(error);
+      orThrow(readProbeFile(opt->probes, volume, error), error);
       options.volumeName = opt->probes;
       options.volumeProbes = std::move(volume.probes);
       options.volumeActive = std::move(volume.active);
@@ -128,9 +86,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     options.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::CodecBenchResult r = bench::runCodecBench(options);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", opt->json, r.svg, opt->chart);
-    exitCode = 0;
   });
+}
 
+// `probecast bench update`: updater speed, convergence, flicker.
+void addBenchUpdate(CLI::App* bench) {
   CLI::App* update = bench->add_subcommand("update", "probe updater speed, convergence and flicker");
   auto ut = std::make_shared<TracingOptions>();
   struct UpdateOptions {
@@ -146,7 +106,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   update->add_option("--reference-samples", uo->referenceSamples, "samples per probe of the reference")
       ->check(CLI::Range(1024u, 1u << 24));
   update->add_option("--w-mins", uo->wMins, "w_min values for the flicker runs")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
-  update->callback([=, &exitCode] {
+  update->callback([=] {
     bench::UpdateBenchOptions o;
     o.scene = ut->scene.load();
     o.grid = ut->grid.resolve(o.scene);
@@ -159,9 +119,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     o.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::UpdateBenchResult r = bench::runUpdateBench(o);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", uo->json, r.svg, uo->chart);
-    exitCode = 0;
   });
+}
 
+// `probecast bench raster`: raster client speed and accuracy.
+void addBenchRaster(CLI::App* bench) {
   CLI::App* raster = bench->add_subcommand("raster", "raster client: ms per view for 1..48 views, PSNR/SSIM per representation");
   auto rt = std::make_shared<TracingOptions>();
   struct RasterOptions {
@@ -182,7 +144,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
       ->check(CLI::Range(16, 8192));
   raster->add_option("--json", ro->json, "write the results as JSON here")->required();
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
-  raster->callback([=, &exitCode] {
+  raster->callback([=] {
     ro->bench.scene = rt->scene.load();
     ro->bench.grid = rt->grid.resolve(ro->bench.scene);
     ro->bench.updater = rt->tracer.options();
@@ -200,9 +162,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
       writeTextFile(views, r.svgViews);
       fmt::print("wrote {}\n", views);
     }
-    exitCode = 0;
   });
+}
 
+// `probecast bench pipeline`: PSNR against wire bytes, update time, representation.
+void addBenchPipeline(CLI::App* bench) {
   CLI::App* pipeline = bench->add_subcommand("pipeline", "PSNR against wire bytes, update time and representation");
   auto pt = std::make_shared<TracingOptions>();
   struct PipelineCli {
@@ -221,7 +185,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   pipeline->add_option("--frames", po->bench.streamFrames, "moving-light frames streamed")->check(CLI::Range(2, 10000));
   pipeline->add_option("--json", po->json, "write the results as JSON here")->required();
   pipeline->add_option("--chart", po->chart, "SVG prefix: writes PREFIX_bytes.svg, PREFIX_update.svg, PREFIX_repr.svg");
-  pipeline->callback([=, &exitCode] {
+  pipeline->callback([=] {
     po->bench.sceneSpec = pt->scene.scene;
     po->bench.scene = pt->scene.load();
     po->bench.t = pt->scene.t;
@@ -239,21 +203,25 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
         writeTextFile(po->chart + suffix, *svg);
         fmt::print("wrote {}{}\n", po->chart, suffix);
       }
-    exitCode = 0;
   });
+}
 
+// `probecast bench stability`: the stability suite.
+void addBenchStability(CLI::App* bench) {
   CLI::App* stability = bench->add_subcommand("stability", "the stability suite: where probe lighting fails, measured");
   auto stabilityJson = std::make_shared<std::string>();
   stability->add_option("--json", *stabilityJson, "write the results as JSON here")->required();
-  stability->callback([stabilityJson, &exitCode] {
+  stability->callback([stabilityJson] {
     bench::StabilityOptions so;
     so.command = commandLine();
     so.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::StabilityResult r = bench::runStabilitySuite(so);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", *stabilityJson, "", "");
-    exitCode = 0;
   });
+}
 
+// `probecast bench stream`: the service under N subscribers.
+void addBenchStream(CLI::App* bench) {
   CLI::App* stream = bench->add_subcommand("stream", "the service under N subscribers on loopback");
   struct StreamOptions {
     std::string json, chart;
@@ -269,13 +237,25 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   addRepresentationOption(stream, so->bench.repr, "l1, zh3h, zh3, l2 or fp16");
   stream->add_option("--json", so->json, "write the results as JSON here")->required();
   stream->add_option("--chart", so->chart, "write an SVG chart here");
-  stream->callback([so, &exitCode] {
+  stream->callback([so] {
     so->bench.command = commandLine();
     so->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
-    exitCode = 0;
   });
+}
+
+}  // namespace
+
+void addBenchCommands(CLI::App& app) {
+  CLI::App* bench = app.add_subcommand("bench", "measured speed and accuracy, machine-readable");
+  bench->require_subcommand(1);
+  addBenchCodec(bench);
+  addBenchUpdate(bench);
+  addBenchRaster(bench);
+  addBenchPipeline(bench);
+  addBenchStability(bench);
+  addBenchStream(bench);
 }
 
 }  // namespace probecast::app

@@ -11,7 +11,7 @@
 
 namespace probecast::app {
 
-void addDemoCommand(CLI::App& app, int& exitCode) {
+void addDemoCommand(CLI::App& app) {
   CLI::App* demo = app.add_subcommand("demo", "server + stereo and light-field viewers over loopback; writes out/");
   auto o = std::make_shared<DemoOptions>();
   demo->add_option("--out", o->out, "output folder");
@@ -26,13 +26,12 @@ void addDemoCommand(CLI::App& app, int& exitCode) {
   demo->add_option("--reference-spp", o->referenceSpp, "samples per pixel of the reference images")
       ->check(CLI::Range(1, 1 << 16));
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
-  demo->callback([o, &exitCode] {
+  demo->callback([o] {
     DemoRun run;
     run.wallStart = DemoClock::now();
     std::filesystem::create_directories(o->out);
     runDemoSession(*o, run);
     writeDemoReport(*o, run);
-    exitCode = 0;
   });
 }
 

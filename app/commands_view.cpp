@@ -13,28 +13,104 @@
 #include "scene_options.h"
 
 namespace probecast::app {
+namespace {
 
-void addViewCommand(CLI::App& app, int& exitCode) {
+struct ViewOptions {
+  TracingOptions tracing;
+  ConnectOptions connection;
+  std::string probes = "live", views = "lf:5x5", out = "out/view";
+  std::string repr = "float", passes = "per-view", toneMap = "filmic";
+  uint32_t shadowMap = 1024;
+  double waitSeconds = 3.0;
+  std::vector<uint32_t> size{320, 200};
+  uint32_t updates = 4;
+  float exposure = 1.0f;
+  bool exr = false;
+};
+
+struct Rendered {
+  std::vector<renderer::Image> images;
+  double viewsMs = 0.0;
+};
+
+// A viewer of a server's stream: subscribe for --wait seconds, then render what it holds.
+Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                          const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
+  session::ViewerConfig vc;
+  vc.width = o.size[0];
+  vc.height = o.size[1];
+  vc.raster = ro;
+  vc.client = o.connection.client("probecast-view");
+  vc.client.interpolateThenHallucinate = true;
+  session::Viewer viewer(context, s, views, vc);
+  viewer.start();
+  viewer.waitFor(o.waitSeconds);
+  viewer.stop();
+  const service::ClientStats st = viewer.clientStats();
+  service::VolumeSnapshot held;
+  if (!viewer.snapshot(held))
+    throw std::runtime_error("no probe volume from " + o.connection.connect + ": " + st.lastError);
+  fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o.connection.connect);
+  if (o.repr != "float") throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
+  viewer.render();
+  return {viewer.images(), viewer.timings().viewsMs};
+}
+
+// Local probes: traced now (--probes live) or read from a file, through --repr when given.
+Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                     const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
+  renderer::ProbeVolumeData volume;
+  if (o.probes == "live") {
+    renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), o.tracing.tracer.options());
+    for (uint32_t u = 0; u < o.updates; ++u) {
+      updater.update();
+      fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o.updates);
+    }
+    fmt::print(stderr, "\n");
+    volume = renderer::volumeFromUpdater(updater);
+  } else {
+    ProbeVolume file;
+    std::string error;
+    orThrow(readProbeFile(o.probes, file, error), error);
+    volume = session::volumeFromFile(std::move(file));
+  }
+  if (o.repr != "float") volume = renderer::decodeAs(volume, session::parseRepresentationOrThrow(o.repr));
+  renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
+  raster.setProbes(volume);
+  Rendered r;
+  r.images = raster.renderViews(views);
+  r.viewsMs = raster.timings().viewsMs;
+  return r;
+}
+
+// quilt.png (tone-mapped), quilt.exr and, with --exr, every view as an EXR.
+void writeViews(const ViewOptions& o, const Rendered& r, const std::vector<renderer::ViewInfo>& views,
+                const renderer::ViewSetSpec& spec) {
+  std::filesystem::create_directories(o.out);
+  const renderer::Image quilt = renderer::composeQuilt(r.images, views, spec.columns, spec.rows);
+  const auto w = static_cast<int>(quilt.width), h = static_cast<int>(quilt.height);
+  bench::ToneMap toneMap = bench::ToneMap::Filmic;
+  bench::parseToneMap(o.toneMap, toneMap);
+  std::string error;
+  orThrow(bench::writePngPreview(o.out + "/quilt.png", quilt.rgb, w, h, o.exposure, error, toneMap) &&
+              bench::writeExr(o.out + "/quilt.exr", quilt.rgb, w, h, error),
+          error);
+  if (o.exr)
+    for (size_t k = 0; k < r.images.size(); ++k)
+      orThrow(bench::writeExr(fmt::format("{}/view_{:02}.exr", o.out, k), r.images[k].rgb, static_cast<int>(o.size[0]),
+                              static_cast<int>(o.size[1]), error),
+              error);
+}
+
+}  // namespace
+
+void addViewCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("view", "render views (mono, stereo, lf:NxM quilt) lit by probes");
-  auto tr = std::make_shared<TracingOptions>();
-  struct Options {
-    std::string probes = "live", views = "lf:5x5", out = "out/view", connect, token, tlsCa, tlsName;
-    std::string repr = "float", passes = "per-view", toneMap = "filmic";
-    uint32_t shadowMap = 1024;
-    double waitSeconds = 3.0;
-    std::vector<uint32_t> size{320, 200};
-    uint32_t updates = 4;
-    float exposure = 1.0f;
-    bool exr = false;
-  };
-  auto o = std::make_shared<Options>();
-  tr->add(cmd);
+  auto o = std::make_shared<ViewOptions>();
+  o->tracing.add(cmd);
   cmd->add_option("--probes", o->probes, "probe volume file, or 'live' to trace it now");
   cmd->add_option("--updates", o->updates, "live: updates to accumulate")->check(CLI::Range(1, 100000));
-  cmd->add_option("--connect", o->connect, "take the probes from a probecast server (host:port) instead");
-  cmd->add_option("--token", o->token, "bearer token for --connect");
-  cmd->add_option("--tls-ca", o->tlsCa, "PEM root certificate to trust (TLS)")->check(CLI::ExistingFile);
-  cmd->add_option("--tls-name", o->tlsName, "server name to check in its certificate");
+  o->connection.add(cmd, "take the probes from a probecast server (host:port) instead", false, false);
   cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
       ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
@@ -47,84 +123,23 @@ void addViewCommand(CLI::App& app, int& exitCode) {
       ->check(CLI::IsMember({"per-view", "multiview"}));
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
-  cmd->callback([=, &exitCode] {
+  cmd->callback([o] {
     renderer::ViewSetSpec spec;
     std::string error;
-    if (!renderer::parseViewSet(o->views, spec, error)) throw std::runtime_error(error);
-    const scene::Scene s = tr->scene.load();
-    const std::vector<renderer::ViewInfo> viewSet =
-        renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
-    renderer::VulkanContext context(tr->gpu.context());
+    orThrow(renderer::parseViewSet(o->views, spec, error), error);
+    const scene::Scene s = o->tracing.scene.load();
+    const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
+        renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
+    renderer::VulkanContext context(o->tracing.gpu.context());
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
-    std::vector<renderer::Image> images;
-    double ms = 0.0;
-    if (!o->connect.empty()) {  // a viewer of a server's stream: subscribe, wait, render what it holds
-      session::ViewerConfig vc;
-      vc.width = o->size[0];
-      vc.height = o->size[1];
-      vc.raster = ro;
-      vc.client.address = o->connect;
-      vc.client.token = o->token;
-      vc.client.name = "probecast-view";
-      if (!o->tlsCa.empty()) {
-        vc.client.tls = true;
-        vc.client.rootCertPem = readTextFile(o->tlsCa);
-        vc.client.tlsServerName = o->tlsName;
-      }
-      vc.client.interpolateThenHallucinate = true;
-      session::Viewer viewer(context, s, viewSet, vc);
-      viewer.start();
-      viewer.waitFor(o->waitSeconds);
-      viewer.stop();
-      const service::ClientStats st = viewer.clientStats();
-      service::VolumeSnapshot held;
-      if (!viewer.snapshot(held)) throw std::runtime_error("no probe volume from " + o->connect + ": " + st.lastError);
-      fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o->connect);
-      if (o->repr != "float") throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
-      viewer.render();
-      images = viewer.images();
-      ms = viewer.timings().viewsMs;
-    } else {
-      renderer::ProbeVolumeData volume;
-      if (o->probes == "live") {
-        const renderer::ProbeGrid g = tr->grid.resolve(s);
-        renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
-        for (uint32_t u = 0; u < o->updates; ++u) {
-          updater.update();
-          fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o->updates);
-        }
-        fmt::print(stderr, "\n");
-        volume = renderer::volumeFromUpdater(updater);
-      } else {
-        ProbeVolume file;
-        if (!readProbeFile(o->probes, file, error)) throw std::runtime_error(error);
-        volume = session::volumeFromFile(std::move(file));
-      }
-      if (o->repr != "float") volume = renderer::decodeAs(volume, session::parseRepresentationOrThrow(o->repr));
-      renderer::RasterRenderer raster(context, s, o->size[0], o->size[1], ro);
-      raster.setProbes(volume);
-      images = raster.renderViews(viewSet);
-      ms = raster.timings().viewsMs;
-    }
-    const auto& views = viewSet;
-    std::filesystem::create_directories(o->out);
-    const renderer::Image quilt = renderer::composeQuilt(images, views, spec.columns, spec.rows);
-    const auto w = static_cast<int>(quilt.width), h = static_cast<int>(quilt.height);
-    bench::ToneMap toneMap = bench::ToneMap::Filmic;
-    bench::parseToneMap(o->toneMap, toneMap);
-    if (!bench::writePngPreview(o->out + "/quilt.png", quilt.rgb, w, h, o->exposure, error, toneMap) ||
-        !bench::writeExr(o->out + "/quilt.exr", quilt.rgb, w, h, error))
-      throw std::runtime_error(error);
-    if (o->exr)
-      for (size_t k = 0; k < images.size(); ++k)
-        if (!bench::writeExr(fmt::format("{}/view_{:02}.exr", o->out, k), images[k].rgb, static_cast<int>(o->size[0]),
-                             static_cast<int>(o->size[1]), error))
-          throw std::runtime_error(error);
+    const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
+                                                     : renderFromServer(*o, context, s, views, ro);
+    writeViews(*o, r, views, spec);
     fmt::print("view: {} {} views of {}x{} on {}: {:.1f} ms per view; wrote {}/quilt.png and quilt.exr\n", o->views,
-               views.size(), o->size[0], o->size[1], context.deviceName(), ms / static_cast<double>(views.size()), o->out);
-    exitCode = 0;
+               views.size(), o->size[0], o->size[1], context.deviceName(), r.viewsMs / static_cast<double>(views.size()),
+               o->out);
   });
 }
 

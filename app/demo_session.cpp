@@ -7,6 +7,7 @@
 #include <random>
 #include <thread>
 
+#include "commands.h"
 #include "demo.h"
 #include "image_io.h"
 #include "probecast/session/representation.h"
@@ -80,7 +81,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
   session::ProbeProducer& producer = *run.producer;
   for (DemoViewer& v : run.viewers) {
     std::string error;
-    if (!renderer::parseViewSet(v.viewSet, v.spec, error)) throw std::runtime_error(error);
+    orThrow(renderer::parseViewSet(v.viewSet, v.spec, error), error);
     session::ViewerConfig vc;
     vc.width = v.width;
     vc.height = v.height;

@@ -9,7 +9,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "commands.h"
 #include "probecast/renderer/probe_updater.h"
+#include "probecast/service/client.h"
 #include "probecast/scene/scene.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/scene_loading.h"
@@ -103,6 +105,39 @@ struct TracerOptions {
     o.minBlendWeight = wMin;
     o.indirectClamp = clamp;
     return o;
+  }
+};
+
+// A bearer token given inline or in a file (trailing newlines and spaces dropped).
+inline std::string tokenFrom(const std::string& token, const std::string& file) {
+  if (file.empty()) return token;
+  std::string t = readTextFile(file);
+  while (!t.empty() && (t.back() == '\n' || t.back() == '\r' || t.back() == ' ')) t.pop_back();
+  return t;
+}
+
+// A client's connection to a server: --connect, --token (and --token-file), --tls-ca, --tls-name.
+struct ConnectOptions {
+  std::string connect, token, tokenFile, tlsCa, tlsName;
+  void add(CLI::App* cmd, const std::string& what, bool required, bool withTokenFile) {
+    CLI::Option* c = cmd->add_option("--connect", connect, what);
+    if (required) c->required();
+    cmd->add_option("--token", token, "bearer token");
+    if (withTokenFile) cmd->add_option("--token-file", tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
+    cmd->add_option("--tls-ca", tlsCa, "PEM root certificate to trust (enables TLS)")->check(CLI::ExistingFile);
+    cmd->add_option("--tls-name", tlsName, "server name to check in its certificate");
+  }
+  service::ClientConfig client(const std::string& name) const {
+    service::ClientConfig cc;
+    cc.address = connect;
+    cc.token = tokenFrom(token, tokenFile);
+    cc.name = name;
+    if (!tlsCa.empty()) {
+      cc.tls = true;
+      cc.rootCertPem = readTextFile(tlsCa);
+      cc.tlsServerName = tlsName;
+    }
+    return cc;
   }
 };
 

@@ -61,6 +61,18 @@ renderer::ProbeVolumeData volumeFromFile(ProbeVolume&& file) {
   return v;
 }
 
+ProbeVolume fileFromUpdater(const renderer::ProbeUpdater& updater, const renderer::ProbeGrid& g) {
+  ProbeVolume volume;
+  for (int a = 0; a < 3; ++a) {
+    volume.dims[a] = g.dims[a];
+    volume.boundsMin[a] = g.min[a];
+    volume.boundsMax[a] = g.max[a];
+  }
+  volume.probes.assign(updater.probes(), updater.probes() + static_cast<size_t>(g.count()) * kProbeFloats);
+  volume.active.assign(updater.activeMask(), updater.activeMask() + g.count());
+  return volume;
+}
+
 ProbeVolume fileFromSnapshot(const service::VolumeSnapshot& snap) {
   ProbeVolume v;
   for (int a = 0; a < 3; ++a) {

@@ -30,6 +30,8 @@ service::HubConfig hubConfigFor(const ProbeVolume& file, Representation repr, in
 renderer::ProbeVolumeData volumeFromSnapshot(service::VolumeSnapshot&& snapshot);
 // A baked probe volume file as the raster client takes it (moves the probes out of `file`).
 renderer::ProbeVolumeData volumeFromFile(ProbeVolume&& file);
+// The updater's probes over `grid` as a probe volume file (updates and samples left for the caller).
+ProbeVolume fileFromUpdater(const renderer::ProbeUpdater& updater, const renderer::ProbeGrid& grid);
 // What a client holds, as a probe volume file.
 ProbeVolume fileFromSnapshot(const service::VolumeSnapshot& snapshot);
 
