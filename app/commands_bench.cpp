@@ -58,7 +58,7 @@ void addBenchCodec(CLI::App* bench) {
                      ->check(CLI::ExistingFile);
   (void)envmaps;
   (void)probes;
-  codec->add_option("--json", opt->json, "write the results as JSON here")->required();
+  addJsonOption(codec, opt->json);
   codec->add_option("--chart", opt->chart, "write an SVG chart of error against bytes here");
   codec->add_option("--deadzones", opt->deadzones, "dead-zones (quantisation steps) for the temporal part")
       ->delimiter(',')
@@ -100,7 +100,7 @@ void addBenchUpdate(CLI::App* bench) {
   };
   auto uo = std::make_shared<UpdateOptions>();
   ut->add(update);
-  update->add_option("--json", uo->json, "write the results as JSON here")->required();
+  addJsonOption(update, uo->json);
   update->add_option("--chart", uo->chart, "write an SVG chart of error against time here");
   update->add_option("--updates", uo->updates, "updates per run")->check(CLI::Range(2, 10000));
   update->add_option("--reference-samples", uo->referenceSamples, "samples per probe of the reference")
@@ -135,14 +135,13 @@ void addBenchRaster(CLI::App* bench) {
   rt->add(raster);
   raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM, lfh:NxM), comma-separated")
       ->delimiter(',');
-  raster->add_option("--size", ro->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
+  addSizeOption(raster, ro->size, "size of each view WxH", 8, 4096);
   raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));
   raster->add_option("--repeats", ro->bench.repeats, "timed renders per case (median)")->check(CLI::Range(1, 1000));
-  raster->add_option("--reference-spp", ro->bench.referenceSpp, "samples per pixel of the reference")
-      ->check(CLI::Range(1, 1 << 20));
+  addReferenceSppOption(raster, ro->bench.referenceSpp, 1u << 20);
   raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
       ->check(CLI::Range(16, 8192));
-  raster->add_option("--json", ro->json, "write the results as JSON here")->required();
+  addJsonOption(raster, ro->json);
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
   raster->callback([=] {
     ro->bench.scene = rt->scene.load();
@@ -176,14 +175,13 @@ void addBenchPipeline(CLI::App* bench) {
   };
   auto po = std::make_shared<PipelineCli>();
   pt->add(pipeline, false);
-  pipeline->add_option("--size", po->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
-  pipeline->add_option("--reference-spp", po->bench.referenceSpp, "samples per pixel of the reference")
-      ->check(CLI::Range(1, 1 << 20));
+  addSizeOption(pipeline, po->size, "image size WxH", 8, 4096);
+  addReferenceSppOption(pipeline, po->bench.referenceSpp, 1u << 20);
   pipeline->add_option("--spps", po->bench.spps, "samples per probe to try")->delimiter(',')->check(CLI::Range(1, 1 << 16));
   pipeline->add_option("--bounces", po->bench.bounces, "bounce limits to try")->delimiter(',')->check(CLI::Range(1, 16));
   pipeline->add_option("--deadzones", po->bench.deadzones, "dead-zones to try")->delimiter(',')->check(CLI::Range(0, 127));
   pipeline->add_option("--frames", po->bench.streamFrames, "moving-light frames streamed")->check(CLI::Range(2, 10000));
-  pipeline->add_option("--json", po->json, "write the results as JSON here")->required();
+  addJsonOption(pipeline, po->json);
   pipeline->add_option("--chart", po->chart, "SVG prefix: writes PREFIX_bytes.svg, PREFIX_update.svg, PREFIX_repr.svg");
   pipeline->callback([=] {
     po->bench.sceneSpec = pt->scene.scene;
@@ -210,7 +208,7 @@ void addBenchPipeline(CLI::App* bench) {
 void addBenchStability(CLI::App* bench) {
   CLI::App* stability = bench->add_subcommand("stability", "the stability suite: where probe lighting fails, measured");
   auto stabilityJson = std::make_shared<std::string>();
-  stability->add_option("--json", *stabilityJson, "write the results as JSON here")->required();
+  addJsonOption(stability, *stabilityJson);
   stability->callback([stabilityJson] {
     bench::StabilityOptions so;
     so.command = commandLine();
@@ -235,7 +233,7 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--seconds", so->bench.seconds, "measured time per subscriber count")->check(CLI::Range(2.0, 3600.0));
   stream->add_option("--budget", so->bench.budgetBytesPerSecond, "bytes per second per subscriber (0 = unlimited)");
   addRepresentationOption(stream, so->bench.repr, "l1, zh3h, zh3, l2 or fp16");
-  stream->add_option("--json", so->json, "write the results as JSON here")->required();
+  addJsonOption(stream, so->json);
   stream->add_option("--chart", so->chart, "write an SVG chart here");
   stream->callback([so] {
     so->bench.command = commandLine();

@@ -18,13 +18,12 @@ void addDemoCommand(CLI::App& app) {
   demo->add_option("--scene", o->scene, "scene the server lights (built-in scenes animate their light)");
   demo->add_option("--seconds", o->seconds, "streaming time with the light moving")->check(CLI::Range(1.0, 3600.0));
   addSppOption(demo, o->spp, "updater samples per probe per update");
-  demo->add_option("--grid", o->grid, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(2, 64));
+  o->grid.add(demo, false, 2, 64);
   addRepresentationOption(demo, o->repr, "representation streamed");
   demo->add_option("--light-field", o->lightField, "the light-field display's view set (lf:NxM or lfh:NxM)");
   demo->add_option("--settle-updates", o->settleUpdates, "updates with the light frozen before the comparison")
       ->check(CLI::Range(1, 10000));
-  demo->add_option("--reference-spp", o->referenceSpp, "samples per pixel of the reference images")
-      ->check(CLI::Range(1, 1 << 16));
+  addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
   demo->callback([o] {
     DemoRun run;

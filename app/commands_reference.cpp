@@ -23,8 +23,8 @@ void addReferenceCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
   scene->add(cmd);
   gpu->add(cmd);
-  cmd->add_option("--size", o->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
-  cmd->add_option("--spp", o->spp, "samples per pixel")->check(CLI::Range(1, 1 << 20));
+  addSizeOption(cmd, o->size, "image size WxH", 1, 8192);
+  addSppOption(cmd, o->spp, "samples per pixel", 1u << 20);
   cmd->add_option("--bounces", o->bounces, "surface interactions per path")->check(CLI::Range(1, 16));
   cmd->add_option("--seed", o->seed, "random seed");
   cmd->add_option("--eye", o->eye, "camera position X,Y,Z (default: the scene's camera)")->delimiter(',')->expected(3);

@@ -114,7 +114,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
       ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
-  cmd->add_option("--size", o->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
+  addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");

@@ -17,6 +17,7 @@
 #include "probecast/scene/scene.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/viewer.h"
+#include "scene_options.h"
 #include "svg_chart.h"
 
 namespace probecast::app {
@@ -29,7 +30,7 @@ struct DemoOptions {
   double seconds = 24.0;        // streaming with the light moving
   double turnsPerMinute = 1.5;  // light speed (builtin scenes move it once around per unit of t)
   uint32_t spp = 64;            // updater samples per probe per update
-  std::vector<uint32_t> grid{8, 8, 8};
+  GridOptions grid;  // --grid only (no --bounds), 2…64 per axis
   std::string repr = "zh3";
   std::string lightField = "lf:5x5";
   uint32_t settleUpdates = 24;  // updates with the light frozen before the comparison

@@ -40,9 +40,7 @@ namespace {
 // The server: the updater tracing the scene as its t follows wall time, the hub, gRPC on loopback.
 service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   run.scene0 = session::loadSceneOrThrow(o.scene, 0.0f);
-  GridOptions gridOptions;
-  gridOptions.dims = o.grid;
-  run.grid = gridOptions.resolve(run.scene0);
+  run.grid = o.grid.resolve(run.scene0);
   run.serverContext = std::make_unique<renderer::VulkanContext>(renderer::ContextOptions{});
   run.producer = std::make_unique<session::ProbeProducer>(
       session::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1));

@@ -49,7 +49,7 @@ struct GridOptions {
   std::vector<float> bounds;  // empty: cell-centred in the scene bounds
   // --grid (each count in [minDim, maxDim]) and, when withBounds, --bounds.
   void add(CLI::App* cmd, bool withBounds = true, uint32_t minDim = 1, uint32_t maxDim = 1024) {
-    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(minDim, maxDim));
+    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(static_cast<int>(minDim), static_cast<int>(maxDim)));
     if (!withBounds) return;
     cmd->add_option("--bounds", bounds, "minX,minY,minZ,maxX,maxY,maxZ of the first and last probe (metres)")
         ->delimiter(',')
@@ -71,9 +71,28 @@ struct GridOptions {
   }
 };
 
-// --spp, with each command's own default.
-inline CLI::Option* addSppOption(CLI::App* cmd, uint32_t& spp, const std::string& what = "samples (paths) per probe per update") {
-  return cmd->add_option("--spp", spp, what)->check(CLI::Range(1, 1 << 16));
+// --spp (samples per probe per update, or per pixel), with each command's own default and limit.
+inline CLI::Option* addSppOption(CLI::App* cmd, uint32_t& spp,
+                                 const std::string& what = "samples (paths) per probe per update",
+                                 uint32_t max = 1u << 16) {
+  return cmd->add_option("--spp", spp, what)->check(CLI::Range(1, static_cast<int>(max)));
+}
+
+// --reference-spp: samples per pixel of the reference images.
+inline CLI::Option* addReferenceSppOption(CLI::App* cmd, uint32_t& spp, uint32_t max,
+                                          const std::string& what = "samples per pixel of the reference") {
+  return cmd->add_option("--reference-spp", spp, what)->check(CLI::Range(1, static_cast<int>(max)));
+}
+
+// --size WxH, each in [min, max].
+inline CLI::Option* addSizeOption(CLI::App* cmd, std::vector<uint32_t>& size, const std::string& what, uint32_t min,
+                                  uint32_t max) {
+  return cmd->add_option("--size", size, what)->delimiter('x')->expected(2)->check(CLI::Range(static_cast<int>(min), static_cast<int>(max)));
+}
+
+// --json FILE, required by every benchmark.
+inline CLI::Option* addJsonOption(CLI::App* cmd, std::string& json) {
+  return cmd->add_option("--json", json, "write the results as JSON here")->required();
 }
 
 // --repr (or another name) checked by the one representation parser; `allowFloat` admits "float"
@@ -81,7 +100,8 @@ inline CLI::Option* addSppOption(CLI::App* cmd, uint32_t& spp, const std::string
 inline CLI::Option* addRepresentationOption(CLI::App* cmd, std::string& repr, const std::string& what,
                                             bool allowFloat = false, const std::string& name = "--repr") {
   return cmd->add_option(name, repr, what)->check(CLI::Validator(
-      [allowFloat](std::string& value) { return session::checkRepresentation(value, allowFloat); }, "REPR"));
+      [allowFloat](std::string& value) { return session::checkRepresentation(value, allowFloat); },
+      allowFloat ? "{float,l1,zh3h,zh3,l2,fp16}" : "{l1,zh3h,zh3,l2,fp16}"));
 }
 
 struct TracerOptions {
