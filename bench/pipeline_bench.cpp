@@ -10,6 +10,7 @@
 #include "probecast/codec/stream.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
 #include "probecast/session/stats.h"
 #include "svg_chart.h"
 
@@ -159,8 +160,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
     say(fmt::format("pipeline bench: {} moving-light frames traced", o.streamFrames));
   }
   std::vector<Point> bytesPoints;
-  StreamLayout layout;
-  for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(o.grid.dims[a]);
+  StreamLayout layout = session::streamLayoutFor(o.grid, Representation::L1);
   for (Representation repr : kAllRepresentations)
     for (int dz : o.deadzones) {
       layout.repr = repr;

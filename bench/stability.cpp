@@ -385,9 +385,7 @@ std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, cons
     }
   }
   SceneNeeds r;
-  StreamLayout layout;
-  for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(grid.dims[a]);
-  layout.repr = Representation::L2;
+  const StreamLayout layout = session::streamLayoutFor(grid, Representation::L2);
   StreamEncoder encoder(layout);
   std::vector<uint8_t> frame;
   encoder.update(v.probes.data(), v.active.data());

@@ -19,13 +19,19 @@ renderer::ProbeGrid unitGrid(glm::uvec3 dims) {
   return g;
 }
 
+StreamLayout streamLayoutFor(const renderer::ProbeGrid& grid, Representation repr, int brick) {
+  StreamLayout layout;
+  for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(grid.dims[a]);
+  layout.brickDim = static_cast<uint8_t>(brick);
+  layout.repr = repr;
+  return layout;
+}
+
 service::HubConfig hubConfigFor(const renderer::ProbeGrid& grid, Representation repr, int brick, int deadzone) {
   service::HubConfig hc;
-  hc.layout.repr = repr;
-  hc.layout.brickDim = static_cast<uint8_t>(brick);
+  hc.layout = streamLayoutFor(grid, repr, brick);
   hc.encoder.deadzone = deadzone;
   for (int a = 0; a < 3; ++a) {
-    hc.layout.grid[a] = static_cast<uint16_t>(grid.dims[a]);
     hc.bounds.min[a] = grid.min[a];
     hc.bounds.max[a] = grid.max[a];
   }

@@ -8,6 +8,7 @@
 
 #include "probecast/codec/probe_file.h"
 #include "probecast/codec/record.h"
+#include "probecast/codec/stream.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/scene/scene.h"
@@ -21,6 +22,8 @@ renderer::ProbeGrid cellCentredGrid(const scene::Scene& scene, glm::uvec3 dims);
 // dims probes from (0, 0, 0) to dims − 1, one metre apart.
 renderer::ProbeGrid unitGrid(glm::uvec3 dims);
 
+// The stream layout of `grid` as `repr` in bricks of `brick`³ probes.
+StreamLayout streamLayoutFor(const renderer::ProbeGrid& grid, Representation repr, int brick = 4);
 // A hub streaming `grid` as `repr` in bricks of `brick`³ probes, dropping changes up to `deadzone` steps.
 service::HubConfig hubConfigFor(const renderer::ProbeGrid& grid, Representation repr, int brick, int deadzone);
 // The same for a baked probe volume file.
