@@ -1,18 +1,29 @@
 // Subcommands of the probecast binary: each registers its options and its action.
 #pragma once
 
+#include <stdexcept>
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace probecast::app {
 
-void addBenchCommands(CLI::App& app, int& exitCode);
-void addDemoCommand(CLI::App& app, int& exitCode);
-void addBakeCommand(CLI::App& app, int& exitCode);
-void addReferenceCommand(CLI::App& app, int& exitCode);
-void addServeCommands(CLI::App& app, int& exitCode);
-void addCompareCommand(CLI::App& app, int& exitCode);
-void addViewCommand(CLI::App& app, int& exitCode);
+void addBenchCommands(CLI::App& app);
+void addDemoCommand(CLI::App& app);
+void addBakeCommand(CLI::App& app);
+void addReferenceCommand(CLI::App& app);
+void addServeCommands(CLI::App& app);
+void addCompareCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
+// The one error channel of the commands: an exception, which main prints and exits 1 with.
+// For the calls that report failure through an error string.
+inline void orThrow(bool ok, const std::string& error) {
+  if (!ok) throw std::runtime_error(error);
+}
+
+// The contents of a text file; throws std::runtime_error with the path when it cannot be read.
+std::string readTextFile(const std::string& path);
 // Writes text to a file, creating parent folders; throws std::runtime_error with the path on failure.
 void writeTextFile(const std::string& path, const std::string& text);
 // Prints a benchmark's table, writes its JSON and (when a path is given) its SVG chart.

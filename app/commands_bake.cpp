@@ -4,11 +4,12 @@
 #include "commands.h"
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/probe_updater.h"
+#include "probecast/session/volumes.h"
 #include "scene_options.h"
 
 namespace probecast::app {
 
-void addBakeCommand(CLI::App& app, int& exitCode) {
+void addBakeCommand(CLI::App& app) {
   CLI::App* bake = app.add_subcommand("bake", "path-trace a probe grid and write it (float SH + active mask)");
   auto tr = std::make_shared<TracingOptions>();
   auto out = std::make_shared<std::string>();
@@ -16,7 +17,7 @@ void addBakeCommand(CLI::App& app, int& exitCode) {
   tr->add(bake);
   bake->add_option("--updates", *updates, "updates to accumulate")->check(CLI::Range(1, 100000));
   bake->add_option("--out", *out, "probe volume file to write")->required();
-  bake->callback([=, &exitCode] {
+  bake->callback([=] {
     const scene::Scene s = tr->scene.load();
     renderer::VulkanContext context(tr->gpu.context());
     const ProbeGrid g = tr->grid.resolve(s);
@@ -32,11 +33,10 @@ void addBakeCommand(CLI::App& app, int& exitCode) {
                  static_cast<double>(st.closestHitRays + st.shadowRays) / st.milliseconds / 1e3);
     }
     std::string error;
-    if (!writeProbeFile(*out, updater.volume(), error)) throw std::runtime_error(error);
+    orThrow(writeProbeFile(*out, updater.volume(), error), error);
     if (context.validationMessages() > 0)
       fmt::print(stderr, "bake: {} Vulkan validation messages\n", context.validationMessages());
     fmt::print("wrote {}\n", *out);
-    exitCode = 0;
   });
 }
 

@@ -1,7 +1,6 @@
-// `probecast bench codec`.
+// `probecast bench codec|update|raster|pipeline|stability|stream`.
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -18,8 +17,6 @@
 
 namespace probecast::app {
 namespace {
-
-std::string gCommandLine;
 
 std::vector<bench::EnvMap> loadEnvMapDir(const std::string& dir) {
   namespace fs = std::filesystem;
@@ -38,44 +35,14 @@ std::vector<bench::EnvMap> loadEnvMapDir(const std::string& dir) {
   for (const std::string& p : paths) {
     bench::EnvMap map;
     std::string error;
-    if (!bench::loadEnvMap(p, map, error)) throw std::runtime_error(error);
+    orThrow(bench::loadEnvMap(p, map, error), error);
     maps.push_back(std::move(map));
   }
   return maps;
 }
 
-}  // namespace
-
-void setCommandLine(int argc, char** argv) {
-  gCommandLine = "probecast";
-  for (int i = 1; i < argc; ++i) gCommandLine += std::string(" ") + argv[i];
-}
-const std::string& commandLine() { return gCommandLine; }
-
-void writeTextFile(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path p(path);
-  std::error_code ec;
-  if (p.has_parent_path()) fs::create_directories(p.parent_path(), ec);
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-  if (!out) throw std::runtime_error(path + ": cannot write");
-}
-
-void writeBenchOutputs(const std::string& table, const std::string& json, const std::string& jsonPath,
-                       const std::string& svg, const std::string& chartPath) {
-  fmt::print("{}", table);
-  writeTextFile(jsonPath, json);
-  fmt::print("wrote {}\n", jsonPath);
-  if (!chartPath.empty()) {
-    writeTextFile(chartPath, svg);
-    fmt::print("wrote {}\n", chartPath);
-  }
-}
-
-void addBenchCommands(CLI::App& app, int& exitCode) {
-  CLI::App* bench = app.add_subcommand("bench", "measured speed and accuracy, machine-readable");
-  bench->require_subcommand(1);
+// `probecast bench codec`: codec size against accuracy and speed.
+void addBenchCodec(CLI::App* bench) {
   CLI::App* codec = bench->add_subcommand("codec", "codec size against irradiance accuracy, speed, and temporal coding");
 
   struct Options {
@@ -91,7 +58,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
                      ->check(CLI::ExistingFile);
   (void)envmaps;
   (void)probes;
-  codec->add_option("--json", opt->json, "write the results as JSON here")->required();
+  addJsonOption(codec, opt->json);
   codec->add_option("--chart", opt->chart, "write an SVG chart of error against bytes here");
   codec->add_option("--deadzones", opt->deadzones, "dead-zones (quantisation steps) for the temporal part")
       ->delimiter(',')
@@ -99,7 +66,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   codec->add_option("--frames", opt->frames, "frames of the moving-light sequence")->check(CLI::Range(2, 100000));
   codec->add_option("--normals", opt->normals, "directions for the brute-force irradiance")->check(CLI::Range(16, 1 << 20));
 
-  codec->callback([opt, &exitCode] {
+  codec->callback([opt] {
     if (opt->envmaps.empty() && opt->probes.empty())
       throw std::runtime_error("give --envmaps DIR and/or --probes FILE");
     bench::CodecBenchOptions options;
@@ -107,7 +74,7 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     if (!opt->probes.empty()) {
       ProbeVolume volume;
       std::string error;
-      if (!readProbeFile(opt->probes, volume, error)) throw std::runtime_error(error);
+      orThrow(readProbeFile(opt->probes, volume, error), error);
       options.volumeName = opt->probes;
       options.volumeProbes = std::move(volume.probes);
       options.volumeActive = std::move(volume.active);
@@ -119,9 +86,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     options.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::CodecBenchResult r = bench::runCodecBench(options);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", opt->json, r.svg, opt->chart);
-    exitCode = 0;
   });
+}
 
+// `probecast bench update`: updater speed, convergence, flicker.
+void addBenchUpdate(CLI::App* bench) {
   CLI::App* update = bench->add_subcommand("update", "probe updater speed, convergence and flicker");
   auto ut = std::make_shared<TracingOptions>();
   struct UpdateOptions {
@@ -131,13 +100,13 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   };
   auto uo = std::make_shared<UpdateOptions>();
   ut->add(update);
-  update->add_option("--json", uo->json, "write the results as JSON here")->required();
+  addJsonOption(update, uo->json);
   update->add_option("--chart", uo->chart, "write an SVG chart of error against time here");
   update->add_option("--updates", uo->updates, "updates per run")->check(CLI::Range(2, 10000));
   update->add_option("--reference-samples", uo->referenceSamples, "samples per probe of the reference")
       ->check(CLI::Range(1024u, 1u << 24));
   update->add_option("--w-mins", uo->wMins, "w_min values for the flicker runs")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
-  update->callback([=, &exitCode] {
+  update->callback([=] {
     bench::UpdateBenchOptions o;
     o.scene = ut->scene.load();
     o.grid = ut->grid.resolve(o.scene);
@@ -150,9 +119,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
     o.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::UpdateBenchResult r = bench::runUpdateBench(o);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", uo->json, r.svg, uo->chart);
-    exitCode = 0;
   });
+}
 
+// `probecast bench raster`: raster client speed and accuracy.
+void addBenchRaster(CLI::App* bench) {
   CLI::App* raster = bench->add_subcommand("raster", "raster client: ms per view for 1..48 views, PSNR/SSIM per representation");
   auto rt = std::make_shared<TracingOptions>();
   struct RasterOptions {
@@ -164,16 +135,15 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   rt->add(raster);
   raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM, lfh:NxM), comma-separated")
       ->delimiter(',');
-  raster->add_option("--size", ro->size, "size of each view WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
+  addSizeOption(raster, ro->size, "size of each view WxH", 8, 4096);
   raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));
   raster->add_option("--repeats", ro->bench.repeats, "timed renders per case (median)")->check(CLI::Range(1, 1000));
-  raster->add_option("--reference-spp", ro->bench.referenceSpp, "samples per pixel of the reference")
-      ->check(CLI::Range(1, 1 << 20));
+  addReferenceSppOption(raster, ro->bench.referenceSpp, 1u << 20);
   raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
       ->check(CLI::Range(16, 8192));
-  raster->add_option("--json", ro->json, "write the results as JSON here")->required();
+  addJsonOption(raster, ro->json);
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
-  raster->callback([=, &exitCode] {
+  raster->callback([=] {
     ro->bench.scene = rt->scene.load();
     ro->bench.grid = rt->grid.resolve(ro->bench.scene);
     ro->bench.updater = rt->tracer.options();
@@ -191,9 +161,11 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
       writeTextFile(views, r.svgViews);
       fmt::print("wrote {}\n", views);
     }
-    exitCode = 0;
   });
+}
 
+// `probecast bench pipeline`: PSNR against wire bytes, update time, representation.
+void addBenchPipeline(CLI::App* bench) {
   CLI::App* pipeline = bench->add_subcommand("pipeline", "PSNR against wire bytes, update time and representation");
   auto pt = std::make_shared<TracingOptions>();
   struct PipelineCli {
@@ -203,16 +175,15 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   };
   auto po = std::make_shared<PipelineCli>();
   pt->add(pipeline, false);
-  pipeline->add_option("--size", po->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(8, 4096));
-  pipeline->add_option("--reference-spp", po->bench.referenceSpp, "samples per pixel of the reference")
-      ->check(CLI::Range(1, 1 << 20));
+  addSizeOption(pipeline, po->size, "image size WxH", 8, 4096);
+  addReferenceSppOption(pipeline, po->bench.referenceSpp, 1u << 20);
   pipeline->add_option("--spps", po->bench.spps, "samples per probe to try")->delimiter(',')->check(CLI::Range(1, 1 << 16));
   pipeline->add_option("--bounces", po->bench.bounces, "bounce limits to try")->delimiter(',')->check(CLI::Range(1, 16));
   pipeline->add_option("--deadzones", po->bench.deadzones, "dead-zones to try")->delimiter(',')->check(CLI::Range(0, 127));
   pipeline->add_option("--frames", po->bench.streamFrames, "moving-light frames streamed")->check(CLI::Range(2, 10000));
-  pipeline->add_option("--json", po->json, "write the results as JSON here")->required();
+  addJsonOption(pipeline, po->json);
   pipeline->add_option("--chart", po->chart, "SVG prefix: writes PREFIX_bytes.svg, PREFIX_update.svg, PREFIX_repr.svg");
-  pipeline->callback([=, &exitCode] {
+  pipeline->callback([=] {
     po->bench.sceneSpec = pt->scene.scene;
     po->bench.scene = pt->scene.load();
     po->bench.t = pt->scene.t;
@@ -230,21 +201,25 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
         writeTextFile(po->chart + suffix, *svg);
         fmt::print("wrote {}{}\n", po->chart, suffix);
       }
-    exitCode = 0;
   });
+}
 
+// `probecast bench stability`: the stability suite.
+void addBenchStability(CLI::App* bench) {
   CLI::App* stability = bench->add_subcommand("stability", "the stability suite: where probe lighting fails, measured");
   auto stabilityJson = std::make_shared<std::string>();
-  stability->add_option("--json", *stabilityJson, "write the results as JSON here")->required();
-  stability->callback([stabilityJson, &exitCode] {
+  addJsonOption(stability, *stabilityJson);
+  stability->callback([stabilityJson] {
     bench::StabilityOptions so;
     so.command = commandLine();
     so.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::StabilityResult r = bench::runStabilitySuite(so);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", *stabilityJson, "", "");
-    exitCode = 0;
   });
+}
 
+// `probecast bench stream`: the service under N subscribers.
+void addBenchStream(CLI::App* bench) {
   CLI::App* stream = bench->add_subcommand("stream", "the service under N subscribers on loopback");
   struct StreamOptions {
     std::string json, chart;
@@ -257,26 +232,28 @@ void addBenchCommands(CLI::App& app, int& exitCode) {
   stream->add_option("--hz", so->bench.hz, "lighting updates per second")->check(CLI::Range(0.5, 240.0));
   stream->add_option("--seconds", so->bench.seconds, "measured time per subscriber count")->check(CLI::Range(2.0, 3600.0));
   stream->add_option("--budget", so->bench.budgetBytesPerSecond, "bytes per second per subscriber (0 = unlimited)");
-  stream->add_option("--repr", so->bench.repr, "l1, zh3h, zh3, l2 or fp16")
-      ->check(CLI::IsMember({"l1", "zh3h", "zh3", "l2", "fp16"}));
-  stream->add_option("--json", so->json, "write the results as JSON here")->required();
+  addRepresentationOption(stream, so->bench.repr, "l1, zh3h, zh3, l2 or fp16");
+  addJsonOption(stream, so->json);
   stream->add_option("--chart", so->chart, "write an SVG chart here");
-  CLI::App* streamServer = bench->add_subcommand("stream-server", "");  // internal: bench stream's server process
-  streamServer->group("");
-  auto ss = std::make_shared<std::tuple<double, double, std::string>>(10.0, 5.0, "zh3");
-  streamServer->add_option("--hz", std::get<0>(*ss))->check(CLI::Range(0.5, 240.0));
-  streamServer->add_option("--seconds", std::get<1>(*ss))->check(CLI::Range(1.0, 3600.0));
-  streamServer->add_option("--repr", std::get<2>(*ss));
-  streamServer->callback([ss, &exitCode] {
-    exitCode = bench::runStreamBenchServer(std::get<0>(*ss), std::get<1>(*ss), std::get<2>(*ss));
-  });
-  stream->callback([so, &exitCode] {
+  stream->callback([so] {
     so->bench.command = commandLine();
     so->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
-    exitCode = 0;
   });
+}
+
+}  // namespace
+
+void addBenchCommands(CLI::App& app) {
+  CLI::App* bench = app.add_subcommand("bench", "measured speed and accuracy, machine-readable");
+  bench->require_subcommand(1);
+  addBenchCodec(bench);
+  addBenchUpdate(bench);
+  addBenchRaster(bench);
+  addBenchPipeline(bench);
+  addBenchStability(bench);
+  addBenchStream(bench);
 }
 
 }  // namespace probecast::app

@@ -7,7 +7,7 @@
 
 namespace probecast::app {
 
-void addCompareCommand(CLI::App& app, int& exitCode) {
+void addCompareCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("compare", "PSNR and SSIM of an image against a reference (both EXR)");
   struct Options {
     std::string test, reference, diff, json;
@@ -19,7 +19,7 @@ void addCompareCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--diff", o->diff, "write a false-colour PNG of the luminance difference");
   cmd->add_option("--diff-scale", o->scale, "difference (after gamma) shown as full red")->check(CLI::Range(1e-6, 10.0));
   cmd->add_option("--json", o->json, "write the metrics as JSON here");
-  cmd->callback([o, &exitCode] {
+  cmd->callback([o] {
     std::vector<float> a, b;
     int wa = 0, ha = 0, wb = 0, hb = 0;
     std::string error;
@@ -31,7 +31,7 @@ void addCompareCommand(CLI::App& app, int& exitCode) {
     fmt::print("PSNR {:.2f} dB, SSIM {:.4f} (both after plain gamma 2.2, no clamping; SSIM on luminance)\n", m.psnrDb,
                m.ssim);
     if (!o->diff.empty()) {
-      if (!imaging::writeDifferencePng(o->diff, a, b, wa, ha, o->scale, error)) throw std::runtime_error(error);
+      orThrow(imaging::writeDifferencePng(o->diff, a, b, wa, ha, o->scale, error), error);
       fmt::print("wrote {}\n", o->diff);
     }
     if (!o->json.empty()) {
@@ -40,7 +40,6 @@ void addCompareCommand(CLI::App& app, int& exitCode) {
                                          m.ssim, m.mse));
       fmt::print("wrote {}\n", o->json);
     }
-    exitCode = 0;
   });
 }
 

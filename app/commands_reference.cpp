@@ -8,7 +8,7 @@
 
 namespace probecast::app {
 
-void addReferenceCommand(CLI::App& app, int& exitCode) {
+void addReferenceCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render-reference", "ground-truth camera path tracer (EXR out)");
   auto scene = std::make_shared<SceneOptions>();
   auto gpu = std::make_shared<GpuOptions>();
@@ -23,8 +23,8 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
   auto o = std::make_shared<Options>();
   scene->add(cmd);
   gpu->add(cmd);
-  cmd->add_option("--size", o->size, "image size WxH")->delimiter('x')->expected(2)->check(CLI::Range(1, 8192));
-  cmd->add_option("--spp", o->spp, "samples per pixel")->check(CLI::Range(1, 1 << 20));
+  addSizeOption(cmd, o->size, "image size WxH", 1, 8192);
+  addSppOption(cmd, o->spp, "samples per pixel", 1u << 20);
   cmd->add_option("--bounces", o->bounces, "surface interactions per path")->check(CLI::Range(1, 16));
   cmd->add_option("--seed", o->seed, "random seed");
   cmd->add_option("--eye", o->eye, "camera position X,Y,Z (default: the scene's camera)")->delimiter(',')->expected(3);
@@ -33,7 +33,7 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
   cmd->add_option("--out", o->out, "EXR file to write (linear radiance)")->required();
   cmd->add_option("--png", o->png, "also write a PNG preview (filmic tone map)");
   cmd->add_option("--exposure", o->exposure, "scale applied to the PNG preview only")->check(CLI::Range(1e-6f, 1e6f));
-  cmd->callback([=, &exitCode] {
+  cmd->callback([=] {
     const scene::Scene s = scene->load();
     renderer::CameraView camera = renderer::CameraView::fromScene(s);
     if (o->eye.size() == 3) camera.position = {o->eye[0], o->eye[1], o->eye[2]};
@@ -67,7 +67,6 @@ void addReferenceCommand(CLI::App& app, int& exitCode) {
         throw std::runtime_error(error);
       fmt::print("wrote {}\n", o->png);
     }
-    exitCode = 0;
   });
 }
 

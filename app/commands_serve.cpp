@@ -2,8 +2,6 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -12,6 +10,8 @@
 #include "probecast/codec/probe_file.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
+#include "probecast/session/probe_producer.h"
+#include "probecast/session/volumes.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -19,44 +19,70 @@ namespace {
 
 std::atomic<bool> gInterrupted{false};
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+struct ServeOptions {
+  TracingOptions tracing;
+  std::string probes, repr = "zh3", listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
+  bool plaintext = false;
+  int brick = 4, deadzone = 1;
+  double hz = 10.0, seconds = 0.0, animate = 0.05;
+};
 
-std::string tokenFrom(const std::string& token, const std::string& file) {
-  if (!file.empty()) {
-    std::string t = readText(file);
-    while (!t.empty() && (t.back() == '\n' || t.back() == '\r' || t.back() == ' ')) t.pop_back();
-    return t;
+// TLS and the token, checked: TLS or an explicit --plaintext.
+service::ServerConfig serverConfig(const ServeOptions& o) {
+  service::ServerConfig sc;
+  sc.listen = o.listen;
+  sc.token = tokenFrom(o.token, o.tokenFile);
+  sc.plaintext = o.plaintext;
+  if (!o.tlsCert.empty() || !o.tlsKey.empty()) {
+    if (o.tlsCert.empty() || o.tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
+    sc.tlsCertPem = readTextFile(o.tlsCert);
+    sc.tlsKeyPem = readTextFile(o.tlsKey);
   }
-  return token;
+  if (sc.tlsCertPem.empty() && !sc.plaintext)
+    throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
+  if (sc.token.empty()) fmt::print(stderr, "serve: warning: no --token, anyone who reaches the port may subscribe\n");
+  return sc;
 }
 
-Representation parseRepr(const std::string& name) {
-  const auto r = parseRepresentation(name);
-  if (!r) throw std::runtime_error("unknown representation '" + name + "' (l1, zh3h, zh3, l2, fp16)");
-  return *r;
+// The producer of a serve: the baked file (published once, then budget ticks) or the scene traced
+// live, its t advanced by --animate per second at --hz. `hub` and `what` describe it.
+std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, ProbeVolume& file,
+                                                     std::unique_ptr<renderer::VulkanContext>& context,
+                                                     service::HubConfig& hub, std::string& what) {
+  const Representation repr = session::parseRepresentationOrThrow(o.repr);
+  const TracingOptions& tr = o.tracing;
+  scene::Scene s;
+  ProbeGrid g;
+  if (!o.probes.empty()) {
+    std::string error;
+    orThrow(readProbeFile(o.probes, file, error), error);
+    hub = service::hubConfigFor(file.grid, repr, o.brick, o.deadzone);
+    what = o.probes;
+  } else {
+    s = tr.scene.load();
+    g = tr.grid.resolve(s);
+    hub = service::hubConfigFor(g, repr, o.brick, o.deadzone);
+    what = s.name;
+  }
+  if (!isValidLayout(hub.layout)) throw std::runtime_error("grid too large for the stream format");
+  auto producer = std::make_unique<session::ProbeProducer>(hub);
+  if (o.probes.empty()) {
+    context = std::make_unique<renderer::VulkanContext>(tr.gpu.context());
+    session::Animation animation;
+    animation.mode = o.animate > 0 ? session::Animation::Mode::PerStep : session::Animation::Mode::Still;
+    animation.start = tr.scene.t;
+    animation.perStep = static_cast<float>(o.animate / o.hz);
+    producer->traceScene(*context, tr.scene.scene, s, g, tr.tracer.options(), animation);
+  }
+  return producer;
 }
 
-}  // namespace
-
-void addServeCommands(CLI::App& app, int& exitCode) {
+void addServeCommand(CLI::App& app) {
   CLI::App* serve = app.add_subcommand("serve", "stream probes over gRPC (live from the updater or a probe file)");
-  auto tr = std::make_shared<TracingOptions>();
-  struct Options {
-    std::string probes, repr = "zh3", listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
-    bool plaintext = false;
-    int brick = 4, deadzone = 1;
-    double hz = 10.0, seconds = 0.0, animate = 0.05;
-  };
-  auto o = std::make_shared<Options>();
-  tr->add(serve);
+  auto o = std::make_shared<ServeOptions>();
+  o->tracing.add(serve);
   serve->add_option("--probes", o->probes, "serve a baked probe volume file instead of tracing live");
-  serve->add_option("--repr", o->repr, "l1, zh3h, zh3, l2 or fp16");
+  addRepresentationOption(serve, o->repr, "l1, zh3h, zh3, l2 or fp16");
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
   serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
       ->check(CLI::Range(0, 127));
@@ -69,115 +95,54 @@ void addServeCommands(CLI::App& app, int& exitCode) {
   serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
   serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
-  serve->callback([=, &exitCode] {
-    service::ServerConfig sc;
-    sc.listen = o->listen;
-    sc.token = tokenFrom(o->token, o->tokenFile);
-    sc.plaintext = o->plaintext;
-    if (!o->tlsCert.empty() || !o->tlsKey.empty()) {
-      if (o->tlsCert.empty() || o->tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
-      sc.tlsCertPem = readText(o->tlsCert);
-      sc.tlsKeyPem = readText(o->tlsKey);
-    }
-    if (sc.tlsCertPem.empty() && !sc.plaintext)
-      throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
-    if (sc.token.empty()) fmt::print(stderr, "serve: warning: no --token, anyone who reaches the port may subscribe\n");
-
-    service::HubConfig hc;
-    hc.layout.brickDim = static_cast<uint8_t>(o->brick);
-    hc.layout.repr = parseRepr(o->repr);
-    hc.encoder.deadzone = o->deadzone;
-    ProbeVolume volume;
-    ProbeGrid grid;
+  serve->callback([o] {
+    const service::ServerConfig sc = serverConfig(*o);
+    ProbeVolume file;
     std::unique_ptr<renderer::VulkanContext> context;
-    std::unique_ptr<renderer::ProbeUpdater> updater;
-    scene::Scene s;
-    if (!o->probes.empty()) {
-      std::string error;
-      if (!readProbeFile(o->probes, volume, error)) throw std::runtime_error(error);
-      grid = volume.grid;
-    } else {
-      s = tr->scene.load();
-      grid = tr->grid.resolve(s);
-      context = std::make_unique<renderer::VulkanContext>(tr->gpu.context());
-      updater = std::make_unique<renderer::ProbeUpdater>(*context, s, grid, tr->tracer.options());
-    }
-    const service::HubConfig base = service::hubConfigFor(grid, hc.layout.repr, hc.layout.brickDim);
-    hc.layout = base.layout;
-    hc.bounds = base.bounds;
-    if (!isValidLayout(hc.layout)) throw std::runtime_error("grid too large for the stream format");
-    service::ProbeHub hub(hc);
-    service::ProbeServer server(sc, hub);
-    fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}\n",
-               o->probes.empty() ? s.name : o->probes, server.port(), sc.tlsCertPem.empty() ? "plaintext" : "TLS",
-               representationName(hc.layout.repr), hc.layout.grid[0], hc.layout.grid[1], hc.layout.grid[2],
-               hc.layout.brickDim, o->probes.empty() ? "live" : "from file");
+    service::HubConfig hc;
+    std::string what;
+    const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what);
+    const int port = producer->serve(sc);
+    fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}\n", what, port,
+               sc.tlsCertPem.empty() ? "plaintext" : "TLS", representationName(hc.layout.repr), hc.layout.grid[0],
+               hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file");
     std::fflush(stdout);
     std::signal(SIGINT, [](int) { gInterrupted = true; });
     std::signal(SIGTERM, [](int) { gInterrupted = true; });
-    if (!o->probes.empty()) hub.publish(volume);
-    const auto start = std::chrono::steady_clock::now();
-    const auto period = std::chrono::duration<double>(1.0 / o->hz);
-    auto next = start;
-    float t = tr->scene.t;
-    uint32_t frames = 0;
-    auto lastReport = start;
-    while (!gInterrupted) {
-      const auto now = std::chrono::steady_clock::now();
-      if (o->seconds > 0 && now - start >= std::chrono::duration<double>(o->seconds)) break;
-      if (updater) {
-        if (o->animate > 0) {
-          t = std::fmod(t + static_cast<float>(o->animate / o->hz), 1.0f);
-          scene::Scene moved;
-          std::string error;
-          if (scene::loadScene(tr->scene.scene, t, moved, error)) updater->setScene(moved);
-        }
-        updater->update();
-        hub.publish(updater->volume());
-        ++frames;
-      } else {
-        hub.tick();
-      }
-      if (now - lastReport >= std::chrono::seconds(5)) {
-        fmt::print("serve: {:.0f} s, {} updates, {} subscribers\n", std::chrono::duration<double>(now - start).count(),
-                   frames, hub.subscriberCount());
-        std::fflush(stdout);
-        lastReport = now;
-      }
-      next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
-      std::this_thread::sleep_until(std::max(next, std::chrono::steady_clock::now()));
-    }
-    server.shutdown();
-    fmt::print("serve: stopped after {} updates\n", frames);
-    exitCode = 0;
+    if (!o->probes.empty()) producer->serveVolume(file);
+    session::Pacing pacing;
+    pacing.mode = session::Pacing::Mode::FixedRate;
+    pacing.hz = o->hz;
+    pacing.seconds = o->seconds;
+    double lastReport = 0.0;
+    producer->run(pacing, &gInterrupted, [&](double seconds) {
+      if (seconds - lastReport < 5.0) return;
+      fmt::print("serve: {:.0f} s, {} updates, {} subscribers\n", seconds, producer->stats().updates,
+                 producer->hub().subscriberCount());
+      std::fflush(stdout);
+      lastReport = seconds;
+    });
+    producer->shutdownServer();
+    fmt::print("serve: stopped after {} updates\n", producer->stats().updates);
   });
+}
 
+void addSubscribeCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("subscribe", "subscribe to a probe stream; report and save the volume");
   struct SubOptions {
-    std::string connect, token, tokenFile, tlsCa, tlsName, out;
+    ConnectOptions connection;
+    std::string out;
     uint64_t budget = 0;
     double seconds = 5.0;
   };
   auto so = std::make_shared<SubOptions>();
-  sub->add_option("--connect", so->connect, "server address host:port")->required();
-  sub->add_option("--token", so->token, "bearer token");
-  sub->add_option("--token-file", so->tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
-  sub->add_option("--tls-ca", so->tlsCa, "PEM root certificate to trust (enables TLS)")->check(CLI::ExistingFile);
-  sub->add_option("--tls-name", so->tlsName, "server name to check in its certificate");
+  so->connection.add(sub, "server address host:port", true, true);
   sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
   sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
   sub->add_option("--out", so->out, "write the received volume here (probe volume file)");
-  sub->callback([=, &exitCode] {
-    service::ClientConfig cc;
-    cc.address = so->connect;
-    cc.token = tokenFrom(so->token, so->tokenFile);
+  sub->callback([so] {
+    service::ClientConfig cc = so->connection.client("probecast-subscribe");
     cc.budgetBytesPerSecond = so->budget;
-    cc.name = "probecast-subscribe";
-    if (!so->tlsCa.empty()) {
-      cc.tls = true;
-      cc.rootCertPem = readText(so->tlsCa);
-      cc.tlsServerName = so->tlsName;
-    }
     service::ProbeClient client(cc);
     client.start();
     const auto start = std::chrono::steady_clock::now();
@@ -191,14 +156,20 @@ void addServeCommands(CLI::App& app, int& exitCode) {
                st.framesRejected, st.bytesReceived, st.connects, st.lastError.empty() ? "" : ", last error: " + st.lastError);
     if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
     service::VolumeSnapshot snap;
-    if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connect);
+    if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connection.connect);
     if (!so->out.empty()) {
       std::string error;
-      if (!writeProbeFile(so->out, snap.volume, error)) throw std::runtime_error(error);
+      orThrow(writeProbeFile(so->out, snap.volume, error), error);
       fmt::print("wrote {}\n", so->out);
     }
-    exitCode = 0;
   });
+}
+
+}  // namespace
+
+void addServeCommands(CLI::App& app) {
+  addServeCommand(app);
+  addSubscribeCommand(app);
 }
 
 }  // namespace probecast::app

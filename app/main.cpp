@@ -10,14 +10,13 @@ int main(int argc, char** argv) {
   probecast::app::setCommandLine(argc, argv);
   CLI::App app{"probecast: streaming light-probe codec and service for real-time global illumination"};
   app.require_subcommand(1);
-  int exitCode = 0;
-  probecast::app::addDemoCommand(app, exitCode);
-  probecast::app::addBenchCommands(app, exitCode);
-  probecast::app::addBakeCommand(app, exitCode);
-  probecast::app::addReferenceCommand(app, exitCode);
-  probecast::app::addServeCommands(app, exitCode);
-  probecast::app::addCompareCommand(app, exitCode);
-  probecast::app::addViewCommand(app, exitCode);
+  probecast::app::addDemoCommand(app);
+  probecast::app::addBenchCommands(app);
+  probecast::app::addBakeCommand(app);
+  probecast::app::addReferenceCommand(app);
+  probecast::app::addServeCommands(app);
+  probecast::app::addCompareCommand(app);
+  probecast::app::addViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -26,5 +25,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "probecast: error: %s\n", e.what());
     return 1;
   }
-  return exitCode;
+  return 0;
 }

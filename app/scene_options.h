@@ -2,14 +2,20 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "commands.h"
 #include "probecast/renderer/probe_updater.h"
+#include "probecast/service/client.h"
 #include "probecast/scene/scene.h"
+#include "probecast/session/representation.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
 
 namespace probecast::app {
 
@@ -20,12 +26,7 @@ struct SceneOptions {
     cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
     cmd->add_option("--t", t, "animation parameter of built-in scenes")->check(CLI::Range(0.0f, 1.0f));
   }
-  scene::Scene load() const {
-    scene::Scene s;
-    std::string error;
-    if (!scene::loadScene(scene, t, s, error)) throw std::runtime_error(error);
-    return s;
-  }
+  scene::Scene load() const { return session::loadSceneOrThrow(scene, t); }
 };
 
 struct GpuOptions {
@@ -46,20 +47,56 @@ struct GpuOptions {
 struct GridOptions {
   std::vector<uint32_t> dims{8, 8, 8};
   std::vector<float> bounds;  // empty: cell-centred in the scene bounds
-  void add(CLI::App* cmd) {
-    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(1, 1024));
+  // --grid (each count in [minDim, maxDim]) and, when withBounds, --bounds.
+  void add(CLI::App* cmd, bool withBounds = true, uint32_t minDim = 1, uint32_t maxDim = 1024) {
+    cmd->add_option("--grid", dims, "probes along X,Y,Z")->delimiter(',')->expected(3)->check(CLI::Range(static_cast<int>(minDim), static_cast<int>(maxDim)));
+    if (!withBounds) return;
     cmd->add_option("--bounds", bounds, "minX,minY,minZ,maxX,maxY,maxZ of the first and last probe (metres)")
         ->delimiter(',')
         ->expected(6);
   }
+  // The grid: the first and last probe at --bounds, or cell-centred over the scene's bounds.
   ProbeGrid resolve(const scene::Scene& s) const {
     if (static_cast<uint64_t>(dims[0]) * dims[1] * dims[2] > (1u << 24)) throw std::runtime_error("grid too large");
-    if (bounds.size() != 6) return renderer::sceneGrid(s, dims.data());
+    if (bounds.size() != 6) return renderer::sceneGrid(s, {dims[0], dims[1], dims[2]});
     for (float b : bounds)
       if (!std::isfinite(b)) throw std::runtime_error("--bounds must be finite");
     return ProbeGrid{{dims[0], dims[1], dims[2]}, {{bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}}};
   }
 };
+
+// --spp (samples per probe per update, or per pixel), with each command's own default and limit.
+inline CLI::Option* addSppOption(CLI::App* cmd, uint32_t& spp,
+                                 const std::string& what = "samples (paths) per probe per update",
+                                 uint32_t max = 1u << 16) {
+  return cmd->add_option("--spp", spp, what)->check(CLI::Range(1, static_cast<int>(max)));
+}
+
+// --reference-spp: samples per pixel of the reference images.
+inline CLI::Option* addReferenceSppOption(CLI::App* cmd, uint32_t& spp, uint32_t max,
+                                          const std::string& what = "samples per pixel of the reference") {
+  return cmd->add_option("--reference-spp", spp, what)->check(CLI::Range(1, static_cast<int>(max)));
+}
+
+// --size WxH, each in [min, max].
+inline CLI::Option* addSizeOption(CLI::App* cmd, std::vector<uint32_t>& size, const std::string& what, uint32_t min,
+                                  uint32_t max) {
+  return cmd->add_option("--size", size, what)->delimiter('x')->expected(2)->check(CLI::Range(static_cast<int>(min), static_cast<int>(max)));
+}
+
+// --json FILE, required by every benchmark.
+inline CLI::Option* addJsonOption(CLI::App* cmd, std::string& json) {
+  return cmd->add_option("--json", json, "write the results as JSON here")->required();
+}
+
+// --repr (or another name) checked by the one representation parser; `allowFloat` admits "float"
+// (probes as traced).
+inline CLI::Option* addRepresentationOption(CLI::App* cmd, std::string& repr, const std::string& what,
+                                            bool allowFloat = false, const std::string& name = "--repr") {
+  return cmd->add_option(name, repr, what)->check(CLI::Validator(
+      [allowFloat](std::string& value) { return session::checkRepresentation(value, allowFloat); },
+      allowFloat ? "{float,l1,zh3h,zh3,l2,fp16}" : "{l1,zh3h,zh3,l2,fp16}"));
+}
 
 struct TracerOptions {
   uint32_t spp = 128;
@@ -68,7 +105,7 @@ struct TracerOptions {
   float wMin = 0.05f;
   float clamp = 16.0f;
   void add(CLI::App* cmd) {
-    cmd->add_option("--spp", spp, "samples (paths) per probe per update")->check(CLI::Range(1, 1 << 16));
+    addSppOption(cmd, spp);
     cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
     cmd->add_option("--seed", seed, "random seed (same seed, same result)");
     cmd->add_option("--w-min", wMin, "minimum temporal blend weight")->check(CLI::Range(0.0f, 1.0f));
@@ -82,6 +119,39 @@ struct TracerOptions {
     o.minBlendWeight = wMin;
     o.indirectClamp = clamp;
     return o;
+  }
+};
+
+// A bearer token given inline or in a file (trailing newlines and spaces dropped).
+inline std::string tokenFrom(const std::string& token, const std::string& file) {
+  if (file.empty()) return token;
+  std::string t = readTextFile(file);
+  while (!t.empty() && (t.back() == '\n' || t.back() == '\r' || t.back() == ' ')) t.pop_back();
+  return t;
+}
+
+// A client's connection to a server: --connect, --token (and --token-file), --tls-ca, --tls-name.
+struct ConnectOptions {
+  std::string connect, token, tokenFile, tlsCa, tlsName;
+  void add(CLI::App* cmd, const std::string& what, bool required, bool withTokenFile) {
+    CLI::Option* c = cmd->add_option("--connect", connect, what);
+    if (required) c->required();
+    cmd->add_option("--token", token, "bearer token");
+    if (withTokenFile) cmd->add_option("--token-file", tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
+    cmd->add_option("--tls-ca", tlsCa, "PEM root certificate to trust (enables TLS)")->check(CLI::ExistingFile);
+    cmd->add_option("--tls-name", tlsName, "server name to check in its certificate");
+  }
+  service::ClientConfig client(const std::string& name) const {
+    service::ClientConfig cc;
+    cc.address = connect;
+    cc.token = tokenFrom(token, tokenFile);
+    cc.name = name;
+    if (!tlsCa.empty()) {
+      cc.tls = true;
+      cc.rootCertPem = readTextFile(tlsCa);
+      cc.tlsServerName = tlsName;
+    }
+    return cc;
   }
 };
 

@@ -13,6 +13,7 @@
 #include "probecast/codec/record.h"
 #include "probecast/codec/stream.h"
 #include "probecast/codec/zh3.h"
+#include "probecast/session/stats.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
@@ -20,11 +21,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using Probe = std::array<float, kProbeFloats>;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
 
 // Relative RMSE of irradiance over a set of normals, pooled over RGB.
 double rmseAgainst(const Probe& probe, const std::vector<float>& normals, const std::vector<float>& reference) {
@@ -170,8 +166,8 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
       enc.push_back(static_cast<double>(many.size()) / std::chrono::duration<double>(t1 - t0).count());
       dec.push_back(static_cast<double>(many.size()) / std::chrono::duration<double>(t2 - t1).count());
     }
-    r.encodeRate = median(enc);
-    r.decodeRate = median(dec);
+    r.encodeRate = session::median(enc);
+    r.decodeRate = session::median(dec);
     reprJson[name] = {{"bytes_per_probe", bytes},
                       {"irradiance_rmse_rel", r.rmseTrue},
                       {"irradiance_rmse_rel_vs_float_l2", r.rmseFloat},

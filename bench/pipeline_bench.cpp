@@ -9,6 +9,9 @@
 #include "probecast/codec/record.h"
 #include "probecast/codec/stream.h"
 #include "probecast/renderer/raster_client.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
+#include "probecast/session/stats.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
@@ -30,12 +33,6 @@ std::vector<size_t> paretoFront(const std::vector<ParetoPoint>& points) {
 }
 
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 struct Point {
   std::string label;
@@ -77,12 +74,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
   };
-  const auto sceneAt = [&](float t) {
-    scene::Scene s;
-    std::string error;
-    if (!scene::loadScene(o.sceneSpec, t, s, error)) throw std::runtime_error(error);
-    return s;
-  };
+  const auto sceneAt = [&](float t) { return session::loadSceneOrThrow(o.sceneSpec, t); };
   renderer::VulkanContext context(o.context);
   const scene::Scene finalScene = sceneAt(o.t);
   const renderer::CameraView camera = renderer::CameraView::fromScene(finalScene);
@@ -125,7 +117,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
       renderer::ProbeUpdater u(context, finalScene, o.grid, uo);
       std::vector<double> ms;
       for (uint32_t k = 0; k < o.updates; ++k) ms.push_back(u.update().milliseconds);
-      Point p{fmt::format("{} spp, {} bounce{}", spp, b, b == 1 ? "" : "s"), median(ms)};
+      Point p{fmt::format("{} spp, {} bounce{}", spp, b, b == 1 ? "" : "s"), session::median(ms)};
       score(u.volume(), p);
       updatePoints.push_back(p);
       say(fmt::format("pipeline bench: {}: {:.1f} ms/update, {:.2f} dB", p.label, p.cost, p.psnr));
@@ -168,8 +160,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
     say(fmt::format("pipeline bench: {} moving-light frames traced", o.streamFrames));
   }
   std::vector<Point> bytesPoints;
-  StreamLayout layout;
-  for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(o.grid.dims[a]);
+  StreamLayout layout = streamLayoutFor(o.grid, Representation::L1, 4);
   for (Representation repr : kAllRepresentations)
     for (int dz : o.deadzones) {
       layout.repr = repr;

@@ -8,16 +8,12 @@
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/codec/record.h"
 #include "probecast/renderer/view_sets.h"
+#include "probecast/session/stats.h"
+#include "probecast/session/viewer.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Representation {
   std::string name;
@@ -85,7 +81,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
     }
     const imaging::ImageMetrics m =
         imaging::compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
-    const double msPerView = median(ms);
+    const double msPerView = session::medianMidpoint(ms);
     json["representations"].push_back({{"representation", r.name},
                                        {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},
                                        {"psnr_db", m.psnrDb},
@@ -106,9 +102,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["multiview_chunk"] = multiview.chunkSize();
   std::vector<imaging::ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
   table += fmt::format("\n{:<8} {:>6} {:>16} {:>16}\n", "views", "count", "per-view ms/view", "multiview ms/view");
-  renderer::ViewSetOptions vo;
-  vo.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
-  vo.displayDistance = std::max(0.1f, glm::length(0.5f * (o.scene.boundsMin + o.scene.boundsMax) - camera.position));
+  const renderer::ViewSetOptions vo = session::viewSetOptions(o.scene, o.width, o.height);
   for (const std::string& name : o.viewSets) {
     renderer::ViewSetSpec spec;
     std::string error;
@@ -124,7 +118,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
         r.renderViews(views);
         ms.push_back(r.timings().viewsMs);
       }
-      const double set = median(ms);
+      const double set = session::medianMidpoint(ms);
       perViewMs[way] = set / static_cast<double>(views.size());
       row[way == 0 ? "per_view_pass" : "multiview"] = {{"ms_per_view_set", set}, {"ms_per_view", perViewMs[way]}};
       speedSeries[static_cast<size_t>(way)].points.push_back({static_cast<double>(views.size()), perViewMs[way], ""});
@@ -141,12 +135,8 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   table += fmt::format("\n{:<10} {:>8} {:>16}\n", "volume", "probes", "ms per update");
   for (const auto& dims : o.uploadGrids) {
     const glm::vec3 lo = o.scene.boundsMin, hi = o.scene.boundsMax;
-    ProbeVolume v;
-    v.grid = ProbeGrid{{dims.x, dims.y, dims.z}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}};
-    const size_t n = v.count();
-    const size_t f = kProbeFloats;
-    v.probes.resize(n * f);
-    v.active.resize(n);
+    ProbeVolume v = makeProbeVolume(ProbeGrid{{dims.x, dims.y, dims.z}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}});
+    const size_t n = v.count(), f = kProbeFloats;
     for (size_t p = 0; p < n; ++p) {
       v.active[p] = p % 8 != 3;
       for (size_t c = 0; c < f; ++c)
@@ -160,9 +150,9 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
       raster.setProbes(v);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     }
-    const std::string name = fmt::format("{}x{}x{}", dims.x, dims.y, dims.z);
-    json["volume_upload"].push_back({{"grid", {dims.x, dims.y, dims.z}}, {"probes", n}, {"ms_median", median(ms)}});
-    table += fmt::format("{:<10} {:>8} {:>16.3f}\n", name, n, median(ms));
+    const double median = session::medianMidpoint(ms);
+    json["volume_upload"].push_back({{"grid", {dims.x, dims.y, dims.z}}, {"probes", n}, {"ms_median", median}});
+    table += fmt::format("{:<10} {:>8} {:>16.3f}\n", fmt::format("{}x{}x{}", dims.x, dims.y, dims.z), n, median);
   }
   json["validation_messages"] = context.validationMessages();
 

@@ -17,6 +17,10 @@
 #include "probecast/renderer/raster_client.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
+#include "probecast/session/probe_producer.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/stats.h"
+#include "probecast/session/volumes.h"
 #include "stream_bench.h"
 #include "update_bench.h"
 
@@ -26,23 +30,7 @@ namespace {
 using Probe = std::vector<float>;
 using Clock = std::chrono::steady_clock;
 
-scene::Scene builtin(const std::string& name, float t) {
-  scene::Scene s;
-  std::string error;
-  if (!scene::makeBuiltinScene(name, t, s, error)) throw std::runtime_error(error);
-  return s;
-}
-
-ProbeGrid cellCentred(const scene::Scene& s, glm::uvec3 dims) {
-  const uint32_t n[3] = {dims.x, dims.y, dims.z};
-  return renderer::sceneGrid(s, n);
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+scene::Scene builtin(const std::string& name, float t) { return session::loadSceneOrThrow("builtin:" + name, t); }
 
 // Directions on a spherical Fibonacci set.
 std::vector<glm::vec3> fibonacci(int n) {
@@ -107,8 +95,7 @@ double waitSeconds(Pred done, double limit) {
 bool holdsServerVolume(const service::ProbeClient& client, const service::ProbeHub& hub) {
   service::VolumeSnapshot snap;
   if (!client.snapshot(snap)) return false;
-  const ProbeVolume server = hub.reconstruction();
-  return snap.volume.probes == server.probes && snap.volume.active == server.active;
+  return session::holdsVolume(snap.volume, hub.reconstruction());
 }
 
 }  // namespace
@@ -116,7 +103,7 @@ bool holdsServerVolume(const service::ProbeClient& client, const service::ProbeH
 std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, const std::vector<float>& wMins,
                                           uint32_t samplesPerProbe, uint32_t updatesAfterJump) {
   const scene::Scene before = builtin("cornell", 0.0f), after = builtin("cornell", 0.5f);
-  const ProbeGrid grid = cellCentred(before, {4, 4, 4});
+  const ProbeGrid grid = renderer::sceneGrid(before, {4, 4, 4});
   const uint32_t n = grid.count();
   const auto converged = [&](const scene::Scene& s) {
     renderer::UpdaterOptions o;
@@ -125,8 +112,7 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
     o.seed = 99;
     renderer::ProbeUpdater u(context, s, grid, o);
     for (int k = 0; k < 16; ++k) u.update();
-    return std::make_pair(std::vector<float>(u.volume().probes.data(), u.volume().probes.data() + n * 27),
-                          std::vector<uint8_t>(u.volume().active.data(), u.volume().active.data() + n));
+    return std::make_pair(u.volume().probes, u.volume().active);
   };
   const auto [ref0, active] = converged(before);
   const auto ref1 = converged(after).first;
@@ -146,7 +132,7 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
       if (k >= settle / 2) changes.push_back(irradianceRmseRel(u.volume().probes.data(), previous.data(), active.data(), n));
       previous.assign(u.volume().probes.data(), u.volume().probes.data() + n * 27);
     }
-    r.flickerRel = median(changes);
+    r.flickerRel = session::median(changes);
     r.errorBeforeJump = irradianceRmseRel(u.volume().probes.data(), ref0.data(), active.data(), n);
     u.setScene(after);
     for (uint32_t k = 1; k <= updatesAfterJump; ++k) {
@@ -240,7 +226,7 @@ Ringing measureRinging(double capDeg) {
 
 WallLeak measureWallLeak(renderer::VulkanContext& context) {
   const scene::Scene s = builtin("thin-wall", 0.0f);
-  const ProbeGrid grid = cellCentred(s, {9, 5, 5});  // 9 along x: one plane inside the wall
+  const ProbeGrid grid = renderer::sceneGrid(s, {9, 5, 5});  // 9 along x: one plane inside the wall
   const auto traced = [&](bool classify) {
     renderer::UpdaterOptions o;
     o.samplesPerProbe = 128;
@@ -278,36 +264,21 @@ WallLeak measureWallLeak(renderer::VulkanContext& context) {
 }
 
 NetworkFaults measureNetworkFaults() {
-  service::HubConfig hc;
-  for (int a = 0; a < 3; ++a) {
-    hc.layout.grid[a] = kLightingGrid[a];
-    hc.bounds.max[a] = static_cast<float>(kLightingGrid[a] - 1);
-  }
-  hc.layout.brickDim = 4;
-  hc.layout.repr = Representation::Zh3;
-  hc.encoder.deadzone = 1;
-  service::ProbeHub hub(hc);
+  session::ProbeProducer producer(service::hubConfigFor(
+      session::unitGrid({kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]}), Representation::Zh3, 4, 1));
+  const service::ProbeHub& hub = producer.hub();
   service::ServerConfig sc;
   sc.plaintext = true;
   sc.token = "stability";
-  service::ProbeServer server(sc, hub);
-  std::atomic<bool> moving{true}, stop{false};
-  std::atomic<int> frames{0};
-  std::thread producer([&] {
-    std::vector<float> probes;
-    while (!stop) {
-      if (moving) {
-        lightingFrame(frames++, probes);
-        hub.publish(probes.data(), nullptr);
-      } else {
-        hub.tick();
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  });
+  const int port = producer.serve(sc);
+  producer.generate([](uint32_t frame, std::vector<float>& probes) { lightingFrame(static_cast<int>(frame), probes); });
+  session::Pacing pacing;
+  pacing.mode = session::Pacing::Mode::FixedSleep;
+  pacing.sleepMs = 20.0;
+  producer.start(pacing);
   const auto config = [&](uint64_t budget) {
     service::ClientConfig cc;
-    cc.address = "127.0.0.1:" + std::to_string(server.port());
+    cc.address = "127.0.0.1:" + std::to_string(port);
     cc.token = sc.token;
     cc.budgetBytesPerSecond = budget;
     cc.reconnectMaxMs = 200;
@@ -317,11 +288,7 @@ NetworkFaults measureNetworkFaults() {
   service::ProbeClient client(config(0));
   client.start();
   waitSeconds([&] { return client.stats().framesApplied >= 50; }, 20.0);
-  const auto percentileMs = [](std::vector<uint32_t> us, double p) {
-    if (us.empty()) return 0.0;
-    std::sort(us.begin(), us.end());
-    return 1e-3 * us[std::min(us.size() - 1, static_cast<size_t>(p * static_cast<double>(us.size() - 1) + 0.5))];
-  };
+  const auto percentileMs = [](const std::vector<uint32_t>& us, double p) { return 1e-3 * session::percentile(us, p); };
   r.latencyP50Ms = percentileMs(client.latenciesUs(), 0.5);
   r.latencyP99Ms = percentileMs(client.latenciesUs(), 0.99);
   // The outage: the link is gone for 2 s while the lighting keeps changing.
@@ -334,7 +301,7 @@ NetworkFaults measureNetworkFaults() {
   for (float v : during.volume.probes) energy += std::fabs(v);
   r.lightingKeptDuringOutage = during.volume.probes == before.volume.probes && energy > 0;
   const uint64_t bytesBefore = client.stats().bytesReceived;
-  moving = false;  // freeze so both clients can finish; the hub holds the lighting of the outage
+  producer.setMoving(false);  // freeze so both clients can finish; the hub holds the lighting of the outage
   client.start();
   service::ProbeClient newcomer(config(0));
   newcomer.start();
@@ -344,9 +311,9 @@ NetworkFaults measureNetworkFaults() {
   r.resumeBytes = static_cast<double>(client.stats().bytesReceived - bytesBefore);
   r.newcomerBytes = static_cast<double>(newcomer.stats().bytesReceived);
   // A slow link next to a fast one, joining together after the light moved again.
-  moving = true;
+  producer.setMoving(true);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  moving = false;
+  producer.setMoving(false);
   r.slowLinkBudget = 0.25 * r.newcomerBytes;  // four seconds for a full volume
   service::ProbeClient slow(config(static_cast<uint64_t>(r.slowLinkBudget))), fast(config(0));
   slow.start();
@@ -357,8 +324,7 @@ NetworkFaults measureNetworkFaults() {
   waitSeconds([&] { return holdsServerVolume(slow, hub); }, 30.0);
   r.slowLinkSecondsToBitExact = std::chrono::duration<double>(Clock::now() - t0).count();
   r.slowLinkLatencyP50Ms = percentileMs(slow.latenciesUs(), 0.5);
-  stop = true;
-  producer.join();
+  producer.stop();
   for (service::ProbeClient* c : {&client, &newcomer, &slow, &fast}) c->stop();
   return r;
 }
@@ -393,7 +359,7 @@ ExtremeInputs measureExtremeInputs() {
 
 std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, const std::vector<double>& maxErrors) {
   const scene::Scene s = builtin("cornell", 0.0f);
-  const ProbeGrid grid = cellCentred(s, {8, 8, 8});
+  const ProbeGrid grid = renderer::sceneGrid(s, {8, 8, 8});
   renderer::UpdaterOptions o;
   o.samplesPerProbe = 128;
   renderer::ProbeUpdater u(context, s, grid, o);
@@ -415,9 +381,7 @@ std::vector<SceneNeeds> measureSceneNeeds(renderer::VulkanContext& context, cons
     }
   }
   SceneNeeds r;
-  StreamLayout layout;
-  for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(grid.dims[a]);
-  layout.repr = Representation::L2;
+  const StreamLayout layout = streamLayoutFor(grid, Representation::L2, 4);
   StreamEncoder encoder(layout);
   std::vector<uint8_t> frame;
   encoder.update(v.probes.data(), v.active.data());

@@ -1,8 +1,6 @@
 #include "stream_bench.h"
 
 #include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,25 +14,23 @@
 
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
+#include "probecast/session/child_process.h"
+#include "probecast/session/probe_producer.h"
+#include "probecast/session/stats.h"
+#include "probecast/session/volumes.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
 
 using namespace std::chrono_literals;
+using session::percentile;
 
 double cpuSeconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5));
-  return v[i];
 }
 
 }  // namespace
@@ -70,53 +66,32 @@ struct ServerReport {
   int frames = 0;
 };
 
-}  // namespace
-
-// The server side in its own process: serve for `seconds`, print "port N", then "report ...".
-int runStreamBenchServer(double hz, double seconds, const std::string& repr) {
-  StreamBenchOptions o;
-  o.hz = hz;
-  o.repr = repr;
-  {
-    service::HubConfig hc;
-    hc.layout.grid[0] = 32;
-    hc.layout.grid[1] = 8;
-    hc.layout.grid[2] = 32;
-    hc.layout.brickDim = 4;
-    hc.layout.repr = parseRepresentation(o.repr).value_or(Representation::Zh3);
-    hc.encoder.deadzone = 1;
-    hc.bounds.max[0] = 31;
-    hc.bounds.max[1] = 7;
-    hc.bounds.max[2] = 31;
-    service::ProbeHub hub(hc);
-    service::ServerConfig sc;
-    sc.plaintext = true;
-    sc.token = "bench";
-    sc.maxSubscribers = 100000;
-    service::ProbeServer server(sc, hub);
-    std::printf("port %d\n", server.port());
-    std::fflush(stdout);
-    const double cpu0 = cpuSeconds();
-    std::vector<float> probes;
-    double encodeMs = 0;
-    int frames = 0;
-    const auto start = std::chrono::steady_clock::now();
-    auto next = start;
-    while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(seconds)) {
-      lightingFrame(frames, probes);
-      const auto t0 = std::chrono::steady_clock::now();
-      hub.publish(probes.data(), nullptr);
-      encodeMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      ++frames;
-      next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.0 / o.hz));
-      std::this_thread::sleep_until(next);
-    }
-    server.shutdown();
-    std::printf("report %.6f %.6f %d\n", cpuSeconds() - cpu0, encodeMs / std::max(frames, 1), frames);
-    std::fflush(stdout);
-  }
+// The server side, in a process of its own: a producer of lighting frames served for `seconds`;
+// says "port N", then "report CPU_SECONDS ENCODE_MS_PER_FRAME FRAMES".
+int serveLightingFrames(double hz, double seconds, const std::string& repr, const session::ChildProcess::Say& say) {
+  session::ProbeProducer producer(service::hubConfigFor(
+      session::unitGrid({kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]}),
+      parseRepresentation(repr).value_or(Representation::Zh3), 4, 1));
+  service::ServerConfig sc;
+  sc.plaintext = true;
+  sc.token = "bench";
+  sc.maxSubscribers = 100000;
+  say(fmt::format("port {}", producer.serve(sc)));
+  const double cpu0 = cpuSeconds();
+  producer.generate([](uint32_t frame, std::vector<float>& probes) { lightingFrame(static_cast<int>(frame), probes); });
+  session::Pacing pacing;
+  pacing.mode = session::Pacing::Mode::FixedRate;
+  pacing.hz = hz;
+  pacing.seconds = seconds;
+  producer.run(pacing);
+  producer.shutdownServer();
+  const session::ProducerStats st = producer.stats();
+  say(fmt::format("report {:.6f} {:.6f} {}", cpuSeconds() - cpu0, st.publishMs / std::max<double>(st.updates, 1),
+                  st.updates));
   return 0;
 }
+
+}  // namespace
 
 namespace {
 
@@ -150,28 +125,23 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   imaging::ChartSeries cpuSeries{"server CPU ms/s per subscriber", {}, true};
   std::string table = fmt::format("{:>6} {:>16} {:>16} {:>12} {:>12} {:>16} {:>14}\n", "subs", "B/s/sub mean",
                                   "B/s/sub p99", "lat p50 ms", "lat p99 ms", "server CPU %/sub", "encode ms/frm");
-  for (int n : o.subscribers) {
+  for (int n : o.subscribers)
     if (n < 1) throw std::invalid_argument("subscriber counts must be positive");
-    const double serverSeconds = o.seconds + 2.0;  // margin for connecting
-    // The server is this binary again (fork + exec: gRPC must not be forked once it runs).
-    int fds[2];
-    if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
-    const std::string hz = fmt::format("{}", o.hz), secs = fmt::format("{}", serverSeconds);
-    const pid_t child = fork();
-    if (child < 0) throw std::runtime_error("fork failed");
-    if (child == 0) {
-      dup2(fds[1], STDOUT_FILENO);
-      close(fds[0]);
-      close(fds[1]);
-      execl("/proc/self/exe", "probecast", "bench", "stream-server", "--hz", hz.c_str(), "--seconds", secs.c_str(),
-            "--repr", o.repr.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    close(fds[1]);
-    FILE* from = fdopen(fds[0], "r");
+  const double serverSeconds = o.seconds + 2.0;  // margin for connecting
+  // One server process per run, all forked now, before this process starts gRPC.
+  std::vector<std::unique_ptr<session::ChildProcess>> servers;
+  for (size_t k = 0; k < o.subscribers.size(); ++k)
+    servers.push_back(std::make_unique<session::ChildProcess>(
+        [&o, serverSeconds](const session::ChildProcess::Say& tell) {
+          return serveLightingFrames(o.hz, serverSeconds, o.repr, tell);
+        }));
+  for (size_t k = 0; k < o.subscribers.size(); ++k) {
+    const int n = o.subscribers[k];
+    session::ChildProcess& server = *servers[k];
+    server.go();
     int port = 0;
-    char line[128];
-    if (!from || !std::fgets(line, sizeof line, from) || std::sscanf(line, "port %d", &port) != 1)
+    std::string line;
+    if (!server.readLine(line) || std::sscanf(line.c_str(), "port %d", &port) != 1)
       throw std::runtime_error("server process did not start");
     say(fmt::format("{} subscribers on port {}, {:.0f} s at {} Hz", n, port, o.seconds, o.hz));
     std::mt19937 rng(7);
@@ -206,12 +176,11 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
     }
     clients.clear();
     ServerReport report;
-    if (!std::fgets(line, sizeof line, from) ||
-        std::sscanf(line, "report %lf %lf %d", &report.cpuSeconds, &report.encodeMsPerFrame, &report.frames) != 3)
+    if (!server.readLine(line) ||
+        std::sscanf(line.c_str(), "report %lf %lf %d", &report.cpuSeconds, &report.encodeMsPerFrame, &report.frames) !=
+            3)
       throw std::runtime_error("server process did not report");
-    std::fclose(from);
-    int status = 0;
-    waitpid(child, &status, 0);
+    server.wait();
     double mean = 0;
     for (double r : rates) mean += r;
     mean /= n;

@@ -1,5 +1,6 @@
 // `probecast bench stream`: the service under N subscribers on loopback, with a moving light.
-// The server (hub, encoder, gRPC) runs in a child process so its CPU time is its own.
+// The server (a probe producer: hub, encoder, gRPC) runs in a child process so its CPU time is its
+// own; call it before this process starts gRPC (the children are forked first).
 #pragma once
 
 #include <functional>
@@ -27,9 +28,6 @@ struct StreamBenchResult {
 };
 
 StreamBenchResult runStreamBench(const StreamBenchOptions& options);
-// The server process of the benchmark (`probecast bench stream-server`): prints "port N", serves
-// for `seconds`, prints "report CPU_SECONDS ENCODE_MS_PER_FRAME FRAMES".
-int runStreamBenchServer(double hz, double seconds, const std::string& repr);
 
 // Lighting frame `frame` of the benchmark's volume: 32 × 8 × 32 probes (x fastest) lit by a light
 // circling above them (analytic SH), 27 floats per probe.

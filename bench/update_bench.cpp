@@ -8,16 +8,11 @@
 #include <fmt/format.h>
 
 #include "probecast/codec/sh.h"
+#include "probecast/session/stats.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 double peakRssMiB() {
   rusage usage{};
@@ -62,8 +57,8 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
     say(fmt::format("reference: update {}/{} ({} samples/probe)", u + 1, refUpdates, refOptions.samplesPerProbe));
     reference.update();
   }
-  const std::vector<float> ref(reference.volume().probes.data(), reference.volume().probes.data() + count * 27);
-  const std::vector<uint8_t> active(reference.volume().active.data(), reference.volume().active.data() + count);
+  const std::vector<float> ref = reference.volume().probes;
+  const std::vector<uint8_t> active = reference.volume().active;
   uint32_t activeCount = 0;
   for (uint8_t a : active) activeCount += a;
 
@@ -103,7 +98,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
         changes.push_back(irradianceRmseRel(u.volume().probes.data(), previous.data(), active.data(), count));
       previous.assign(u.volume().probes.data(), u.volume().probes.data() + count * 27);
     }
-    const double f = changes.empty() ? 0.0 : median(changes);
+    const double f = changes.empty() ? 0.0 : session::median(changes);
     const double e = irradianceRmseRel(u.volume().probes.data(), ref.data(), active.data(), count);
     say(fmt::format("w_min {:.3f}: flicker {:.2f}% per update, error {:.2f}%", w, 100 * f, 100 * e));
     flicker.push_back({{"w_min", w}, {"flicker_rel", f}, {"rmse_rel", e}});
@@ -120,10 +115,10 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
             {"spp", convOptions.samplesPerProbe},
             {"bounces", convOptions.maxBounces},
             {"reference_samples_per_probe", refUpdates * refOptions.samplesPerProbe},
-            {"ms_per_update", median(ms)},
-            {"rays_per_s", median(raysPerS)},
-            {"closest_hit_rays_per_s", median(closestPerS)},
-            {"shadow_rays_per_s", median(shadowPerS)},
+            {"ms_per_update", session::median(ms)},
+            {"rays_per_s", session::median(raysPerS)},
+            {"closest_hit_rays_per_s", session::median(closestPerS)},
+            {"shadow_rays_per_s", session::median(shadowPerS)},
             {"rmse_rel_after_updates", rmse},
             {"cumulative_ms", cumulativeMs},
             {"flicker_rel", flicker},
@@ -136,8 +131,8 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
       "ms/update {:.1f} | rays/s {:.2f} M (closest-hit {:.2f} M, shadow {:.2f} M) | device memory {:.1f} MiB | peak RSS "
       "{:.0f} MiB\n",
       opt.scene.name, opt.scene.triangleCount(), opt.grid.dims[0], opt.grid.dims[1], opt.grid.dims[2], activeCount,
-      convOptions.samplesPerProbe, convOptions.maxBounces, context.deviceName(), median(ms), median(raysPerS) / 1e6,
-      median(closestPerS) / 1e6, median(shadowPerS) / 1e6, static_cast<double>(deviceBytes) / (1 << 20), peakRssMiB());
+      convOptions.samplesPerProbe, convOptions.maxBounces, context.deviceName(), session::median(ms), session::median(raysPerS) / 1e6,
+      session::median(closestPerS) / 1e6, session::median(shadowPerS) / 1e6, static_cast<double>(deviceBytes) / (1 << 20), peakRssMiB());
   r.table += "error after updates:";
   for (size_t i = 0; i < rmse.size(); ++i) r.table += fmt::format(" {:.2f}%", 100 * rmse[i]);
   r.table += "\nw_min   flicker/update   error\n";

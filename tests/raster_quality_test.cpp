@@ -29,8 +29,7 @@ double rmse(const Image& a, const Image& b) {
 
 ProbeVolume tracedVolume(VulkanContext& context, const scene::Scene& s, glm::uvec3 dims, uint32_t updates,
                              bool classify = true) {
-  const uint32_t n[3] = {dims.x, dims.y, dims.z};
-  const ProbeGrid g = sceneGrid(s, n);
+  const ProbeGrid g = sceneGrid(s, {dims.x, dims.y, dims.z});
   UpdaterOptions uo;
   uo.samplesPerProbe = 128;
   uo.classify = classify;

@@ -87,8 +87,8 @@ shaders::mat4 identity() {
 
 }  // namespace
 
-ProbeGrid sceneGrid(const scene::Scene& scene, const uint32_t dims[3]) {
-  return cellCentredGrid(dims, &scene.boundsMin.x, &scene.boundsMax.x);
+ProbeGrid sceneGrid(const scene::Scene& scene, const std::array<uint32_t, 3>& dims) {
+  return cellCentredGrid(dims.data(), &scene.boundsMin.x, &scene.boundsMax.x);
 }
 
 struct ProbeUpdater::Impl {

@@ -22,10 +22,11 @@ uint64_t randomEpoch() {
 ProbeHub::ProbeHub(const HubConfig& config)
     : config_(config), epoch_(randomEpoch()), encoder_(config.layout, config.encoder) {}
 
-HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, uint8_t brickDim) {
-  HubConfig c;
-  c.layout = streamLayoutFor(grid, repr, brickDim);
+HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, int brickDim, int deadzone) {
+  HubConfig c;  // an edge out of the uint8_t range becomes 0, which isValidLayout refuses
+  c.layout = streamLayoutFor(grid, repr, brickDim >= 0 && brickDim <= 255 ? static_cast<uint8_t>(brickDim) : 0);
   c.bounds = grid.bounds;
+  c.encoder.deadzone = deadzone;
   return c;
 }
 

@@ -7,6 +7,7 @@
 // floats per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -18,7 +19,7 @@
 namespace probecast::renderer {
 
 // The default grid of a scene: dims probes at the centres of the cells of a grid over its bounds.
-ProbeGrid sceneGrid(const scene::Scene& scene, const uint32_t dims[3]);
+ProbeGrid sceneGrid(const scene::Scene& scene, const std::array<uint32_t, 3>& dims);
 
 struct UpdaterOptions {
   uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32

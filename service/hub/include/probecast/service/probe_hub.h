@@ -30,9 +30,10 @@ struct HubConfig {
   double burstSeconds = 1.0;  // a subscriber's budget bucket holds this many seconds of bytes
 };
 
-// The hub of a probe grid streamed as `repr` in bricks of brickDim³ probes; check the layout
-// with isValidLayout (a grid can be too large for the stream format).
-HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, uint8_t brickDim = 4);
+// The hub of a probe grid streamed as `repr` in bricks of brickDim³ probes, dropping changes of
+// up to `deadzone` quantisation steps; check the layout with isValidLayout (a grid can be too
+// large for the stream format).
+HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, int brickDim = 4, int deadzone = 0);
 
 struct HeldBrick {
   uint32_t brick = 0;

@@ -1,0 +1,80 @@
+// `probecast demo` in two parts: running the session (a server tracing and streaming the scene
+// while its light moves, two viewers re-rendering as lighting arrives, then settling) and
+// writing the report (references, metrics, images, charts, suites, report.md / report.json).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "probecast/renderer/probe_updater.h"
+#include "probecast/renderer/view_sets.h"
+#include "probecast/renderer/vulkan_context.h"
+#include "probecast/scene/scene.h"
+#include "probecast/session/probe_producer.h"
+#include "probecast/session/viewer.h"
+#include "scene_options.h"
+#include "probecast/imaging/svg_chart.h"
+
+namespace probecast::app {
+
+using DemoClock = std::chrono::steady_clock;
+
+struct DemoOptions {
+  std::string out = "out";
+  std::string scene = "builtin:cornell";
+  double seconds = 24.0;        // streaming with the light moving
+  double turnsPerMinute = 1.5;  // light speed (builtin scenes move it once around per unit of t)
+  uint32_t spp = 64;            // updater samples per probe per update
+  GridOptions grid;  // --grid only (no --bounds), 2…64 per axis
+  std::string repr = "zh3";
+  std::string lightField = "lf:5x5";
+  uint32_t settleUpdates = 24;  // updates with the light frozen before the comparison
+  uint32_t referenceSpp = 256;
+  uint64_t lightFieldBudget = 6 * 1024;  // bytes/s: the display sits on a thin link
+  bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
+};
+
+struct DemoViewer {
+  std::string name, viewSet;
+  uint32_t width = 0, height = 0;
+  uint64_t budget = 0;
+  renderer::ViewSetSpec spec;
+  std::unique_ptr<session::Viewer> viewer;
+  std::vector<imaging::ChartPoint> bandwidth;  // (seconds, bytes/s over the last interval)
+  uint64_t lastBytes = 0;
+  uint64_t streamBytes = 0;  // received while the light moved
+  bool converged = false;    // ended holding the server's volume bit for bit
+};
+
+// Everything the report needs from the session; the Vulkan contexts outlive what uses them.
+struct DemoRun {
+  DemoClock::time_point wallStart;
+  std::unique_ptr<renderer::VulkanContext> serverContext, viewerContext;
+  std::unique_ptr<session::ProbeProducer> producer;
+  scene::Scene scene0;
+  ProbeGrid grid;
+  std::vector<DemoViewer> viewers;  // the headset, the light-field display
+  nlohmann::json moments = nlohmann::json::array();
+  nlohmann::json phases;
+  double streamSeconds = 0.0;
+  float finalT = 0.0f;
+};
+
+// Streams with the light moving, freezes it, lets the probes settle and waits for both viewers
+// to hold the server's volume; writes the images of three moments to o.out.
+void runDemoSession(const DemoOptions& o, DemoRun& run);
+// Renders the final views, compares them with references, runs the suites (unless skipped),
+// writes report.json, report.md, charts and images to o.out, and prints the summary.
+void writeDemoReport(const DemoOptions& o, DemoRun& run);
+
+std::string progressBar(double fraction);
+double secondsSince(DemoClock::time_point t0);
+// A viewer's current images on disk: a stereo pair side by side, or a light-field quilt.
+void writeViewerImages(const std::string& prefix, const DemoViewer& v, const std::vector<renderer::Image>& images);
+
+}  // namespace probecast::app

@@ -1,0 +1,295 @@
+// `probecast demo`, the report: the final views against path-traced references, the charts, the
+// pipeline benchmark and the stability suite, report.json and report.md, the printed summary.
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "commands.h"
+#include "demo.h"
+#include "probecast/imaging/image_io.h"
+#include "probecast/imaging/image_metrics.h"
+#include "pipeline_bench.h"
+#include "probecast/renderer/reference_camera.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/stats.h"
+#include "stability.h"
+#include "probecast/imaging/svg_chart.h"
+
+namespace probecast::app {
+namespace {
+
+// The pipeline benchmark (small) and the stability suite, written next to the report; returns
+// their report sections.
+std::string runSuites(const DemoOptions& o, const std::string& dir, const scene::Scene& finalScene, float finalT,
+                      const ProbeGrid& grid, nlohmann::json& phases) {
+  const auto status = [](const std::string& s) { fmt::print(stderr, "\rdemo: {:<90}", s.substr(0, 90)); };
+  auto phaseStart = DemoClock::now();
+  bench::PipelineBenchOptions po;
+  po.sceneSpec = o.scene;
+  po.scene = finalScene;
+  po.t = finalT;
+  po.grid = grid;
+  po.width = 128;
+  po.height = 80;
+  po.referenceSpp = 2 * o.referenceSpp;
+  po.spps = {32, 128};
+  po.bounces = {1, 4};
+  po.deadzones = {0, 4, 16};
+  po.streamFrames = 16;
+  po.updates = 3;
+  po.command = commandLine() + " (pipeline part)";
+  po.progress = status;
+  const bench::PipelineBenchResult pr = bench::runPipelineBench(po);
+  writeTextFile(dir + "/pipeline.json", pr.json.dump(2) + "\n");
+  writeTextFile(dir + "/pipeline_bytes.svg", pr.svgBytes);
+  writeTextFile(dir + "/pipeline_update.svg", pr.svgUpdate);
+  writeTextFile(dir + "/pipeline_repr.svg", pr.svgRepr);
+  phases["pipeline"] = secondsSince(phaseStart);
+  phaseStart = DemoClock::now();
+  bench::StabilityOptions so;
+  so.command = commandLine() + " (stability part)";
+  so.progress = status;
+  const bench::StabilityResult sr = bench::runStabilitySuite(so);
+  writeTextFile(dir + "/stability.json", sr.json.dump(2) + "\n");
+  phases["stability"] = secondsSince(phaseStart);
+  fmt::print(stderr, "\n");
+  return "\n## Speed against accuracy across the pipeline\n\n"
+         "Same scene, same view (the light frozen where the demo stopped it), one run; the Pareto front of "
+         "each chart is joined. Data: [pipeline.json](pipeline.json).\n\n"
+         "![PSNR against wire bytes](pipeline_bytes.svg)\n\n![PSNR against update time](pipeline_update.svg)"
+         "\n\n![PSNR against representation](pipeline_repr.svg)\n\n```\n" +
+         pr.table +
+         "```\n"
+         "\n## Stability: where probe lighting fails, measured\n\nEach case is also a test "
+         "(`ctest -L stability`). Data: [stability.json](stability.json).\n\n" +
+         sr.markdown;
+}
+
+// report.md without the suites' sections.
+std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, const std::string& device,
+                           const std::vector<size_t>& viewsAboveScene) {
+  std::string md = "# probecast demo\n\n";
+  md += fmt::format("Produced by `{}` in {:.0f} s on {} (server and viewers on one machine, loopback gRPC).\n\n",
+                    commandLine(), report["wall_seconds"].get<double>(), device);
+  md += fmt::format(
+      "A server path-traces {} into {}x{}x{} probes ({} samples per probe per update, median "
+      "{:.0f} ms per update) while its light circles, and streams them as `{}`. A stereo headset "
+      "and a {} light-field display subscribe over gRPC, re-render each time new lighting arrives "
+      "(direct light locally at the light's current position, indirect light from the probes they "
+      "hold), and after {:.0f} s the light stops, the probes settle for {} updates, and every view "
+      "is compared with the reference path tracer ({} samples per pixel).\n\n",
+      report["scene"].get<std::string>(), report["grid"][0].get<int>(), report["grid"][1].get<int>(),
+      report["grid"][2].get<int>(), o.spp, report["update_ms_median"].get<double>(), o.repr, o.lightField,
+      report["stream_seconds"].get<double>(), o.settleUpdates, o.referenceSpp);
+  md +=
+      "| viewer | views | size | budget | frames | renders | ms/view | bytes/s while moving | PSNR dB (mean) | SSIM "
+      "(mean) | holds the server's volume |\n";
+  md += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& v : report["viewers"])
+    md += fmt::format(
+        "| {} | {} | {}x{} | {} | {} | {} | {:.1f} | {:.0f} | {:.2f} | {:.4f} | {} |\n", v["name"].get<std::string>(),
+        v["views"].get<std::string>(), v["size"][0].get<int>(), v["size"][1].get<int>(),
+        v["budget_bytes_per_s"].get<uint64_t>() ? fmt::format("{} B/s", v["budget_bytes_per_s"].get<uint64_t>())
+                                                : std::string("none"),
+        v["frames_applied"].get<uint32_t>(), v["renders"].get<uint32_t>(), v["render_ms_per_view_median"].get<double>(),
+        v["bytes_per_s_streaming"].get<double>(), v["psnr_db_mean"].get<double>(), v["ssim_mean"].get<double>(),
+        v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
+  md += fmt::format(
+      "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without "
+      "clamping; the PNGs use a filmic tone map. The reference has noise of its own: two "
+      "references of the headset's left eye with different seeds differ by {:.2f} dB PSNR, SSIM "
+      "{:.4f} — the ceiling these figures can reach. Light-field views compared: the corners and "
+      "the centre ({} in quilt order).\n\n",
+      report["reference_noise_floor"]["psnr_db"].get<double>(), report["reference_noise_floor"]["ssim"].get<double>(),
+      report["viewers"][1]["reference_views"].dump());
+  if (!viewsAboveScene.empty())
+    md += fmt::format(
+        "Views {} look from above the scene's top (the light field's top rows): they see the "
+        "outer face of the ceiling lit by the probes inside — a leak the reference does not have, "
+        "and why they score lowest.\n\n",
+        nlohmann::json(viewsAboveScene).dump());
+  md += "## While the light moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
+  for (const auto& m : report["moments"])
+    md += fmt::format("At {:.1f} s (t = {:.3f}): ![stereo]({}) ![quilt]({})\n\n", m["seconds"].get<double>(),
+                      m["t"].get<double>(), m.value("stereo", ""), m.value("quilt", ""));
+  md += "## Against the reference\n\n![PSNR per view](psnr_per_view.svg)\n\n";
+  md += "| | headset (stereo) | light-field quilt |\n|---|---|---|\n";
+  md += "| probecast | ![](final_stereo.png) | ![](final_quilt.png) |\n";
+  md += "| reference | ![](reference_stereo.png) | ![](reference_quilt.png) |\n";
+  md += "| difference, view 0 | ![](difference_stereo_view0.png) | ![](difference_quilt_view0.png) |\n\n";
+  md += "Data: [report.json](report.json).\n";
+  return md;
+}
+
+// Every view of the headset; the corners and the centre of a light field (a reference costs
+// seconds per view here).
+std::vector<size_t> referenceViews(const DemoViewer& v) {
+  const size_t n = v.viewer->views().size(), c = static_cast<size_t>(v.spec.columns);
+  std::vector<size_t> views = {0};
+  if (v.spec.kind != renderer::ViewSetSpec::Kind::Mono && v.spec.kind != renderer::ViewSetSpec::Kind::Stereo && n > 5) {
+    for (size_t i : {c - 1, n / 2, n - c, n - 1}) views.push_back(i);
+  } else {
+    for (size_t i = 1; i < n; ++i) views.push_back(i);
+  }
+  std::sort(views.begin(), views.end());
+  views.erase(std::unique(views.begin(), views.end()), views.end());
+  return views;
+}
+
+// Final images of every viewer at the frozen light, compared with references; the viewers' part
+// of the report and the PSNR-per-view series. Views without a reference stay black in the reference quilt.
+void compareWithReferences(const DemoOptions& o, DemoRun& run, const scene::Scene& finalScene, nlohmann::json& report,
+                           std::vector<std::vector<size_t>>& compared, std::vector<imaging::ChartSeries>& psnrSeries) {
+  uint32_t referencesDone = 0, referencesTotal = 1;  // + the noise floor
+  for (const DemoViewer& v : run.viewers) {
+    compared.push_back(referenceViews(v));
+    referencesTotal += static_cast<uint32_t>(compared.back().size());
+  }
+  const auto progressReferences = [&] {
+    ++referencesDone;
+    fmt::print(stderr, "\rdemo: {} reference images {}/{}",
+               progressBar(static_cast<double>(referencesDone) / referencesTotal), referencesDone, referencesTotal);
+  };
+  for (size_t k = 0; k < run.viewers.size(); ++k) {
+    DemoViewer& v = run.viewers[k];
+    session::Viewer& viewer = *v.viewer;
+    const std::vector<renderer::ViewInfo>& views = viewer.views();
+    viewer.setShading(finalScene);
+    viewer.render();
+    const std::vector<renderer::Image>& images = viewer.images();
+    std::vector<renderer::Image> references(views.size());
+    for (renderer::Image& img : references) {
+      img.width = v.width;
+      img.height = v.height;
+      img.rgb.assign(static_cast<size_t>(v.width) * v.height * 3, 0.0f);
+    }
+    std::vector<double> psnr, ssim;
+    imaging::ChartSeries series{v.name + " (" + v.viewSet + ")", {}, true};
+    renderer::ReferenceOptions ro;
+    ro.width = v.width;
+    ro.height = v.height;
+    ro.samplesPerPixel = o.referenceSpp;
+    for (size_t i : compared[k]) {
+      references[i] = renderer::renderReference(*run.viewerContext, finalScene, views[i].camera, ro);
+      const imaging::ImageMetrics m = imaging::compareImages(images[i].rgb, references[i].rgb, static_cast<int>(v.width),
+                                                         static_cast<int>(v.height));
+      psnr.push_back(m.psnrDb);
+      ssim.push_back(m.ssim);
+      series.points.push_back({static_cast<double>(i), m.psnrDb, fmt::format("view {}", i)});
+      progressReferences();
+    }
+    if (k == 0) {  // how far the reference itself is from converged: two seeds of view 0
+      ro.seed = 7;
+      const renderer::Image second = renderer::renderReference(*run.viewerContext, finalScene, views[0].camera, ro);
+      const imaging::ImageMetrics floor =
+          imaging::compareImages(second.rgb, references[0].rgb, static_cast<int>(v.width), static_cast<int>(v.height));
+      report["reference_noise_floor"] = {{"psnr_db", floor.psnrDb}, {"ssim", floor.ssim}};
+      progressReferences();
+    }
+    const std::string tag = k == 0 ? "stereo" : "quilt";
+    writeViewerImages(o.out + "/final_" + tag, v, images);
+    writeViewerImages(o.out + "/reference_" + tag, v, references);
+    std::string error;
+    if (!imaging::writeDifferencePng(o.out + "/difference_" + tag + "_view0.png", images[0].rgb, references[0].rgb,
+                                   static_cast<int>(v.width), static_cast<int>(v.height), 0.25, error))
+      throw std::runtime_error(error);
+    double meanPsnr = 0, meanSsim = 0;
+    for (size_t i = 0; i < psnr.size(); ++i) {
+      meanPsnr += psnr[i] / static_cast<double>(psnr.size());
+      meanSsim += ssim[i] / static_cast<double>(ssim.size());
+    }
+    const service::ClientStats st = viewer.clientStats();
+    report["viewers"].push_back({{"name", v.name},
+                                 {"views", v.viewSet},
+                                 {"view_count", views.size()},
+                                 {"size", {v.width, v.height}},
+                                 {"budget_bytes_per_s", v.budget},
+                                 {"frames_applied", st.framesApplied},
+                                 {"renders", viewer.stats().renders},
+                                 {"render_ms_per_view_median", session::median(viewer.stats().renderMsPerView)},
+                                 {"bytes_streaming", v.streamBytes},
+                                 {"bytes_per_s_streaming", static_cast<double>(v.streamBytes) / run.streamSeconds},
+                                 {"bytes_total", st.bytesReceived},
+                                 {"converged_to_server_volume", v.converged},
+                                 {"reference_views", compared[k]},
+                                 {"psnr_db", psnr},
+                                 {"ssim", ssim},
+                                 {"psnr_db_mean", meanPsnr},
+                                 {"ssim_mean", meanSsim},
+                                 {"images",
+                                  {{"final", "final_" + tag + ".png"},
+                                   {"reference", "reference_" + tag + ".png"},
+                                   {"difference_view0", "difference_" + tag + "_view0.png"}}}});
+    psnrSeries.push_back(std::move(series));
+    viewer.stop();
+  }
+  fmt::print(stderr, "\n");
+}
+
+void writeCharts(const DemoOptions& o, const DemoRun& run, const std::vector<imaging::ChartSeries>& psnrSeries) {
+  std::vector<imaging::ChartSeries> bandwidthSeries;
+  for (const DemoViewer& v : run.viewers) bandwidthSeries.push_back({v.name, v.bandwidth, true});
+  imaging::ChartSpec bw;
+  bw.title = "Bytes per second received by each viewer while the light moves";
+  bw.xLabel = "seconds";
+  bw.yLabel = "bytes/s";
+  bw.footnote = commandLine();
+  writeTextFile(o.out + "/bandwidth.svg", imaging::renderSvgChart(bw, bandwidthSeries));
+  imaging::ChartSpec q;
+  q.title = "Each view against its reference (light frozen, probes settled)";
+  q.xLabel = "view index (quilt order)";
+  q.yLabel = "PSNR, dB";
+  q.yFromZero = false;
+  q.footnote = commandLine();
+  writeTextFile(o.out + "/psnr_per_view.svg", imaging::renderSvgChart(q, psnrSeries));
+}
+
+}  // namespace
+
+void writeDemoReport(const DemoOptions& o, DemoRun& run) {
+  auto phaseStart = DemoClock::now();
+  const scene::Scene finalScene = session::loadSceneOrThrow(o.scene, run.finalT);
+  const session::ProducerStats producer = run.producer->stats();
+  nlohmann::json report;
+  report["command"] = commandLine();
+  report["scene"] = run.scene0.name;
+  report["grid"] = {run.grid.dims[0], run.grid.dims[1], run.grid.dims[2]};
+  report["representation"] = o.repr;
+  report["spp_per_update"] = o.spp;
+  report["stream_seconds"] = run.streamSeconds;
+  report["updates"] = producer.updates;
+  report["update_ms_median"] = session::median(producer.updateMs);
+  report["final_t"] = run.finalT;
+  report["moments"] = run.moments;
+  report["server_device"] = run.serverContext->deviceName();
+  report["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
+  std::vector<std::vector<size_t>> compared;
+  std::vector<imaging::ChartSeries> psnrSeries;
+  compareWithReferences(o, run, finalScene, report, compared, psnrSeries);
+  run.producer->shutdownServer();
+  nlohmann::json& phases = run.phases;
+  phases["references"] = secondsSince(phaseStart);
+  report["phase_seconds"] = phases;
+  writeCharts(o, run, psnrSeries);
+  // Speed against accuracy across the pipeline, and the stability suite.
+  std::string suites;
+  if (!o.skipSuites) {
+    suites = runSuites(o, o.out, finalScene, run.finalT, run.grid, phases);
+    report["phase_seconds"] = phases;
+  }
+  const double wall = secondsSince(run.wallStart);
+  report["wall_seconds"] = wall;
+  writeTextFile(o.out + "/report.json", report.dump(2) + "\n");
+
+  std::vector<size_t> above;  // light-field eyes above the scene: they see the ceiling's outer face
+  for (size_t i : compared[1])
+    if (run.viewers[1].viewer->views()[i].eye.y > finalScene.boundsMax.y) above.push_back(i);
+  writeTextFile(o.out + "/report.md", reportMarkdown(o, report, run.serverContext->deviceName(), above) + suites);
+  for (const auto& v : report["viewers"])
+    fmt::print("demo: {:<20} {:>7} {:>4} frames, {:>8.0f} B/s while moving, PSNR {:.2f} dB, SSIM {:.4f}\n",
+               v["name"].get<std::string>(), v["views"].get<std::string>(), v["frames_applied"].get<uint32_t>(),
+               v["bytes_per_s_streaming"].get<double>(), v["psnr_db_mean"].get<double>(), v["ssim_mean"].get<double>());
+  fmt::print("demo: wrote {}/report.md (and report.json, charts, images) in {:.0f} s\n", o.out, wall);
+}
+
+}  // namespace probecast::app

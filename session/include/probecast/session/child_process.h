@@ -1,0 +1,37 @@
+// A function run in a process of its own (so its CPU time is its own), forked when constructed
+// and released by go(). Fork every child before this process starts gRPC: gRPC cannot be
+// forked once it runs, which is why children are forked up front and wait.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdio>
+#include <functional>
+#include <string>
+
+namespace probecast::session {
+
+class ChildProcess {
+ public:
+  // Sends one line of text (no newline) to the parent.
+  using Say = std::function<void(const std::string& line)>;
+  // Forks now; the child runs `body` after go() and exits with its return value, or exits 0
+  // without running it when the parent drops the child first.
+  explicit ChildProcess(std::function<int(const Say& say)> body);
+  ~ChildProcess();  // releases an unstarted child without running it, then waits for it
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  void go();
+  // The child's next line; false when it has ended without one.
+  bool readLine(std::string& line);
+  // Waits for the child to end; its exit status (-1 when it did not exit normally).
+  int wait();
+
+ private:
+  pid_t pid_ = -1;
+  int goFd_ = -1;
+  FILE* from_ = nullptr;
+};
+
+}  // namespace probecast::session

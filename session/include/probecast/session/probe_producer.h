@@ -1,0 +1,130 @@
+// The producer side of a session: a lighting source (a scene traced by the probe updater, a
+// baked volume, or generated frames) published to a ProbeHub, optionally served over gRPC, in a
+// paced loop on the caller's thread or a thread of its own, with the animation parameter t
+// driven by wall time or by steps.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "probecast/renderer/probe_updater.h"
+#include "probecast/renderer/vulkan_context.h"
+#include "probecast/scene/scene.h"
+#include "probecast/service/probe_hub.h"
+#include "probecast/service/server.h"
+
+namespace probecast::session {
+
+// How the loop spaces its steps.
+struct Pacing {
+  enum class Mode {
+    Free,        // one step after another
+    FixedRate,   // `hz` steps per second; a late step starts at once
+    FixedSleep,  // a pause of `sleepMs` after every step
+  };
+  Mode mode = Mode::Free;
+  double hz = 10.0;
+  double sleepMs = 0.0;
+  double seconds = 0.0;  // the loop ends after this long (0 = when stopped or interrupted)
+};
+
+// The animation parameter t of a traced scene (built-in scenes move their light once around per unit of t).
+struct Animation {
+  enum class Mode {
+    Still,      // t stays at `start`
+    WallClock,  // t = start + ratePerSecond × seconds since the loop started (mod 1)
+    PerStep,    // t advances by `perStep` before every update (mod 1)
+  };
+  Mode mode = Mode::Still;
+  float start = 0.0f;
+  double ratePerSecond = 0.0;
+  float perStep = 0.0f;
+  bool reloadScene = true;  // load the scene at t before every update (false: t is only reported)
+};
+
+struct ProducerStats {
+  uint32_t updates = 0;         // steps that published new lighting
+  uint32_t settledUpdates = 0;  // of those, the ones that began with the animation frozen
+  std::vector<double> updateMs; // the updater's own time per update, ms (traced scenes)
+  double publishMs = 0.0;       // time spent in ProbeHub::publish (encoding), all steps, ms
+};
+
+class ProbeProducer {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // Fills `probes` (27 floats per probe, all active) with lighting frame number `frame`.
+  using FrameGenerator = std::function<void(uint32_t frame, std::vector<float>& probes)>;
+
+  explicit ProbeProducer(const service::HubConfig& hub);
+  ~ProbeProducer();  // stops the loop and the server
+  ProbeProducer(const ProbeProducer&) = delete;
+  ProbeProducer& operator=(const ProbeProducer&) = delete;
+
+  // Serves the hub over gRPC; returns the port. Throws like ProbeServer.
+  int serve(const service::ServerConfig& config);
+  int port() const;
+  void shutdownServer();
+
+  // The lighting source (one of three). A traced scene: `first` is `sceneSpec` at the animation's start.
+  void traceScene(renderer::VulkanContext& context, const std::string& sceneSpec, const scene::Scene& first,
+                  const ProbeGrid& grid, const renderer::UpdaterOptions& options, const Animation& animation);
+  // A fixed volume: published once now; every step then only ticks the hub's budgets.
+  void serveVolume(const ProbeVolume& volume);
+  // Generated frames 0, 1, 2, … one per step while moving (setMoving), ticks otherwise.
+  void generate(FrameGenerator generator);
+
+  // One step of the source: animate, update, publish (or tick).
+  void step();
+  // Steps paced until stopped, `interrupted`, or pacing.seconds; `afterStep` gets the seconds since the start.
+  void run(const Pacing& pacing, const std::atomic<bool>* interrupted = nullptr,
+           const std::function<void(double seconds)>& afterStep = {});
+  // The same loop on a thread of its own; an exception ends it, passed to `onError` and kept in error().
+  void start(const Pacing& pacing, std::function<void(const std::string&)> onError = {});
+  // Ends the loop (and joins its thread).
+  void stop();
+  bool running() const { return running_; }
+  std::string error() const;
+
+  // The animation holds its current t from now on; updates that begin afterwards count as settled.
+  void freeze();
+  // Generated frames: false holds the lighting (steps only tick), true moves on.
+  void setMoving(bool moving) { moving_ = moving; }
+  // The animation parameter now (wall-clock animation: at this moment; otherwise of the last update).
+  float t() const;
+  // When the loop (start or run) began.
+  Clock::time_point started() const { return started_; }
+
+  ProducerStats stats() const;
+  service::ProbeHub& hub() { return hub_; }
+  const service::ProbeHub& hub() const { return hub_; }
+
+ private:
+  void loop(const Pacing& pacing, const std::atomic<bool>* interrupted, const std::function<void(double)>& afterStep);
+
+  service::ProbeHub hub_;
+  std::unique_ptr<service::ProbeServer> server_;
+  // Source.
+  std::unique_ptr<renderer::ProbeUpdater> updater_;
+  std::string sceneSpec_;
+  Animation animation_;
+  FrameGenerator generator_;
+  std::vector<float> frame_;
+  uint32_t frameIndex_ = 0;
+  // Loop.
+  std::thread thread_;
+  std::atomic<bool> stop_{false}, running_{false}, moving_{true}, frozen_{false};
+  std::atomic<float> t_{0.0f}, frozenT_{0.0f};
+  Clock::time_point started_ = Clock::now();
+  mutable std::mutex mutex_;
+  ProducerStats stats_;
+  std::string error_;
+};
+
+}  // namespace probecast::session

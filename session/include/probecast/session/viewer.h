@@ -1,0 +1,73 @@
+// The viewer side of a session: a ProbeClient subscribed with its views, and a RasterRenderer
+// that re-renders them whenever new lighting has arrived.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "probecast/codec/priority.h"
+#include "probecast/renderer/raster_client.h"
+#include "probecast/renderer/view_sets.h"
+#include "probecast/scene/scene.h"
+#include "probecast/service/client.h"
+
+namespace probecast::session {
+
+// View sets of width × height with the display plane through the centre of the scene's bounds.
+renderer::ViewSetOptions viewSetOptions(const scene::Scene& scene, uint32_t width, uint32_t height);
+// The same views as the service's frustum priority takes them.
+std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views);
+
+struct ViewerConfig {
+  uint32_t width = 0, height = 0;  // of each view
+  service::ClientConfig client;
+  renderer::RasterOptions raster;
+  // Direct light is local: when set, every render first shades with `sceneSpec` at lightT().
+  std::string sceneSpec;
+  std::function<float()> lightT;
+};
+
+struct ViewerStats {
+  uint32_t framesSeen = 0;              // frames applied when it last rendered
+  uint32_t renders = 0;
+  std::vector<double> renderMsPerView;  // per render
+};
+
+class Viewer {
+ public:
+  Viewer(renderer::VulkanContext& context, const scene::Scene& scene, std::vector<renderer::ViewInfo> views,
+         ViewerConfig config);
+
+  // Subscribes (sending the views for the server's priority) / unsubscribes, keeping what it holds.
+  void start();
+  void stop();
+  // Waits until `seconds` have passed or the server refused the subscription.
+  void waitFor(double seconds) const;
+
+  // Renders when frames arrived since the last render; false otherwise.
+  bool renderIfNew();
+  // Renders what it holds now; false while it holds nothing.
+  bool render();
+  void setShading(const scene::Scene& scene) { raster_->setShading(scene); }
+
+  const std::vector<renderer::Image>& images() const { return images_; }
+  const std::vector<renderer::ViewInfo>& views() const { return views_; }
+  const ViewerStats& stats() const { return stats_; }
+  service::ClientStats clientStats() const { return client_->stats(); }
+  bool snapshot(service::VolumeSnapshot& out) const { return client_->snapshot(out); }
+  const renderer::RasterTimings& timings() const { return raster_->timings(); }
+
+ private:
+  ViewerConfig config_;
+  std::vector<renderer::ViewInfo> views_;
+  std::unique_ptr<service::ProbeClient> client_;
+  std::unique_ptr<renderer::RasterRenderer> raster_;
+  service::VolumeSnapshot held_;  // what it rendered last; its storage is reused
+  std::vector<renderer::Image> images_;
+  ViewerStats stats_;
+};
+
+}  // namespace probecast::session

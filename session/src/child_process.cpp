@@ -1,0 +1,79 @@
+#include "probecast/session/child_process.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace probecast::session {
+
+ChildProcess::ChildProcess(std::function<int(const Say& say)> body) {
+  int toChild[2], fromChild[2];
+  if (pipe(toChild) != 0) throw std::runtime_error("pipe failed");
+  if (pipe(fromChild) != 0) {
+    close(toChild[0]);
+    close(toChild[1]);
+    throw std::runtime_error("pipe failed");
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  pid_ = fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ == 0) {
+    // Only its own pipes: a copy of another child's would keep that child from seeing its parent go.
+    const long maxFd = std::min(sysconf(_SC_OPEN_MAX), 65536L);
+    for (int fd = 3; fd < maxFd; ++fd)
+      if (fd != toChild[0] && fd != fromChild[1]) close(fd);
+    char go = 0;
+    if (read(toChild[0], &go, 1) != 1) _exit(0);  // dropped before go()
+    FILE* to = fdopen(fromChild[1], "w");
+    const Say say = [to](const std::string& line) {
+      std::fprintf(to, "%s\n", line.c_str());
+      std::fflush(to);
+    };
+    int status = 1;
+    try {
+      status = body(say);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "probecast: error in a child process: %s\n", e.what());
+    }
+    std::fflush(nullptr);
+    _exit(status);  // not exit(): the parent's state (and its atexit handlers) is not ours
+  }
+  close(toChild[0]);
+  close(fromChild[1]);
+  goFd_ = toChild[1];
+  from_ = fdopen(fromChild[0], "r");
+}
+
+ChildProcess::~ChildProcess() {
+  if (goFd_ >= 0) close(goFd_);
+  if (from_) std::fclose(from_);
+  wait();
+}
+
+void ChildProcess::go() {
+  const char go = 1;
+  if (goFd_ < 0 || write(goFd_, &go, 1) != 1) throw std::runtime_error("child process is gone");
+  close(goFd_);
+  goFd_ = -1;
+}
+
+bool ChildProcess::readLine(std::string& line) {
+  char buffer[256];
+  if (!from_ || !std::fgets(buffer, sizeof buffer, from_)) return false;
+  line = buffer;
+  while (!line.empty() && line.back() == '\n') line.pop_back();
+  return true;
+}
+
+int ChildProcess::wait() {
+  if (pid_ <= 0) return -1;
+  int status = 0;
+  waitpid(pid_, &status, 0);
+  pid_ = -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace probecast::session

@@ -1,0 +1,150 @@
+#include "probecast/session/probe_producer.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "probecast/session/scene_loading.h"
+
+namespace probecast::session {
+
+ProbeProducer::ProbeProducer(const service::HubConfig& hub) : hub_(hub) {}
+
+ProbeProducer::~ProbeProducer() {
+  stop();
+  shutdownServer();
+}
+
+int ProbeProducer::serve(const service::ServerConfig& config) {
+  server_ = std::make_unique<service::ProbeServer>(config, hub_);
+  return server_->port();
+}
+
+int ProbeProducer::port() const { return server_ ? server_->port() : 0; }
+
+void ProbeProducer::shutdownServer() {
+  if (server_) server_->shutdown();
+}
+
+void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::string& sceneSpec,
+                               const scene::Scene& first, const ProbeGrid& grid,
+                               const renderer::UpdaterOptions& options, const Animation& animation) {
+  updater_ = std::make_unique<renderer::ProbeUpdater>(context, first, grid, options);
+  sceneSpec_ = sceneSpec;
+  animation_ = animation;
+  t_ = animation.start;
+}
+
+void ProbeProducer::serveVolume(const ProbeVolume& volume) {
+  hub_.publish(volume);
+}
+
+void ProbeProducer::generate(FrameGenerator generator) { generator_ = std::move(generator); }
+
+float ProbeProducer::t() const {
+  if (frozen_) return frozenT_;
+  if (animation_.mode != Animation::Mode::WallClock || !running_) return t_;
+  const double seconds = std::chrono::duration<double>(Clock::now() - started_).count();
+  return static_cast<float>(std::fmod(animation_.start + animation_.ratePerSecond * seconds, 1.0));
+}
+
+void ProbeProducer::freeze() {
+  frozenT_ = t();
+  frozen_ = true;
+}
+
+void ProbeProducer::step() {
+  if (updater_) {
+    const bool wasFrozen = frozen_;
+    if (!wasFrozen && animation_.mode == Animation::Mode::PerStep) t_ = std::fmod(t_ + animation_.perStep, 1.0f);
+    if (animation_.mode != Animation::Mode::Still && animation_.reloadScene)
+      updater_->setScene(loadSceneOrThrow(sceneSpec_, t()));
+    const renderer::UpdateStats st = updater_->update();
+    const auto t0 = Clock::now();
+    hub_.publish(updater_->volume());
+    const double publishMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.updates;
+    if (wasFrozen) ++stats_.settledUpdates;
+    stats_.updateMs.push_back(st.milliseconds);
+    stats_.publishMs += publishMs;
+  } else if (generator_ && moving_) {
+    generator_(frameIndex_++, frame_);
+    const auto t0 = Clock::now();
+    hub_.publish(frame_.data(), nullptr);
+    const double publishMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.updates;
+    stats_.publishMs += publishMs;
+  } else {
+    hub_.tick();
+  }
+}
+
+void ProbeProducer::loop(const Pacing& pacing, const std::atomic<bool>* interrupted,
+                         const std::function<void(double)>& afterStep) {
+  const auto start = started_;
+  auto next = start;
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / pacing.hz));
+  while (!stop_ && !(interrupted && *interrupted)) {
+    const auto now = Clock::now();
+    if (pacing.seconds > 0 && now - start >= std::chrono::duration<double>(pacing.seconds)) break;
+    step();
+    if (afterStep) afterStep(std::chrono::duration<double>(now - start).count());
+    if (pacing.mode == Pacing::Mode::FixedRate) {
+      next += period;
+      std::this_thread::sleep_until(next);
+    } else if (pacing.mode == Pacing::Mode::FixedSleep) {
+      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(pacing.sleepMs));
+    }
+  }
+}
+
+void ProbeProducer::run(const Pacing& pacing, const std::atomic<bool>* interrupted,
+                        const std::function<void(double)>& afterStep) {
+  started_ = Clock::now();
+  stop_ = false;
+  running_ = true;
+  try {
+    loop(pacing, interrupted, afterStep);
+  } catch (...) {
+    running_ = false;
+    throw;
+  }
+  running_ = false;
+}
+
+void ProbeProducer::start(const Pacing& pacing, std::function<void(const std::string&)> onError) {
+  stop();
+  started_ = Clock::now();
+  stop_ = false;
+  running_ = true;
+  thread_ = std::thread([this, pacing, onError = std::move(onError)] {
+    try {
+      loop(pacing, nullptr, {});
+    } catch (const std::exception& e) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        error_ = e.what();
+      }
+      if (onError) onError(e.what());
+    }
+    running_ = false;
+  });
+}
+
+void ProbeProducer::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+std::string ProbeProducer::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
+}
+
+ProducerStats ProbeProducer::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+}  // namespace probecast::session

@@ -1,0 +1,62 @@
+#include "probecast/session/viewer.h"
+
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
+
+namespace probecast::session {
+
+renderer::ViewSetOptions viewSetOptions(const scene::Scene& s, uint32_t width, uint32_t height) {
+  const renderer::CameraView camera = renderer::CameraView::fromScene(s);
+  renderer::ViewSetOptions vo;
+  vo.aspect = static_cast<float>(width) / static_cast<float>(height);
+  vo.displayDistance = std::max(0.1f, glm::length(0.5f * (s.boundsMin + s.boundsMax) - camera.position));
+  return vo;
+}
+
+std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views) {
+  std::vector<View> out(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    std::memcpy(out[k].viewProj, &views[k].viewProj[0][0], sizeof out[k].viewProj);
+    for (int i = 0; i < 3; ++i) out[k].eye[i] = views[k].eye[i];
+  }
+  return out;
+}
+
+Viewer::Viewer(renderer::VulkanContext& context, const scene::Scene& scene, std::vector<renderer::ViewInfo> views,
+               ViewerConfig config)
+    : config_(std::move(config)), views_(std::move(views)) {
+  client_ = std::make_unique<service::ProbeClient>(config_.client);
+  client_->setViews(priorityViews(views_));
+  raster_ = std::make_unique<renderer::RasterRenderer>(context, scene, config_.width, config_.height, config_.raster);
+}
+
+void Viewer::start() { client_->start(); }
+void Viewer::stop() { client_->stop(); }
+
+void Viewer::waitFor(double seconds) const {
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(seconds) && !client_->stats().fatal)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+}
+
+bool Viewer::renderIfNew() {
+  if (client_->stats().framesApplied == stats_.framesSeen) return false;
+  return render();
+}
+
+bool Viewer::render() {
+  if (!client_->snapshot(held_)) return false;  // into the storage of the last snapshot
+  stats_.framesSeen = held_.framesApplied;
+  if (config_.lightT) raster_->setShading(loadSceneOrThrow(config_.sceneSpec, config_.lightT()));
+  raster_->setProbes(held_.volume);
+  images_ = raster_->renderViews(views_);
+  stats_.renderMsPerView.push_back(raster_->timings().viewsMs / static_cast<double>(views_.size()));
+  ++stats_.renders;
+  return true;
+}
+
+}  // namespace probecast::session
