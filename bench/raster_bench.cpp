@@ -23,6 +23,39 @@ struct Representation {
 
 }  // namespace
 
+namespace {
+
+// What one volume update costs the client (validate, fill inactive probes, upload), for the
+// volume sizes of the demo and of a large hall; one probe in eight inactive. Returns table rows.
+std::string timeVolumeUpdates(renderer::RasterRenderer& raster, const RasterBenchOptions& o, nlohmann::json& json) {
+  using Clock = std::chrono::steady_clock;
+  std::string table = fmt::format("\n{:<10} {:>8} {:>16}\n", "volume", "probes", "ms per update");
+  for (const auto& dims : o.uploadGrids) {
+    const glm::vec3 lo = o.scene.boundsMin, hi = o.scene.boundsMax;
+    ProbeVolume v = makeProbeVolume(ProbeGrid{{dims.x, dims.y, dims.z}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}});
+    const size_t n = v.count(), f = kProbeFloats;
+    for (size_t p = 0; p < n; ++p) {
+      v.active[p] = p % 8 != 3;
+      for (size_t c = 0; c < f; ++c)
+        v.probes[p * f + c] = (c % 9 == 0 ? 1.0f : 0.1f) * static_cast<float>((p * 31 + c * 7) % 17) / 17.0f;
+    }
+    raster.setProbes(v);  // warm-up (first allocation)
+    std::vector<double> ms;
+    for (uint32_t k = 0; k < 4 * o.repeats; ++k) {
+      v.probes[(k % n) * f] += 0.01f;  // a new volume each time
+      const auto t0 = Clock::now();
+      raster.setProbes(v);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    }
+    const double median = session::medianMidpoint(ms);
+    json["volume_upload"].push_back({{"grid", {dims.x, dims.y, dims.z}}, {"probes", n}, {"ms_median", median}});
+    table += fmt::format("{:<10} {:>8} {:>16.3f}\n", fmt::format("{}x{}x{}", dims.x, dims.y, dims.z), n, median);
+  }
+  return table;
+}
+
+}  // namespace
+
 RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   using Clock = std::chrono::steady_clock;
   const auto say = [&](const std::string& s) {
@@ -130,30 +163,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   }
   table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
 
-  // What one volume update costs the client (validate, fill inactive probes, upload), for the
-  // volume sizes of the demo and of a large hall; one probe in eight inactive.
-  table += fmt::format("\n{:<10} {:>8} {:>16}\n", "volume", "probes", "ms per update");
-  for (const auto& dims : o.uploadGrids) {
-    const glm::vec3 lo = o.scene.boundsMin, hi = o.scene.boundsMax;
-    ProbeVolume v = makeProbeVolume(ProbeGrid{{dims.x, dims.y, dims.z}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}});
-    const size_t n = v.count(), f = kProbeFloats;
-    for (size_t p = 0; p < n; ++p) {
-      v.active[p] = p % 8 != 3;
-      for (size_t c = 0; c < f; ++c)
-        v.probes[p * f + c] = (c % 9 == 0 ? 1.0f : 0.1f) * static_cast<float>((p * 31 + c * 7) % 17) / 17.0f;
-    }
-    raster.setProbes(v);  // warm-up (first allocation)
-    std::vector<double> ms;
-    for (uint32_t k = 0; k < 4 * o.repeats; ++k) {
-      v.probes[(k % n) * f] += 0.01f;  // a new volume each time
-      const auto t0 = Clock::now();
-      raster.setProbes(v);
-      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-    }
-    const double median = session::medianMidpoint(ms);
-    json["volume_upload"].push_back({{"grid", {dims.x, dims.y, dims.z}}, {"probes", n}, {"ms_median", median}});
-    table += fmt::format("{:<10} {:>8} {:>16.3f}\n", fmt::format("{}x{}x{}", dims.x, dims.y, dims.z), n, median);
-  }
+  table += timeVolumeUpdates(raster, o, json);
   json["validation_messages"] = context.validationMessages();
 
   imaging::ChartSpec spec;
