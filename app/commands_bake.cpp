@@ -4,7 +4,6 @@
 #include "commands.h"
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/probe_updater.h"
-#include "probecast/session/volumes.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -32,8 +31,10 @@ void addBakeCommand(CLI::App& app) {
       fmt::print("bake: update {}/{}: {:.1f} ms, {} paths, {:.2f} M rays/s\n", u + 1, *updates, st.milliseconds, st.paths,
                  static_cast<double>(st.closestHitRays + st.shadowRays) / st.milliseconds / 1e3);
     }
+    ProbeVolume volume = updater.volume();
+    volume.samplesPerProbe = tr->tracer.spp;  // as asked for (the updater traces it rounded up to 32s)
     std::string error;
-    orThrow(writeProbeFile(*out, updater.volume(), error), error);
+    orThrow(writeProbeFile(*out, volume, error), error);
     if (context.validationMessages() > 0)
       fmt::print(stderr, "bake: {} Vulkan validation messages\n", context.validationMessages());
     fmt::print("wrote {}\n", *out);

@@ -11,7 +11,6 @@
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
 #include "probecast/session/probe_producer.h"
-#include "probecast/session/volumes.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -72,6 +71,7 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     animation.mode = o.animate > 0 ? session::Animation::Mode::PerStep : session::Animation::Mode::Still;
     animation.start = tr.scene.t;
     animation.perStep = static_cast<float>(o.animate / o.hz);
+    animation.reloadScene = session::sceneAnimates(tr.scene.scene);  // a glTF file is the same at every t
     producer->traceScene(*context, tr.scene.scene, s, g, tr.tracer.options(), animation);
   }
   return producer;

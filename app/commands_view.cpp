@@ -72,7 +72,8 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
     std::string error;
     orThrow(readProbeFile(o.probes, volume, error), error);
   }
-  if (o.repr != "float") volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr));
+  if (o.repr != "float")
+    volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
   renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
   raster.setProbes(volume);
   Rendered r;

@@ -15,7 +15,6 @@
 #include "probecast/scene/scene.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/scene_loading.h"
-#include "probecast/session/volumes.h"
 
 namespace probecast::app {
 

@@ -10,7 +10,6 @@
 #include "probecast/codec/stream.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/session/scene_loading.h"
-#include "probecast/session/volumes.h"
 #include "probecast/session/stats.h"
 #include "probecast/imaging/svg_chart.h"
 
@@ -134,7 +133,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   std::vector<Point> reprPoints;
   for (Representation repr : kAllRepresentations) {
     Point p{representationName(repr), static_cast<double>(recordSize(repr))};
-    score(decodeAs(volume, repr), p);
+    score(decodeAs(volume, repr, /*zh3PerPixel=*/true), p);
     reprPoints.push_back(p);
   }
   Point floatPoint{"float", 108.0};
@@ -179,12 +178,8 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
         if (decoder.apply(bytes.data(), bytes.size()) != CodecStatus::Ok)
           throw std::runtime_error("pipeline bench: decoder refused its own stream");
       }
-      ProbeVolume held = frames.back();
-      const size_t n = held.probes.size();
-      held.probes.assign(decoder.probes(), decoder.probes() + n);
-      held.active.assign(decoder.activeMask(), decoder.activeMask() + held.active.size());
-      held.decodedFrom = repr;
-      held.zh3PerPixel = repr == Representation::Zh3Hallucinated;
+      ProbeVolume held;
+      decoder.copyVolume(frames.back().grid.bounds, held);
       Point p{fmt::format("{} dz{}", representationName(repr), dz),
               static_cast<double>(total) / static_cast<double>(frames.size() - 1) * o.hz};
       score(held, p);

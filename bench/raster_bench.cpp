@@ -103,7 +103,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   imaging::ChartSeries qualitySeries{"representations (mono view)", {}, false};
   table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
   for (const Representation& r : reprs) {
-    raster.setProbes(r.viaCodec ? decodeAs(volume, r.repr) : volume);
+    raster.setProbes(r.viaCodec ? decodeAs(volume, r.repr, /*zh3PerPixel=*/true) : volume);
     const glm::mat4 vp = raster.viewProjection(camera);
     renderer::Image image = raster.render(vp, camera.position);  // warm-up (and shadow maps)
     std::vector<double> ms;
@@ -126,7 +126,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   }
 
   // Speed per view set, both ways of drawing several views.
-  const ProbeVolume l2 = decodeAs(volume, probecast::Representation::L2);
+  const ProbeVolume l2 = decodeAs(volume, probecast::Representation::L2, /*zh3PerPixel=*/true);
   raster.setProbes(l2);
   renderer::RasterOptions multi = o.raster;
   multi.passes = renderer::ViewPasses::Multiview;

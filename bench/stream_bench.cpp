@@ -36,7 +36,7 @@ double cpuSeconds() {
 }  // namespace
 
 void lightingFrame(int frame, std::vector<float>& probes) {
-  const int nx = 32, ny = 8, nz = 32;
+  const int nx = kLightingGrid[0], ny = kLightingGrid[1], nz = kLightingGrid[2];
   probes.assign(static_cast<size_t>(nx) * ny * nz * 27, 0.0f);
   const float a = 0.05f * static_cast<float>(frame);
   const float light[3] = {16.0f + 10.0f * std::cos(a), 10.0f, 16.0f + 10.0f * std::sin(a)};

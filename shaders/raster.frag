@@ -79,7 +79,7 @@ bool probeCoefficients(vec3 p, out float c[28]) {
   return true;
 }
 
-// Interpolate-then-hallucinate (zh3h): the L2 band from the interpolated L1 alone, as
+// zh3PerPixel (zh3h, interpolate then hallucinate): the L2 band from the interpolated L1 alone, as
 // zh3HallucinateInPlace in codec/zh3.h (same axis, curve and expansion).
 void hallucinateZh3(inout float c[28]) {
   const vec3 luma = vec3(0.2126, 0.7152, 0.0722);

@@ -75,7 +75,7 @@ TEST(ProbeVolume, DecodeAsZh3hChoosesPerPixelOrPerProbeHallucination) {
   std::mt19937 rng(5);
   const test::Probe probe = test::randomNonNegativeProbe(rng, 3, 0.2f);
   std::copy(probe.begin(), probe.end(), v.probes.begin());
-  const ProbeVolume perPixel = decodeAs(v, Representation::Zh3Hallucinated);
+  const ProbeVolume perPixel = decodeAs(v, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true);
   EXPECT_TRUE(perPixel.zh3PerPixel);
   ASSERT_TRUE(perPixel.decodedFrom.has_value());
   EXPECT_EQ(*perPixel.decodedFrom, Representation::Zh3Hallucinated);
@@ -90,7 +90,43 @@ TEST(ProbeVolume, DecodeAsZh3hChoosesPerPixelOrPerProbeHallucination) {
   for (int k = 12; k < kProbeFloats; ++k) l2 += std::fabs(perProbe.probes[k]);
   EXPECT_GT(l2, 0.0);
   // Other representations never take the flag.
-  EXPECT_FALSE(decodeAs(v, Representation::L2).zh3PerPixel);
+  EXPECT_FALSE(decodeAs(v, Representation::L2, /*zh3PerPixel=*/true).zh3PerPixel);
+}
+
+TEST(ProbeVolume, CodersCopyTheirVolumeWithGridAndRepresentation) {
+  const ProbeGrid g{{4, 2, 2}, {{0, 0, 0}, {3, 1, 1}}};
+  const StreamLayout layout = streamLayoutFor(g, Representation::Zh3Hallucinated, 2);
+  StreamEncoder encoder(layout);
+  StreamDecoder decoder(layout);
+  std::mt19937 rng(9);
+  std::vector<float> probes = test::movingLightFrame(static_cast<int>(g.count()), 0, 0.01f, rng);
+  std::vector<uint8_t> active(g.count(), 1);
+  active[3] = 0;
+  encoder.update(probes.data(), active.data());
+  std::vector<uint8_t> frame;
+  encoder.writeKeyframeFrame(frame);
+  ASSERT_EQ(decoder.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  ProbeVolume sent, held;
+  encoder.copyVolume(g.bounds, sent);
+  decoder.copyVolume(g.bounds, held);
+  std::string error;
+  EXPECT_TRUE(checkProbeVolume(held, error)) << error;
+  EXPECT_EQ(held.probes, sent.probes);  // drift-free: the decoder holds the encoder's reconstruction
+  EXPECT_EQ(held.active, active);
+  EXPECT_EQ(held.grid.dims[0], 4u);
+  EXPECT_EQ(held.grid.bounds.max[0], 3.0f);
+  ASSERT_TRUE(held.decodedFrom.has_value());
+  EXPECT_EQ(*held.decodedFrom, Representation::Zh3Hallucinated);
+  EXPECT_FALSE(held.zh3PerPixel);
+  StreamDecoder perPixel(layout);
+  perPixel.setZh3PerPixel(true);
+  ASSERT_EQ(perPixel.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  perPixel.copyVolume(g.bounds, held);
+  EXPECT_TRUE(held.zh3PerPixel);
+  for (size_t i = 0; i < held.probes.size(); ++i)
+    if (i % kProbeFloats >= 12) {
+      EXPECT_EQ(held.probes[i], 0.0f) << i;  // L1 only
+    }
 }
 
 }  // namespace

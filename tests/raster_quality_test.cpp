@@ -89,17 +89,17 @@ TEST(RasterQuality, L2AndStoredZh3AreCloserToTheFloatRenderThanL1) {
     return raster.render(raster.viewProjection(cam), cam.position);
   };
   const Image reference = renderAs(volume);
-  const double l1 = rmse(renderAs(decodeAs(volume, Representation::L1)), reference);
-  const double zh3h = rmse(renderAs(decodeAs(volume, Representation::Zh3Hallucinated)), reference);
-  const double zh3 = rmse(renderAs(decodeAs(volume, Representation::Zh3)), reference);
-  const double l2 = rmse(renderAs(decodeAs(volume, Representation::L2)), reference);
+  const double l1 = rmse(renderAs(decodeAs(volume, Representation::L1, /*zh3PerPixel=*/true)), reference);
+  const double zh3h = rmse(renderAs(decodeAs(volume, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true)), reference);
+  const double zh3 = rmse(renderAs(decodeAs(volume, Representation::Zh3, /*zh3PerPixel=*/true)), reference);
+  const double l2 = rmse(renderAs(decodeAs(volume, Representation::L2, /*zh3PerPixel=*/true)), reference);
   EXPECT_LT(l2, l1);
   EXPECT_LT(zh3, l1);
   EXPECT_LT(l2, 0.5 * l1);
   EXPECT_NE(zh3h, l1);  // the per-pixel hallucination did something
   EXPECT_GT(l1, 0.0);
   // zh3h decodes L1 only and leaves the L2 band to the shader.
-  const ProbeVolume h = decodeAs(volume, Representation::Zh3Hallucinated);
+  const ProbeVolume h = decodeAs(volume, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true);
   EXPECT_TRUE(h.zh3PerPixel);
   for (size_t p = 0; p < h.probes.size(); p += 27)
     for (int k = 12; k < 27; ++k) ASSERT_EQ(h.probes[p + k], 0.0f);
@@ -174,7 +174,7 @@ TEST(RasterQuality, CornellAgainstTheReferenceAboveTheRecordedFloor) {
   const ProbeVolume volume = tracedVolume(context, s, {8, 8, 8}, 4);
   const CameraView cam = CameraView::fromScene(s);
   RasterRenderer raster(context, s, 80, 50);
-  raster.setProbes(decodeAs(volume, Representation::L2));
+  raster.setProbes(decodeAs(volume, Representation::L2, /*zh3PerPixel=*/true));
   const Image image = raster.render(raster.viewProjection(cam), cam.position);
   ReferenceOptions ro;
   ro.width = 80;

@@ -64,6 +64,16 @@ StreamLayout streamLayoutFor(const ProbeGrid& grid, Representation repr, uint8_t
   return layout;
 }
 
+void copyStreamVolume(const StreamLayout& layout, const GridBounds& bounds, const float* probes, const uint8_t* active,
+                      bool zh3PerPixel, ProbeVolume& out) {
+  const size_t n = probeCount(layout);
+  out.grid = gridOf(layout, bounds);
+  out.probes.assign(probes, probes + n * kProbeFloats);
+  out.active.assign(active, active + n);
+  out.decodedFrom = layout.repr;
+  out.zh3PerPixel = zh3PerPixel;
+}
+
 ProbeGrid gridOf(const StreamLayout& layout, const GridBounds& bounds) {
   ProbeGrid grid;
   for (int a = 0; a < 3; ++a) grid.dims[a] = layout.grid[a];

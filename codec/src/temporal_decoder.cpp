@@ -137,5 +137,9 @@ uint32_t StreamDecoder::lastFrameSequence() const { return impl_->lastFrame; }
 const float* StreamDecoder::probes() const { return impl_->probes.data(); }
 const uint8_t* StreamDecoder::activeMask() const { return impl_->active.data(); }
 void StreamDecoder::setZh3PerPixel(bool zh3PerPixel) { impl_->zh3PerPixel = zh3PerPixel; }
+void StreamDecoder::copyVolume(const GridBounds& bounds, ProbeVolume& out) const {
+  const bool l1Only = impl_->zh3PerPixel && impl_->layout.repr == Representation::Zh3Hallucinated;
+  copyStreamVolume(impl_->layout, bounds, impl_->probes.data(), impl_->active.data(), l1Only, out);
+}
 
 }  // namespace probecast

@@ -178,5 +178,8 @@ void StreamEncoder::writeKeyframeFrame(std::vector<uint8_t>& out) {
 
 const float* StreamEncoder::reconstruction() const { return impl_->reconstruction.data(); }
 const uint8_t* StreamEncoder::activeMask() const { return impl_->active.data(); }
+void StreamEncoder::copyVolume(const GridBounds& bounds, ProbeVolume& out) const {
+  copyStreamVolume(impl_->layout, bounds, impl_->reconstruction.data(), impl_->active.data(), false, out);
+}
 
 }  // namespace probecast

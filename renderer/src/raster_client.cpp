@@ -159,21 +159,35 @@ struct RasterRenderer::Impl {
   std::vector<float> filled;            // a volume with inactive probes, filled (capacity kept)
 
   // Probe textures and staging memory for a grid, kept across updates of the same size.
+  // New storage is made before the old is freed: when creating it throws, the old textures,
+  // descriptors and size stay as they were.
   void ensureVolumeStorage(const uint32_t dims[3]) {
     if (staging.buffer && std::equal(dims, dims + 3, volumeDims)) return;
-    for (GpuImage& img : probeTextures) destroyImage(*d, img);
-    destroyBuffer(*d, staging);
     const size_t count = static_cast<size_t>(dims[0]) * dims[1] * dims[2];
-    staging = createBuffer(*d, count * 4 * sizeof(float) * RS_PROBE_TEXTURES, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    for (GpuImage& img : probeTextures)
-      img = createImage(*d, VK_FORMAT_R32G32B32A32_SFLOAT, {dims[0], dims[1], dims[2]},
-                        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, true);
+    Buffer newStaging;
+    GpuImage newTextures[RS_PROBE_TEXTURES];
+    try {
+      newStaging = createBuffer(*d, count * 4 * sizeof(float) * RS_PROBE_TEXTURES, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+      for (GpuImage& img : newTextures)
+        img = createImage(*d, VK_FORMAT_R32G32B32A32_SFLOAT, {dims[0], dims[1], dims[2]},
+                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, true);
+    } catch (...) {
+      for (GpuImage& img : newTextures) destroyImage(*d, img);
+      destroyBuffer(*d, newStaging);
+      throw;
+    }
+    for (int t = 0; t < RS_PROBE_TEXTURES; ++t) {
+      destroyImage(*d, probeTextures[t]);
+      probeTextures[t] = newTextures[t];
+    }
+    destroyBuffer(*d, staging);
+    staging = newStaging;
     std::copy(dims, dims + 3, volumeDims);
     writeDescriptors();
   }
 
-  // Writes the volume straight into the staging memory (through `filled` only when some probes
-  // are inactive) and copies it into the textures.
+  // Writes the volume into the staging memory (straight from `v`, or from `filled` when some
+  // probes are inactive) and copies it into the textures.
   void uploadVolume(const ProbeVolume& v) {
     ensureVolumeStorage(v.grid.dims);
     const size_t count = v.count();

@@ -234,14 +234,8 @@ void ProbeClient::setViews(std::vector<View> views) {
 bool ProbeClient::snapshot(VolumeSnapshot& out) const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (!impl_->decoder) return false;
-  const uint32_t n = probeCount(impl_->layout);
   out.layout = impl_->layout;
-  ProbeVolume& v = out.volume;
-  v.grid = gridOf(impl_->layout, impl_->bounds);
-  v.probes.assign(impl_->decoder->probes(), impl_->decoder->probes() + static_cast<size_t>(n) * kProbeFloats);
-  v.active.assign(impl_->decoder->activeMask(), impl_->decoder->activeMask() + n);
-  v.decodedFrom = impl_->layout.repr;
-  v.zh3PerPixel = impl_->config.zh3PerPixel && impl_->layout.repr == Representation::Zh3Hallucinated;
+  impl_->decoder->copyVolume(impl_->bounds, out.volume);
   out.framesApplied = impl_->stats.framesApplied;
   out.newestServerTimeUs = impl_->newestServerTimeUs;
   return true;

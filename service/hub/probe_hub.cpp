@@ -31,13 +31,12 @@ HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, int brickDim,
 }
 
 void ProbeHub::publish(const ProbeVolume& volume) {
+  std::string error;
+  if (!checkProbeVolume(volume, error)) throw std::invalid_argument(error);
   for (int a = 0; a < 3; ++a)
     if (volume.grid.dims[a] != config_.layout.grid[a])
       throw std::invalid_argument("published volume's grid differs from the hub's");
-  if (volume.probes.size() != static_cast<size_t>(probeCount(config_.layout)) * kProbeFloats ||
-      (!volume.active.empty() && volume.active.size() != probeCount(config_.layout)))
-    throw std::invalid_argument("published volume's sizes do not match its grid");
-  publish(volume.probes.data(), volume.active.empty() ? nullptr : volume.active.data());
+  publish(volume.probes.data(), volume.active.data());
 }
 
 void ProbeHub::publish(const float* probes, const uint8_t* active) {
@@ -230,12 +229,8 @@ SubscriberStats ProbeHub::stats(uint64_t id) const {
 
 ProbeVolume ProbeHub::reconstruction() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const uint32_t n = probeCount(config_.layout);
   ProbeVolume v;
-  v.grid = gridOf(config_.layout, config_.bounds);
-  v.probes.assign(encoder_.reconstruction(), encoder_.reconstruction() + static_cast<size_t>(n) * kProbeFloats);
-  v.active.assign(encoder_.activeMask(), encoder_.activeMask() + n);
-  v.decodedFrom = config_.layout.repr;
+  encoder_.copyVolume(config_.bounds, v);
   return v;
 }
 

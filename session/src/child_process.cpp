@@ -1,5 +1,6 @@
 #include "probecast/session/child_process.h"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,7 +20,10 @@ ChildProcess::ChildProcess(std::function<int(const Say& say)> body) {
   std::fflush(stdout);
   std::fflush(stderr);
   pid_ = fork();
-  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ < 0) {
+    for (int fd : {toChild[0], toChild[1], fromChild[0], fromChild[1]}) close(fd);
+    throw std::runtime_error("fork failed");
+  }
   if (pid_ == 0) {
     // Only its own pipes: a copy of another child's would keep that child from seeing its parent go.
     const long maxFd = std::min(sysconf(_SC_OPEN_MAX), 65536L);
@@ -37,6 +41,8 @@ ChildProcess::ChildProcess(std::function<int(const Say& say)> body) {
       status = body(say);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "probecast: error in a child process: %s\n", e.what());
+    } catch (...) {
+      std::fprintf(stderr, "probecast: unknown error in a child process\n");
     }
     std::fflush(nullptr);
     _exit(status);  // not exit(): the parent's state (and its atexit handlers) is not ours
@@ -55,7 +61,14 @@ ChildProcess::~ChildProcess() {
 
 void ChildProcess::go() {
   const char go = 1;
-  if (goFd_ < 0 || write(goFd_, &go, 1) != 1) throw std::runtime_error("child process is gone");
+  // A child that is already gone must not take this process with it (SIGPIPE): ignore the signal
+  // for the one write and get EPIPE instead.
+  struct sigaction ignore {}, previous {};
+  ignore.sa_handler = SIG_IGN;
+  sigaction(SIGPIPE, &ignore, &previous);
+  const bool written = goFd_ >= 0 && write(goFd_, &go, 1) == 1;
+  sigaction(SIGPIPE, &previous, nullptr);
+  if (!written) throw std::runtime_error("child process is gone");
   close(goFd_);
   goFd_ = -1;
 }

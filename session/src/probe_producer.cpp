@@ -56,6 +56,7 @@ void ProbeProducer::step() {
   if (updater_) {
     const bool wasFrozen = frozen_;
     if (!wasFrozen && animation_.mode == Animation::Mode::PerStep) t_ = std::fmod(t_ + animation_.perStep, 1.0f);
+    if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) t_ = t();  // what t() says once the loop ends
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene)
       updater_->setScene(loadSceneOrThrow(sceneSpec_, t()));
     const renderer::UpdateStats st = updater_->update();
@@ -65,6 +66,8 @@ void ProbeProducer::step() {
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.updates;
     if (wasFrozen) ++stats_.settledUpdates;
+    if (stats_.updateMs.size() >= kMaxUpdateSamples)  // a serve that runs for days: keep the newest
+      stats_.updateMs.erase(stats_.updateMs.begin(), stats_.updateMs.begin() + kMaxUpdateSamples / 2);
     stats_.updateMs.push_back(st.milliseconds);
     stats_.publishMs += publishMs;
   } else if (generator_ && moving_) {
@@ -84,7 +87,9 @@ void ProbeProducer::loop(const Pacing& pacing, const std::atomic<bool>* interrup
                          const std::function<void(double)>& afterStep) {
   const auto start = started_;
   auto next = start;
-  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / pacing.hz));
+  const auto period = pacing.mode == Pacing::Mode::FixedRate
+                          ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / pacing.hz))
+                          : Clock::duration::zero();
   while (!stop_ && !(interrupted && *interrupted)) {
     const auto now = Clock::now();
     if (pacing.seconds > 0 && now - start >= std::chrono::duration<double>(pacing.seconds)) break;

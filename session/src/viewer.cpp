@@ -5,7 +5,6 @@
 #include <thread>
 
 #include "probecast/session/scene_loading.h"
-#include "probecast/session/volumes.h"
 
 namespace probecast::session {
 

@@ -62,7 +62,7 @@ bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back
 // (inactive probes too, as the raster client fills them from neighbours anyway). For zh3h,
-// `zh3PerPixel` chooses L1 only (true, the raster client's default) or per-probe hallucination.
-ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel = true);
+// `zh3PerPixel` chooses L1 only (true, as the raster client draws zh3h) or per-probe hallucination.
+ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel);
 
 }  // namespace probecast

@@ -82,6 +82,11 @@ struct FrameHeader {
 // Parses and checks a frame header (magic, version, representation, layout, CRC, total size).
 CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* header);
 
+// A volume of the stream's grid over `bounds` from a coder's samples and mask (into `out`'s
+// storage): decodedFrom is the layout's representation.
+void copyStreamVolume(const StreamLayout& layout, const GridBounds& bounds, const float* probes, const uint8_t* active,
+                      bool zh3PerPixel, ProbeVolume& out);
+
 // Writes a frame: header plus the given sections (as produced by StreamEncoder) back to back.
 void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
                 std::vector<uint8_t>& out);
@@ -122,6 +127,8 @@ class StreamEncoder {
   // The decoder's reconstruction: 27 floats per probe (0 for inactive probes), and active flags.
   const float* reconstruction() const;
   const uint8_t* activeMask() const;
+  // The reconstruction as a volume over `bounds`, into `out` (its storage reused).
+  void copyVolume(const GridBounds& bounds, ProbeVolume& out) const;
 
  private:
   struct Impl;
@@ -143,8 +150,11 @@ class StreamDecoder {
   uint32_t lastFrameSequence() const;
   const float* probes() const;      // 27 floats per probe, 0 for inactive probes
   const uint8_t* activeMask() const;  // 1 = active
+  // What it holds as a volume over `bounds`, into `out` (its storage reused); zh3PerPixel as set.
+  void copyVolume(const GridBounds& bounds, ProbeVolume& out) const;
   // zh3h only: true decodes L1 with a zero L2 band, for a renderer that hallucinates ZH3 per
-  // pixel (ProbeVolume::zh3PerPixel); false (the default) hallucinates per probe.
+  // pixel (ProbeVolume::zh3PerPixel); false (the default) hallucinates per probe. Set it before
+  // the first frame: probes decoded earlier stay as they were decoded.
   void setZh3PerPixel(bool zh3PerPixel);
 
  private:

@@ -52,12 +52,15 @@ struct Animation {
 struct ProducerStats {
   uint32_t updates = 0;         // steps that published new lighting
   uint32_t settledUpdates = 0;  // of those, the ones that began with the animation frozen
-  std::vector<double> updateMs; // the updater's own time per update, ms (traced scenes)
+  std::vector<double> updateMs; // the updater's own time per update, ms (traced scenes; the newest 2¹⁶ at most)
   double publishMs = 0.0;       // time spent in ProbeHub::publish (encoding), all steps, ms
 };
 
+// Set the source (traceScene, serveVolume or generate) before start(); step() and the setters of
+// the source are not for use while the producer's own thread runs.
 class ProbeProducer {
  public:
+  static constexpr size_t kMaxUpdateSamples = size_t{1} << 16;
   using Clock = std::chrono::steady_clock;
   // Fills `probes` (27 floats per probe, all active) with lighting frame number `frame`.
   using FrameGenerator = std::function<void(uint32_t frame, std::vector<float>& probes)>;

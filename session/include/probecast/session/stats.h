@@ -26,10 +26,4 @@ inline double medianMidpoint(std::vector<double> v) {
   return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-inline double mean(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x / static_cast<double>(v.size());
-  return sum;
-}
-
 }  // namespace probecast::session

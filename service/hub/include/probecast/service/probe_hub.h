@@ -67,7 +67,8 @@ class ProbeHub {
   // A new lighting frame (27 floats per probe, sh.h layout; active mask or null). Each changed
   // brick gets a new version, encoded once. Wakes subscribers that wait for data.
   void publish(const float* probes, const uint8_t* active);
-  // The same for a volume, which must have the hub's grid size (std::invalid_argument otherwise).
+  // The same for a volume, which must pass checkProbeVolume and have the hub's grid size
+  // (std::invalid_argument otherwise, nothing published).
   void publish(const ProbeVolume& volume);
   // Wakes subscribers whose budget has refilled (call at the producer's rate when nothing changes).
   void tick();
