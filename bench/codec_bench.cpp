@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/record.h"
 #include "probecast/codec/stream.h"
 #include "probecast/codec/zh3.h"
@@ -22,32 +23,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Probe = std::array<float, kProbeFloats>;
 
-// Relative RMSE of irradiance over a set of normals, pooled over RGB.
 double rmseAgainst(const Probe& probe, const std::vector<float>& normals, const std::vector<float>& reference) {
-  double num = 0, den = 0;
-  for (size_t n = 0; n < normals.size() / 3; ++n) {
-    float e[3];
-    shEvalIrradiance(probe.data(), normals[n * 3], normals[n * 3 + 1], normals[n * 3 + 2], e);
-    for (int c = 0; c < 3; ++c) {
-      const double d = e[c] - reference[n * 3 + c];
-      num += d * d;
-      den += static_cast<double>(reference[n * 3 + c]) * reference[n * 3 + c];
-    }
-  }
-  return den > 0 ? std::sqrt(num / den) : 0.0;
+  return irradianceRmseRel(probe.data(), normals.data(), reference.data(), normals.size() / 3);
 }
 
-// Exact irradiance error over the whole sphere between two SH3 probes (orthonormality):
-// ∫ |ΔE|² dω = Σ_l Â_l² Σ_m Δc_lm². Returns the two sums (error, reference energy).
 void irradianceEnergy(const float* test, const float* ref, double& err, double& energy) {
-  for (int i = 0; i < kShCoeffs; ++i) {
-    const double a2 = static_cast<double>(kCosineBand[shBand(i)]) * kCosineBand[shBand(i)];
-    for (int c = 0; c < 3; ++c) {
-      const double d = static_cast<double>(test[i * 3 + c]) - ref[i * 3 + c];
-      err += a2 * d * d;
-      energy += a2 * static_cast<double>(ref[i * 3 + c]) * ref[i * 3 + c];
-    }
-  }
+  irradianceErrorEnergy(test, ref, err, energy);
 }
 
 Probe floatVariant(const Probe& l2, const std::string& which) {

@@ -1,4 +1,5 @@
-// Equirectangular environment maps: loading, projection to SH, and brute-force irradiance.
+// Equirectangular environment maps: loading, and the projection to SH and brute-force irradiance
+// of probecast/codec/equirect.h on an EnvMap.
 //
 // Convention: lat-long, linear radiance, the top row is +Y (up), u = 0 at the left edge.
 // Pixel (u, v) in [0, 1)² looks along θ = π v from +Y, φ = 2π (u − 0.5):

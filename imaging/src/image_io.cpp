@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdlib>
 
+#include <stb_image.h>
 #include <stb_image_write.h>
 #include <tinyexr.h>
 
@@ -33,6 +34,18 @@ bool readExr(const std::string& path, std::vector<float>& rgb, int& width, int& 
   for (size_t i = 0; i < static_cast<size_t>(width) * height; ++i)
     for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = data[i * 4 + c];
   std::free(data);
+  return true;
+}
+
+bool readHdr(const std::string& path, std::vector<float>& rgb, int& width, int& height, std::string& error) {
+  int channels = 0;
+  float* data = stbi_loadf(path.c_str(), &width, &height, &channels, 3);
+  if (!data) {
+    error = path + ": cannot read Radiance HDR (" + (stbi_failure_reason() ? stbi_failure_reason() : "unknown") + ")";
+    return false;
+  }
+  rgb.assign(data, data + static_cast<size_t>(width) * height * 3);
+  stbi_image_free(data);
   return true;
 }
 
