@@ -13,9 +13,15 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 WERROR=${PROBECAST_WERROR:-OFF}
 [ "${CI:-}" = "true" ] && WERROR=ON
 
+# The Python module and its tests use the system Python (Debian's numpy, pytest, pybind11), not
+# whatever python3 comes first on PATH.
+PYTHON_ARGS=()
+[ -x /usr/bin/python3 ] && PYTHON_ARGS=(-DPython3_EXECUTABLE=/usr/bin/python3)
+
 configure_and_build() {  # DIR [cmake args...]
   local dir=$1
   shift
+  set -- "${PYTHON_ARGS[@]}" "$@"
   if [ ! -f "$dir/build.ninja" ]; then
     cmake -S . -B "$dir" -G Ninja -DPROBECAST_WERROR="$WERROR" "$@"
   else

@@ -10,6 +10,7 @@ PACKAGES=(
   libvulkan-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   clang-14 libclang-rt-14-dev openssl
+  python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev
 )
 # Mesa >= 24 from bookworm-backports: lavapipe with ray tracing (see LAVAPIPE.md).
 MESA_MIN=24
