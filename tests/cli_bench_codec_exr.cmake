@@ -6,11 +6,14 @@ execute_process(COMMAND ${WRITE_EXRS} ${WORK}/maps DWAB PIZ B44 RESULT_VARIABLE 
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "write_test_exrs failed (${rc}): ${err}")
 endif()
-execute_process(COMMAND ${PROBECAST} bench codec --envmaps ${WORK}/maps --json ${WORK}/codec.json --frames 2
+execute_process(COMMAND ${PROBECAST} --quiet bench codec --envmaps ${WORK}/maps --json ${WORK}/codec.json --frames 2
                         --normals 64
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "bench codec failed (${rc}): ${out} ${err}")
+endif()
+if(err MATCHES "representation ")
+  message(FATAL_ERROR "bench codec --quiet still printed progress: ${err}")
 endif()
 file(READ ${WORK}/codec.json json)
 foreach(name test_DWAB.exr test_PIZ.exr test_B44.exr)
