@@ -9,7 +9,12 @@
 #include <fstream>
 #include <iterator>
 
+#include <ImfChannelList.h>
 #include <ImfCompression.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfTileDescription.h>
+#include <ImfTiledOutputFile.h>
 
 #include "exr_test_files.h"
 #include "probecast/imaging/image_io.h"
@@ -82,6 +87,36 @@ TEST(ImageIo, WriteReadRoundTripIsExactAndZipCompressed) {
   EXPECT_EQ(rgb, image);
   // ZIP: the smooth image takes well under its raw 40·20·12 = 9600 bytes.
   EXPECT_LT(std::filesystem::file_size(path), 9600u);
+  std::filesystem::remove(path);
+}
+
+TEST(ImageIo, TiledFilesRead) {
+  // A tiled (one level, 16×16 tiles), PIZ-compressed float file: same pixels as written.
+  const int w = 37, h = 19;
+  const std::vector<float> image = exrTestImage(w, h);
+  const std::string path = tmpPath("tiled.exr");
+  Imf::Header header(w, h);
+  header.compression() = Imf::PIZ_COMPRESSION;
+  header.setTileDescription(Imf::TileDescription(16, 16, Imf::ONE_LEVEL));
+  Imf::FrameBuffer fb;
+  const char* names[3] = {"R", "G", "B"};
+  char* base = reinterpret_cast<char*>(const_cast<float*>(image.data()));
+  for (int c = 0; c < 3; ++c) {
+    header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float), 3 * sizeof(float) * w));
+  }
+  {
+    Imf::TiledOutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writeTiles(0, file.numXTiles() - 1, 0, file.numYTiles() - 1);
+  }
+  std::vector<float> rgb;
+  int rw = 0, rh = 0;
+  std::string error;
+  ASSERT_TRUE(readExr(path, rgb, rw, rh, error)) << error;
+  EXPECT_EQ(rw, w);
+  EXPECT_EQ(rh, h);
+  EXPECT_EQ(rgb, image);
   std::filesystem::remove(path);
 }
 
