@@ -13,6 +13,7 @@
 #include <ImfCompression.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfRgbaFile.h>
 #include <ImfTileDescription.h>
 #include <ImfTiledOutputFile.h>
 
@@ -132,6 +133,32 @@ TEST(ImageIo, LuminanceOnlyReadsAsGrey) {
   ASSERT_EQ(rgb.size(), image.size());
   for (size_t i = 0; i < rgb.size() / 3; ++i)
     for (int c = 0; c < 3; ++c) EXPECT_EQ(rgb[i * 3 + c], image[i * 3]) << i;  // Y was written from R
+  std::filesystem::remove(path);
+}
+
+TEST(ImageIo, LuminanceChromaReadsAsRgb) {
+  // Y/RY/BY (chroma subsampled 2×2, half): a grey ramp comes back grey, within half precision and
+  // the YC round trip (1 %).
+  const int w = 16, h = 8;
+  std::vector<Imf::Rgba> pixels(static_cast<size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float v = 0.1f + 0.2f * static_cast<float>(x + y);
+      pixels[static_cast<size_t>(y) * w + x] = Imf::Rgba(v, v, v, 1.0f);
+    }
+  const std::string path = tmpPath("yc.exr");
+  {
+    Imf::RgbaOutputFile file(path.c_str(), w, h, Imf::WRITE_YC);
+    file.setFrameBuffer(pixels.data(), 1, static_cast<size_t>(w));
+    file.writePixels(h);
+  }
+  std::vector<float> rgb;
+  int rw = 0, rh = 0;
+  std::string error;
+  ASSERT_TRUE(readExr(path, rgb, rw, rh, error)) << error;
+  ASSERT_EQ(rgb.size(), pixels.size() * 3);
+  for (size_t i = 0; i < pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb[i * 3 + c], static_cast<float>(pixels[i].r), 0.01f * static_cast<float>(pixels[i].r)) << i;
   std::filesystem::remove(path);
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <exception>
 
 #include <ImfChannelList.h>
@@ -66,13 +65,13 @@ bool readDataWindow(const std::string& path, Imf::InputFile& file, const Imath::
     for (size_t i = 0; i < pixels; ++i) src[i * 3 + 1] = src[i * 3 + 2] = src[i * 3];
   } else {
     Imf::RgbaInputFile rgbaFile(path.c_str());
-    std::vector<Imf::Rgba> half(pixels);
-    rgbaFile.setFrameBuffer(half.data() - int64_t{dw.min.y} * dataW - dw.min.x, 1, static_cast<size_t>(dataW));
+    std::vector<Imf::Rgba> rgba(pixels);
+    rgbaFile.setFrameBuffer(rgba.data() - int64_t{dw.min.y} * dataW - dw.min.x, 1, static_cast<size_t>(dataW));
     rgbaFile.readPixels(dw.min.y, dw.max.y);
     for (size_t i = 0; i < pixels; ++i) {
-      src[i * 3] = half[i].r;
-      src[i * 3 + 1] = half[i].g;
-      src[i * 3 + 2] = half[i].b;
+      src[i * 3] = rgba[i].r;
+      src[i * 3 + 1] = rgba[i].g;
+      src[i * 3 + 2] = rgba[i].b;
     }
   }
   return true;
