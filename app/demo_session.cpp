@@ -150,7 +150,8 @@ void settle(const DemoOptions& o, DemoRun& run) {
   while (producer.running() && producer.stats().settledUpdates < o.settleUpdates) {
     const uint32_t settled = producer.stats().settledUpdates;
     progress.update(static_cast<double>(settled) / o.settleUpdates,
-                    fmt::format("light frozen at t = {:.3f}, settling {}/{} updates", run.finalT, settled, o.settleUpdates));
+                    fmt::format("light frozen at t = {:.3f}, settling {}/{} updates", run.finalT, settled,
+                                o.settleUpdates));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   producer.stop();

@@ -63,7 +63,8 @@ void writeTestExr(const std::string& path, const std::vector<float>& rgb, int wi
   std::vector<float> alphaF(pixels, 1.0f);
   std::vector<half> alphaH(pixels, half(1.0f));
   const size_t elem = halfPixels ? sizeof(half) : sizeof(float);
-  char* base = halfPixels ? reinterpret_cast<char*>(halves.data()) : reinterpret_cast<char*>(const_cast<float*>(rgb.data()));
+  char* base = halfPixels ? reinterpret_cast<char*>(halves.data())
+                          : reinterpret_cast<char*>(const_cast<float*>(rgb.data()));
   const ptrdiff_t origin = (static_cast<ptrdiff_t>(dataY) * width + dataX) * static_cast<ptrdiff_t>(3 * elem);
   base -= origin;
   Imf::FrameBuffer fb;
