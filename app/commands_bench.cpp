@@ -8,6 +8,7 @@
 #include "codec_bench.h"
 #include "probecast/codec/probe_file.h"
 #include "commands.h"
+#include "progress.h"
 #include "scene_options.h"
 #include "pipeline_bench.h"
 #include "raster_bench.h"
@@ -83,7 +84,7 @@ void addBenchCodec(CLI::App* bench) {
     options.frames = opt->frames;
     options.normals = opt->normals;
     options.command = commandLine();
-    options.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    options.progress = progressLine;
     const bench::CodecBenchResult r = bench::runCodecBench(options);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", opt->json, r.svg, opt->chart);
   });
@@ -116,7 +117,7 @@ void addBenchUpdate(CLI::App* bench) {
     o.referenceSamples = uo->referenceSamples;
     o.minBlendWeights = uo->wMins;
     o.command = commandLine();
-    o.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    o.progress = progressLine;
     const bench::UpdateBenchResult r = bench::runUpdateBench(o);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", uo->json, r.svg, uo->chart);
   });
@@ -151,7 +152,7 @@ void addBenchRaster(CLI::App* bench) {
     ro->bench.width = ro->size[0];
     ro->bench.height = ro->size[1];
     ro->bench.command = commandLine();
-    ro->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    ro->bench.progress = progressLine;
     const bench::RasterBenchResult r = bench::runRasterBench(ro->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", ro->json, r.svg, ro->chart);
     if (!ro->chart.empty()) {
@@ -192,7 +193,7 @@ void addBenchPipeline(CLI::App* bench) {
     po->bench.width = po->size[0];
     po->bench.height = po->size[1];
     po->bench.command = commandLine();
-    po->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    po->bench.progress = progressLine;
     const bench::PipelineBenchResult r = bench::runPipelineBench(po->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", po->json, "", "");
     if (!po->chart.empty())
@@ -212,7 +213,7 @@ void addBenchStability(CLI::App* bench) {
   stability->callback([stabilityJson] {
     bench::StabilityOptions so;
     so.command = commandLine();
-    so.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    so.progress = progressLine;
     const bench::StabilityResult r = bench::runStabilitySuite(so);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", *stabilityJson, "", "");
   });
@@ -237,7 +238,7 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--chart", so->chart, "write an SVG chart here");
   stream->callback([so] {
     so->bench.command = commandLine();
-    so->bench.progress = [](const std::string& s) { fmt::print(stderr, "{}\n", s); };
+    so->bench.progress = progressLine;
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
   });

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/renderer/reference_camera.h"
 #include "scene_options.h"
@@ -51,9 +52,11 @@ void addReferenceCommand(CLI::App& app) {
     ro.samplesPerPixel = o->spp;
     ro.maxBounces = o->bounces;
     ro.seed = o->seed;
-    ro.progress = [](uint32_t done, uint32_t total) {
-      fmt::print(stderr, "\rrender-reference: {}/{} spp ({:.0f}%)", done, total, 100.0 * done / total);
-      if (done == total) fmt::print(stderr, "\n");
+    auto progress = std::make_shared<Progress>("render-reference", /*bar=*/false);
+    ro.progress = [progress](uint32_t done, uint32_t total) {
+      progress->update(static_cast<double>(done) / total,
+                       fmt::format("{}/{} spp ({:.0f}%)", done, total, 100.0 * done / total));
+      if (done == total) progress->finish();
     };
     fmt::print("render-reference: {} on {}, {}x{}, {} spp\n", s.name, context.deviceName(), ro.width, ro.height, ro.samplesPerPixel);
     const renderer::Image image = renderer::renderReference(context, s, camera, ro);

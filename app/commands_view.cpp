@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/raster_client.h"
@@ -62,11 +63,12 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   ProbeVolume volume;
   if (o.probes == "live") {
     renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), o.tracing.tracer.options());
+    Progress progress("view", /*bar=*/false);
     for (uint32_t u = 0; u < o.updates; ++u) {
       updater.update();
-      fmt::print(stderr, "\rview: probe update {}/{}", u + 1, o.updates);
+      progress.update(static_cast<double>(u + 1) / o.updates, fmt::format("probe update {}/{}", u + 1, o.updates));
     }
-    fmt::print(stderr, "\n");
+    progress.finish();
     volume = updater.volume();
   } else {
     std::string error;

@@ -72,7 +72,6 @@ void runDemoSession(const DemoOptions& o, DemoRun& run);
 // writes report.json, report.md, charts and images to o.out, and prints the summary.
 void writeDemoReport(const DemoOptions& o, DemoRun& run);
 
-std::string progressBar(double fraction);
 double secondsSince(DemoClock::time_point t0);
 // A viewer's current images on disk: a stereo pair side by side, or a light-field quilt.
 void writeViewerImages(const std::string& prefix, const DemoViewer& v, const std::vector<renderer::Image>& images);

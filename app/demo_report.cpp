@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "demo.h"
+#include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/imaging/image_metrics.h"
 #include "pipeline_bench.h"
@@ -22,7 +23,8 @@ namespace {
 // their report sections.
 std::string runSuites(const DemoOptions& o, const std::string& dir, const scene::Scene& finalScene, float finalT,
                       const ProbeGrid& grid, nlohmann::json& phases) {
-  const auto status = [](const std::string& s) { fmt::print(stderr, "\rdemo: {:<90}", s.substr(0, 90)); };
+  Progress progress("demo");
+  const auto status = [&progress](const std::string& s) { progress.message(s); };
   auto phaseStart = DemoClock::now();
   bench::PipelineBenchOptions po;
   po.sceneSpec = o.scene;
@@ -52,7 +54,7 @@ std::string runSuites(const DemoOptions& o, const std::string& dir, const scene:
   const bench::StabilityResult sr = bench::runStabilitySuite(so);
   writeTextFile(dir + "/stability.json", sr.json.dump(2) + "\n");
   phases["stability"] = secondsSince(phaseStart);
-  fmt::print(stderr, "\n");
+  progress.finish();
   return "\n## Speed against accuracy across the pipeline\n\n"
          "Same scene, same view (the light frozen where the demo stopped it), one run; the Pareto front of "
          "each chart is joined. Data: [pipeline.json](pipeline.json).\n\n"
@@ -145,10 +147,11 @@ void compareWithReferences(const DemoOptions& o, DemoRun& run, const scene::Scen
     compared.push_back(referenceViews(v));
     referencesTotal += static_cast<uint32_t>(compared.back().size());
   }
+  Progress progress("demo");
   const auto progressReferences = [&] {
     ++referencesDone;
-    fmt::print(stderr, "\rdemo: {} reference images {}/{}",
-               progressBar(static_cast<double>(referencesDone) / referencesTotal), referencesDone, referencesTotal);
+    progress.update(static_cast<double>(referencesDone) / referencesTotal,
+                    fmt::format("reference images {}/{}", referencesDone, referencesTotal));
   };
   for (size_t k = 0; k < run.viewers.size(); ++k) {
     DemoViewer& v = run.viewers[k];
@@ -223,7 +226,7 @@ void compareWithReferences(const DemoOptions& o, DemoRun& run, const scene::Scen
     psnrSeries.push_back(std::move(series));
     viewer.stop();
   }
-  fmt::print(stderr, "\n");
+  progress.finish();
 }
 
 void writeCharts(const DemoOptions& o, const DemoRun& run, const std::vector<imaging::ChartSeries>& psnrSeries) {

@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "demo.h"
+#include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/scene_loading.h"
@@ -19,12 +20,6 @@ namespace probecast::app {
 
 double secondsSince(DemoClock::time_point t0) {
   return std::chrono::duration<double>(DemoClock::now() - t0).count();
-}
-
-std::string progressBar(double fraction) {
-  const int width = 30, filled = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * width);
-  return "[" + std::string(static_cast<size_t>(filled), '#') + std::string(static_cast<size_t>(width - filled), ' ') +
-         "]";
 }
 
 void writeViewerImages(const std::string& prefix, const DemoViewer& v, const std::vector<renderer::Image>& images) {
@@ -103,6 +98,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
 
 // Streaming with the light moving: re-render as lighting arrives, images at three moments.
 void stream(const DemoOptions& o, DemoRun& run) {
+  Progress progress("demo");
   session::ProbeProducer& producer = *run.producer;
   const double moment[3] = {o.seconds / 3.0, 2.0 * o.seconds / 3.0, o.seconds};
   int nextMoment = 0;
@@ -132,32 +128,34 @@ void stream(const DemoOptions& o, DemoRun& run) {
       ++nextMoment;
     }
     const session::ViewerStats &head = run.viewers[0].viewer->stats(), &display = run.viewers[1].viewer->stats();
-    fmt::print(stderr,
-               "\rdemo: {} {:4.1f}/{:.0f} s  updates {:4}  headset {:4} frames {:4} renders  display {:4} frames "
-               "{:4} renders",
-               progressBar(now / o.seconds), std::min(now, o.seconds), o.seconds, producer.stats().updates,
-               head.framesSeen, head.renders, display.framesSeen, display.renders);
+    progress.update(now / o.seconds,
+                    fmt::format("{:4.1f}/{:.0f} s  updates {:4}  headset {:4} frames {:4} renders  display {:4} frames "
+                                "{:4} renders",
+                                std::min(now, o.seconds), o.seconds, producer.stats().updates, head.framesSeen,
+                                head.renders, display.framesSeen, display.renders));
     if (now >= o.seconds) break;
     if (!rendered) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  fmt::print(stderr, "\n");
+  progress.finish();
   run.streamSeconds = secondsSince(producer.started());
   for (DemoViewer& v : run.viewers) v.streamBytes = v.viewer->clientStats().bytesReceived;
 }
 
 // Freeze the light and let the probes settle for o.settleUpdates updates.
 void settle(const DemoOptions& o, DemoRun& run) {
+  Progress progress("demo");
   session::ProbeProducer& producer = *run.producer;
   producer.freeze();
   run.finalT = producer.t();
   while (producer.running() && producer.stats().settledUpdates < o.settleUpdates) {
     const uint32_t settled = producer.stats().settledUpdates;
-    fmt::print(stderr, "\rdemo: {} light frozen at t = {:.3f}, settling {}/{} updates",
-               progressBar(static_cast<double>(settled) / o.settleUpdates), run.finalT, settled, o.settleUpdates);
+    progress.update(static_cast<double>(settled) / o.settleUpdates,
+                    fmt::format("light frozen at t = {:.3f}, settling {}/{} updates", run.finalT, settled,
+                                o.settleUpdates));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   producer.stop();
-  fmt::print(stderr, "\n");
+  progress.finish();
 }
 
 // Wait (up to 30 s) until both viewers hold the server's volume bit for bit.

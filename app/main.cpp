@@ -5,11 +5,16 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "progress.h"
 
 int main(int argc, char** argv) {
   probecast::app::setCommandLine(argc, argv);
   CLI::App app{"probecast: streaming light-probe codec and service for real-time global illumination"};
   app.require_subcommand(1);
+  app.fallthrough();  // top-level flags (--quiet) are accepted after the subcommand too
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "no progress output on stderr (results and errors still print)");
+  app.parse_complete_callback([&quiet] { probecast::app::setQuiet(quiet); });
   probecast::app::addDemoCommand(app);
   probecast::app::addBenchCommands(app);
   probecast::app::addBakeCommand(app);

@@ -5,7 +5,8 @@
 #include <filesystem>
 
 #include <stb_image.h>
-#include <tinyexr.h>
+
+#include "probecast/imaging/image_io.h"
 
 #include "probecast/codec/equirect.h"
 
@@ -28,20 +29,7 @@ bool loadEnvMap(const std::string& path, EnvMap& map, std::string& error) {
     map.rgb.assign(data, data + static_cast<size_t>(w) * h * 3);
     stbi_image_free(data);
   } else if (ext == ".exr") {
-    float* data = nullptr;
-    int w = 0, h = 0;
-    const char* err = nullptr;
-    if (LoadEXR(&data, &w, &h, path.c_str(), &err) != TINYEXR_SUCCESS) {
-      error = path + ": cannot read OpenEXR (" + (err ? err : "unknown") + ")";
-      if (err) FreeEXRErrorMessage(err);
-      return false;
-    }
-    map.width = w;
-    map.height = h;
-    map.rgb.resize(static_cast<size_t>(w) * h * 3);
-    for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
-      for (int c = 0; c < 3; ++c) map.rgb[i * 3 + c] = data[i * 4 + c];  // RGBA
-    free(data);
+    if (!imaging::readExr(path, map.rgb, map.width, map.height, error)) return false;
   } else {
     error = path + ": not an environment map (expected .hdr or .exr)";
     return false;

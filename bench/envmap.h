@@ -21,7 +21,8 @@ struct EnvMap {
   std::vector<float> rgb;  // width * height * 3, row-major from the top row
 };
 
-// Loads .hdr (stb_image) or .exr (tinyexr). On failure returns false and sets `error`.
+// Loads .hdr (stb_image) or .exr (imaging::readExr: OpenEXR, any compression; R, G, B or Y).
+// On failure returns false and sets `error`.
 bool loadEnvMap(const std::string& path, EnvMap& map, std::string& error);
 
 // Direction of the centre of pixel (x, y).

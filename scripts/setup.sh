@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config ccache
   libzstd-dev libgtest-dev libbenchmark-dev libcli11-dev libspdlog-dev libfmt-dev
-  nlohmann-json3-dev libstb-dev libtinyexr-dev libglm-dev libtinygltf-dev
+  nlohmann-json3-dev libstb-dev libopenexr-dev libglm-dev libtinygltf-dev
   libvulkan-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   clang-14 libclang-rt-14-dev openssl

@@ -1,10 +1,14 @@
 // Environment-map conventions, projection and brute-force irradiance.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
+#include <ImfCompression.h>
+
 #include "envmap.h"
+#include "exr_test_files.h"
 
 namespace probecast::bench {
 namespace {
@@ -81,6 +85,43 @@ TEST(EnvMap, BadFilesFailWithAMessage) {
   EXPECT_FALSE(loadEnvMap(std::string(PROBECAST_TEST_DATA) + "/CREDITS.md", m, error));
   EXPECT_NE(error.find("not an environment map"), std::string::npos);
   EXPECT_FALSE(loadEnvMap(std::string(PROBECAST_TEST_DATA) + "/scenes/cornell-box/CornellBox-Original.bin.hdr", m, error));
+}
+
+TEST(EnvMap, LoadsExrInEveryCompression) {
+  // The same files as ImageIo.EveryCompressionReadsBack, through the loader `bench codec --envmaps` uses.
+  using namespace probecast::testing;
+  const int w = 64, h = 32;
+  const std::vector<float> image = exrTestImage(w, h);
+  for (const ExrCompressionCase& c : exrCompressionCases()) {
+    SCOPED_TRACE(c.name);
+    const std::string path =
+        (std::filesystem::temp_directory_path() / (std::string("probecast_envmap_") + c.name + ".exr")).string();
+    writeTestExr(path, image, w, h, c.compression, c.half);
+    EnvMap map;
+    std::string error;
+    ASSERT_TRUE(loadEnvMap(path, map, error)) << error;
+    ASSERT_EQ(map.width, w);
+    ASSERT_EQ(map.height, h);
+    EXPECT_EQ(map.name, std::string("probecast_envmap_") + c.name + ".exr");
+    const std::vector<float> stored = c.half ? roundToHalf(image) : image;
+    float worst = 0.0f;
+    for (size_t i = 0; i < stored.size(); ++i)
+      worst = std::max(worst, std::fabs(map.rgb[i] - stored[i]) / std::max(1.0f, std::fabs(stored[i])));
+    EXPECT_LE(worst, c.tolerance);
+    std::filesystem::remove(path);
+  }
+}
+
+TEST(EnvMap, TruncatedExrFailsNamingTheFile) {
+  using namespace probecast::testing;
+  const std::string path = (std::filesystem::temp_directory_path() / "probecast_envmap_truncated.exr").string();
+  writeTestExr(path, exrTestImage(64, 32), 64, 32, Imf::ZIP_COMPRESSION, false);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+  EnvMap map;
+  std::string error;
+  EXPECT_FALSE(loadEnvMap(path, map, error));
+  EXPECT_NE(error.find("probecast_envmap_truncated.exr: cannot read EXR"), std::string::npos) << error;
+  std::filesystem::remove(path);
 }
 
 TEST(EnvMap, LoadsProjectRadianceMap) {

@@ -3,37 +3,130 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
+#include <exception>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfRgbaFile.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
-#include <tinyexr.h>
 
 namespace probecast::imaging {
 
+namespace {
+
+// Larger images are refused before anything is allocated (a header is untrusted input).
+constexpr int64_t kMaxExrPixels = int64_t{1} << 28;
+
+// Copies the data window (dw, `src`: rgb floats) into the display window (`rgb`), black where the
+// data window has no pixels.
+void cropToDisplayWindow(const Imath::Box2i& dw, const Imath::Box2i& disp, const std::vector<float>& src,
+                         std::vector<float>& rgb) {
+  const int64_t dataW = int64_t{dw.max.x} - dw.min.x + 1;
+  const int64_t dispW = int64_t{disp.max.x} - disp.min.x + 1;
+  const int x0 = std::max(dw.min.x, disp.min.x), x1 = std::min(dw.max.x, disp.max.x);
+  const int y0 = std::max(dw.min.y, disp.min.y), y1 = std::min(dw.max.y, disp.max.y);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x)
+      for (int c = 0; c < 3; ++c)
+        rgb[static_cast<size_t>(((int64_t{y} - disp.min.y) * dispW + (int64_t{x} - disp.min.x)) * 3 + c)] =
+            src[static_cast<size_t>(((int64_t{y} - dw.min.y) * dataW + (int64_t{x} - dw.min.x)) * 3 + c)];
+}
+
+// Reads the data window of `file` as rgb floats: R, G, B (a missing one reads 0), or Y as grey.
+// Luminance/chroma files (Y, RY, BY: half by definition) go through the RGBA interface.
+bool readDataWindow(const std::string& path, Imf::InputFile& file, const Imath::Box2i& dw, size_t pixels,
+                    std::vector<float>& src, std::string& error) {
+  const Imf::ChannelList& channels = file.header().channels();
+  const bool hasRgb = channels.findChannel("R") || channels.findChannel("G") || channels.findChannel("B");
+  const bool hasY = channels.findChannel("Y") != nullptr;
+  const bool hasChroma = channels.findChannel("RY") || channels.findChannel("BY");
+  if (!hasRgb && !hasY) return error = path + ": EXR has no R, G, B or Y channel", false;
+  src.assign(pixels * 3, 0.0f);
+  const int64_t dataW = int64_t{dw.max.x} - dw.min.x + 1;
+  // FrameBuffer slices are addressed by absolute pixel coordinates: shift the base pointer.
+  char* base = reinterpret_cast<char*>(src.data()) -
+               (int64_t{dw.min.y} * dataW + dw.min.x) * static_cast<int64_t>(3 * sizeof(float));
+  const size_t xStride = 3 * sizeof(float), yStride = static_cast<size_t>(dataW) * xStride;
+  if (hasRgb) {
+    Imf::FrameBuffer fb;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xStride, yStride, 1, 1, 0.0));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+  } else if (!hasChroma) {
+    Imf::FrameBuffer fb;
+    fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xStride, yStride, 1, 1, 0.0));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    for (size_t i = 0; i < pixels; ++i) src[i * 3 + 1] = src[i * 3 + 2] = src[i * 3];
+  } else {
+    Imf::RgbaInputFile rgbaFile(path.c_str());
+    std::vector<Imf::Rgba> rgba(pixels);
+    rgbaFile.setFrameBuffer(rgba.data() - int64_t{dw.min.y} * dataW - dw.min.x, 1, static_cast<size_t>(dataW));
+    rgbaFile.readPixels(dw.min.y, dw.max.y);
+    for (size_t i = 0; i < pixels; ++i) {
+      src[i * 3] = rgba[i].r;
+      src[i * 3 + 1] = rgba[i].g;
+      src[i * 3 + 2] = rgba[i].b;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 bool writeExr(const std::string& path, const std::vector<float>& rgb, int width, int height, std::string& error) {
-  if (rgb.size() != static_cast<size_t>(width) * height * 3) return error = path + ": image size mismatch", false;
-  const char* err = nullptr;
-  if (SaveEXR(rgb.data(), width, height, 3, 0, path.c_str(), &err) != TINYEXR_SUCCESS) {
-    error = path + ": cannot write EXR (" + (err ? err : "unknown") + ")";
-    if (err) FreeEXRErrorMessage(err);
-    return false;
+  if (width <= 0 || height <= 0 || rgb.size() != static_cast<size_t>(width) * height * 3)
+    return error = path + ": image size mismatch", false;
+  try {
+    Imf::Header header(width, height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(const_cast<float*>(rgb.data()));
+    const size_t xStride = 3 * sizeof(float), yStride = static_cast<size_t>(width) * xStride;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+      header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xStride, yStride));
+    }
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(height);
+  } catch (const std::exception& e) {
+    return error = path + ": cannot write EXR (" + e.what() + ")", false;
   }
   return true;
 }
 
 bool readExr(const std::string& path, std::vector<float>& rgb, int& width, int& height, std::string& error) {
-  float* data = nullptr;
-  const char* err = nullptr;
-  if (LoadEXR(&data, &width, &height, path.c_str(), &err) != TINYEXR_SUCCESS) {
-    error = path + ": cannot read EXR (" + (err ? err : "unknown") + ")";
-    if (err) FreeEXRErrorMessage(err);
-    return false;
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    const Imath::Box2i disp = file.header().displayWindow();
+    const int64_t dataW = int64_t{dw.max.x} - dw.min.x + 1, dataH = int64_t{dw.max.y} - dw.min.y + 1;
+    const int64_t dispW = int64_t{disp.max.x} - disp.min.x + 1, dispH = int64_t{disp.max.y} - disp.min.y + 1;
+    if (dataW <= 0 || dataH <= 0 || dispW <= 0 || dispH <= 0)
+      return error = path + ": EXR has an empty data or display window", false;
+    if (dataW * dataH > kMaxExrPixels || dispW * dispH > kMaxExrPixels)
+      return error = path + ": EXR is too large", false;
+    std::vector<float> src;
+    if (!readDataWindow(path, file, dw, static_cast<size_t>(dataW * dataH), src, error)) return false;
+    if (dw == disp) {
+      rgb = std::move(src);
+    } else {
+      rgb.assign(static_cast<size_t>(dispW * dispH) * 3, 0.0f);
+      cropToDisplayWindow(dw, disp, src, rgb);
+    }
+    width = static_cast<int>(dispW);
+    height = static_cast<int>(dispH);
+  } catch (const std::exception& e) {
+    return error = path + ": cannot read EXR (" + e.what() + ")", false;
   }
-  rgb.resize(static_cast<size_t>(width) * height * 3);
-  for (size_t i = 0; i < static_cast<size_t>(width) * height; ++i)
-    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = data[i * 4 + c];
-  std::free(data);
   return true;
 }
 

@@ -6,8 +6,18 @@
 
 namespace probecast::imaging {
 
-// rgb: width × height × 3 floats, row-major from the top.
+// EXR through OpenEXR. rgb: width × height × 3 linear floats, row-major from the top.
+// writeExr writes R, G, B as 32-bit float, ZIP-compressed (lossless).
 bool writeExr(const std::string& path, const std::vector<float>& rgb, int width, int height, std::string& error);
+// readExr reads any compression (NO, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A, DWAA, DWAB), scan lines
+// or tiles (the top level), half, float or uint channels into floats:
+// - R, G, B when any of them is present (a missing one reads 0); else Y as grey (R = G = B = Y), or
+//   luminance/chroma (Y, RY, BY) converted to RGB; alpha and other channels are ignored (EXR colour
+//   is premultiplied, so the colour is already what the pixel contributes).
+// - The result covers the display window: data-window pixels outside it are dropped, display-window
+//   pixels the data window lacks are 0. width/height are the display window's.
+// Returns false with a message naming the file for a missing, corrupt, truncated or deep file, or
+// one with no colour channel.
 bool readExr(const std::string& path, std::vector<float>& rgb, int& width, int& height, std::string& error);
 // Radiance .hdr (RGBE) as linear float RGB (stb_image).
 bool readHdr(const std::string& path, std::vector<float>& rgb, int& width, int& height, std::string& error);
