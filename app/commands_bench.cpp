@@ -51,6 +51,7 @@ void addBenchCodec(CLI::App* bench) {
     std::vector<int> deadzones{0, 1, 2, 4, 8};
     int frames = 60;
     int normals = 2048;
+    int throughputProbes = 65536;
   };
   auto opt = std::make_shared<Options>();
   auto* envmaps = codec->add_option("--envmaps", opt->envmaps, "folder of equirect .hdr/.exr maps (top row +Y)")
@@ -66,6 +67,8 @@ void addBenchCodec(CLI::App* bench) {
       ->check(CLI::Range(0, 127));
   codec->add_option("--frames", opt->frames, "frames of the moving-light sequence")->check(CLI::Range(2, 100000));
   codec->add_option("--normals", opt->normals, "directions for the brute-force irradiance")->check(CLI::Range(16, 1 << 20));
+  codec->add_option("--throughput-probes", opt->throughputProbes, "probes encoded and decoded for the speed figures")
+      ->check(CLI::Range(1, 1 << 24));
 
   codec->callback([opt] {
     if (opt->envmaps.empty() && opt->probes.empty())
@@ -83,6 +86,7 @@ void addBenchCodec(CLI::App* bench) {
     options.deadzones = opt->deadzones;
     options.frames = opt->frames;
     options.normals = opt->normals;
+    options.throughputProbes = opt->throughputProbes;
     options.command = commandLine();
     options.progress = progressLine;
     const bench::CodecBenchResult r = bench::runCodecBench(options);

@@ -57,6 +57,17 @@ const T* checkedData(const py::array& a, const char* what, std::initializer_list
   return static_cast<const T*>(a.data());
 }
 
+// An output array: `out` when given (checked as checkedData does, and writable), else a new one.
+template <typename T>
+py::array_t<T> outputArray(const py::object& out, const char* what, py::ssize_t rows, py::ssize_t columns) {
+  if (out.is_none()) return py::array_t<T>({rows, columns});
+  if (!py::isinstance<py::array>(out)) throw py::value_error(std::string(what) + ": expected a numpy array");
+  const py::array a = out.cast<py::array>();
+  checkedData<T>(a, what, {rows, columns});
+  if (!a.writeable()) throw py::value_error(std::string(what) + ": array is read-only");
+  return out.cast<py::array_t<T>>();
+}
+
 Representation reprOf(const std::string& name) {
   auto r = parseRepresentation(name);
   if (!r) throw py::value_error("unknown representation '" + name + "' (expected l1, zh3h, zh3, l2 or fp16)");
@@ -170,12 +181,13 @@ PYBIND11_MODULE(probecast, m) {
 
   m.def(
       "encode",
-      [](const py::array& probes, const std::string& repr) {
+      [](const py::array& probes, const std::string& repr, const py::object& outArg) {
         const Representation r = reprOf(repr);
         const float* in = checkedData<float>(probes, "probes", {-1, kProbeFloats});
         const size_t n = static_cast<size_t>(probes.shape(0));
         const size_t bytes = recordSize(r);
-        py::array_t<uint8_t> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(bytes)});
+        py::array_t<uint8_t> out =
+            outputArray<uint8_t>(outArg, "out", static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(bytes));
         uint8_t* o = out.mutable_data();
         {
           py::gil_scoped_release release;
@@ -183,18 +195,19 @@ PYBIND11_MODULE(probecast, m) {
         }
         return out;
       },
-      py::arg("probes"), py::arg("repr"),
+      py::arg("probes"), py::arg("repr"), py::arg("out") = py::none(),
       "Encodes probes (N, 27) float32 (see the module's conventions) into records (N, record_size(repr)) uint8, "
-      "as the C++ encodeProbeRecord (ratio records: DC as RGB9E5, other coefficients as ratios to the DC).");
+      "as the C++ encodeProbeRecord (ratio records: DC as RGB9E5, other coefficients as ratios to the DC). "
+      "out: an (N, record_size(repr)) uint8 C-contiguous array to write into (reused, no allocation).");
 
   m.def(
       "decode",
-      [](const py::array& records, const std::string& repr, bool zh3PerPixel) {
+      [](const py::array& records, const std::string& repr, bool zh3PerPixel, const py::object& outArg) {
         const Representation r = reprOf(repr);
         const size_t bytes = recordSize(r);
         const uint8_t* in = checkedData<uint8_t>(records, "records", {-1, static_cast<py::ssize_t>(bytes)});
         const size_t n = static_cast<size_t>(records.shape(0));
-        py::array_t<float> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(kProbeFloats)});
+        py::array_t<float> out = outputArray<float>(outArg, "out", static_cast<py::ssize_t>(n), kProbeFloats);
         float* o = out.mutable_data();
         size_t bad = n;
         {
@@ -205,10 +218,11 @@ PYBIND11_MODULE(probecast, m) {
         if (bad != n) throw py::value_error("records: fp16 record " + std::to_string(bad) + " holds Inf or NaN");
         return out;
       },
-      py::arg("records"), py::arg("repr"), py::arg("zh3_per_pixel") = false,
+      py::arg("records"), py::arg("repr"), py::arg("zh3_per_pixel") = false, py::arg("out") = py::none(),
       "Decodes records (N, record_size(repr)) uint8 into probes (N, 27) float32. For zh3h, zh3_per_pixel=True "
       "gives L1 with a zero L2 band (a renderer hallucinating per pixel), False the per-probe hallucinated L2. "
-      "Raises ValueError for fp16 records holding Inf or NaN.");
+      "Raises ValueError for fp16 records holding Inf or NaN. out: an (N, 27) float32 C-contiguous array to write "
+      "into (reused, no allocation).");
 
   m.def(
       "project_equirect",

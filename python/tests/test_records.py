@@ -87,3 +87,28 @@ def test_fp16_record_with_nan_is_an_error():
     rec[0, 0:2] = [0x00, 0x7E]  # half NaN
     with pytest.raises(ValueError, match="Inf or NaN"):
         probecast.decode(rec, "fp16")
+
+
+@pytest.mark.parametrize("repr_", REPRS)
+def test_out_arrays_are_written_in_place_with_the_same_bytes(golden, repr_):
+    records = np.full((len(golden["input"]), probecast.record_size(repr_)), 0xAB, dtype=np.uint8)
+    returned = probecast.encode(golden["input"], repr_, out=records)
+    assert returned is not None and np.shares_memory(returned, records)
+    np.testing.assert_array_equal(records, golden[repr_ + ".rec"])
+    probes = np.full(golden[repr_ + ".dec"].shape, np.nan, dtype=np.float32)
+    probecast.decode(records, repr_, out=probes)
+    assert probes.tobytes() == golden[repr_ + ".dec"].tobytes()
+
+
+def test_out_arrays_of_the_wrong_kind_are_refused():
+    p = np.zeros((4, 27), np.float32)
+    with pytest.raises(ValueError, match="out: dimension 0 must be 4"):
+        probecast.encode(p, "l1", out=np.zeros((3, 13), np.uint8))
+    with pytest.raises(ValueError, match="out: expected dtype"):
+        probecast.encode(p, "l1", out=np.zeros((4, 13), np.int16))
+    with pytest.raises(ValueError, match="out: array is read-only"):
+        ro = np.zeros((4, 27), np.float32)
+        ro.flags.writeable = False
+        probecast.decode(np.zeros((4, 13), np.uint8), "l1", out=ro)
+    with pytest.raises(ValueError, match="C-contiguous"):
+        probecast.decode(np.zeros((4, 13), np.uint8), "l1", out=np.zeros((27, 4), np.float32).T)
