@@ -68,12 +68,7 @@ int main(int argc, char** argv) {
     ok = ok && writeFile(dir + "/" + name + ".rec", rec.data(), rec.size());
     ok = ok && writeFile(dir + "/" + name + ".dec", dec.data(), dec.size() * sizeof(float));
 
-    StreamLayout layout;
-    layout.grid[0] = 6;
-    layout.grid[1] = 5;
-    layout.grid[2] = 3;
-    layout.brickDim = 4;
-    layout.repr = repr;
+    const StreamLayout layout = streamLayoutFor(ProbeGrid{{6, 5, 3}, {{0, 0, 0}, {5, 4, 2}}}, repr, 4);
     EncoderOptions options;
     options.compress = false;  // byte-exact whatever zstd the module links
     StreamEncoder encoder(layout, options);
