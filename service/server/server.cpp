@@ -1,7 +1,9 @@
 // ProbeStream over gRPC's callback API: authentication, validation, one reactor per subscriber.
 #include "probecast/service/server.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <mutex>
@@ -40,6 +42,29 @@ class RejectReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::Serv
 
 class SubscribeReactor;
 
+// Instrumentation: how long frames take from the publish of their newest lighting to gRPC's
+// OnWriteDone (the message handed to the transport), over all subscribers.
+class FrameWriteTimes {
+ public:
+  void written(uint64_t serverTimeUs) {
+    const uint64_t now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                                   std::chrono::system_clock::now().time_since_epoch())
+                                                   .count());
+    std::lock_guard<std::mutex> lock(mutex_);
+    histogram_.record(now - std::min(now, serverTimeUs));
+  }
+  LatencyHistogram take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    LatencyHistogram h = histogram_;
+    histogram_.clear();
+    return h;
+  }
+
+ private:
+  std::mutex mutex_;
+  LatencyHistogram histogram_;
+};
+
 // What the hub's wake-up may touch: the reactor, only while it is alive.
 struct ReactorLink {
   std::mutex mutex;
@@ -48,8 +73,10 @@ struct ReactorLink {
 
 class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage> {
  public:
-  SubscribeReactor(ProbeHub& hub, const ServerConfig& config, std::atomic<uint32_t>& subscribers)
-      : hub_(hub), config_(config), subscribers_(subscribers), link_(std::make_shared<ReactorLink>()) {
+  SubscribeReactor(ProbeHub& hub, const ServerConfig& config, std::atomic<uint32_t>& subscribers,
+                   FrameWriteTimes& writeTimes)
+      : hub_(hub), config_(config), subscribers_(subscribers), writeTimes_(writeTimes),
+        link_(std::make_shared<ReactorLink>()) {
     link_->reactor = this;
     StartRead(&in_);
   }
@@ -70,6 +97,8 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   void OnWriteDone(bool ok) override {
     std::lock_guard<std::mutex> lock(link_->mutex);
     writing_ = false;
+    if (ok && frameServerTimeUs_) writeTimes_.written(frameServerTimeUs_);
+    frameServerTimeUs_ = 0;
     if (pendingFinish_) {  // a finish waited for this write, whether it went through or not
       finished_ = true;
       Finish(*pendingFinish_);
@@ -121,6 +150,7 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     f->set_keyframes(frame->keyframes);
     f->set_deltas(frame->deltas);
     ++framesSinceStats_;
+    frameServerTimeUs_ = frame->serverTimeUs;
     writing_ = true;
     StartWrite(&out_);
   }
@@ -207,11 +237,13 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   ProbeHub& hub_;
   const ServerConfig& config_;
   std::atomic<uint32_t>& subscribers_;
+  FrameWriteTimes& writeTimes_;
   std::shared_ptr<ReactorLink> link_;
   pb::ClientMessage in_;
   pb::ServerMessage out_;
   static constexpr uint32_t kFramesPerStats = 16;
   uint32_t framesSinceStats_ = 0;
+  uint64_t frameServerTimeUs_ = 0;  // of the frame being written (0: no frame in flight)
   uint64_t id_ = 0;
   bool counted_ = false;
   bool writing_ = false;
@@ -226,7 +258,7 @@ class Service final : public pb::ProbeStream::CallbackService {
   grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage>* Subscribe(grpc::CallbackServerContext* ctx) override {
     if (!authorized(ctx, config_.token))
       return new RejectReactor(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
-    return new SubscribeReactor(hub_, config_, subscribers_);
+    return new SubscribeReactor(hub_, config_, subscribers_, writeTimes_);
   }
 
   grpc::ServerUnaryReactor* GetVolume(grpc::CallbackServerContext* ctx, const pb::GetVolumeRequest*,
@@ -241,10 +273,13 @@ class Service final : public pb::ProbeStream::CallbackService {
     return reactor;
   }
 
+  FrameWriteTimes& writeTimes() { return writeTimes_; }
+
  private:
   ProbeHub& hub_;
   const ServerConfig& config_;
   std::atomic<uint32_t> subscribers_{0};
+  FrameWriteTimes writeTimes_;
 };
 
 }  // namespace
@@ -300,6 +335,8 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
 ProbeServer::~ProbeServer() { shutdown(); }
 
 int ProbeServer::port() const { return impl_->port; }
+
+LatencyHistogram ProbeServer::takeFrameWriteLatency() { return impl_->service->writeTimes().take(); }
 
 void ProbeServer::shutdown() {
   {

@@ -74,6 +74,7 @@ class ProbeProducer {
   int serve(const service::ServerConfig& config);
   int port() const;
   void shutdownServer();
+  service::ProbeServer* server() { return server_.get(); }  // null until serve()
 
   // The lighting source (one of three). A traced scene: `first` is `sceneSpec` at the animation's start.
   void traceScene(renderer::VulkanContext& context, const std::string& sceneSpec, const scene::Scene& first,

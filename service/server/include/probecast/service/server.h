@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "probecast/service/latency_histogram.h"
 #include "probecast/service/probe_hub.h"
 
 namespace probecast::service {
@@ -34,6 +35,11 @@ class ProbeServer {
 
   int port() const;
   void shutdown();
+
+  // Instrumentation for load tests: the time from the publish of a frame's newest lighting
+  // (OutgoingFrame::serverTimeUs, system clock) to gRPC's write-done for it, over all frames
+  // written since the last call, which starts a new count.
+  LatencyHistogram takeFrameWriteLatency();
 
  private:
   struct Impl;
