@@ -167,16 +167,9 @@ CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* heade
 CodecStatus verifyFrame(const uint8_t* data, size_t size, FrameHeader* header) {
   FrameHeader h;
   if (CodecStatus st = readFrameHeader(data, size, &h); st != CodecStatus::Ok) return st;
-  const uint8_t* p = data + kFrameHeaderSize;
-  size_t left = h.sectionBytes;
-  for (uint32_t i = 0; i < h.sectionCount; ++i) {
-    SectionView view;
-    size_t consumed = 0;
-    if (CodecStatus st = parseSection(h.layout, p, left, &view, &consumed); st != CodecStatus::Ok) return st;
-    p += consumed;
-    left -= consumed;
-  }
-  if (left != 0) return CodecStatus::TrailingBytes;
+  if (CodecStatus st = forEachSection(h.layout, data, h, [](const SectionView&) { return CodecStatus::Ok; });
+      st != CodecStatus::Ok)
+    return st;
   if (header) *header = h;
   return CodecStatus::Ok;
 }
