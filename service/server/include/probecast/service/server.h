@@ -12,7 +12,8 @@ namespace probecast::service {
 
 struct ServerConfig {
   std::string listen = "127.0.0.1:0";  // host:port; port 0 picks a free one
-  std::string token;                    // bearer token required on every call; empty = none
+  std::string token;                    // bearer token required on every call
+  bool noAuth = false;                  // must be set to serve without a token (anyone may subscribe)
   std::string tlsCertPem;               // PEM contents; with tlsKeyPem enables TLS
   std::string tlsKeyPem;
   bool plaintext = false;               // must be set to serve without TLS
@@ -26,7 +27,8 @@ struct ServerConfig {
 
 class ProbeServer {
  public:
-  // Throws std::runtime_error when the configuration is unsafe or the port cannot be bound.
+  // Throws std::runtime_error when the configuration is unsafe (no TLS without plaintext, no token
+  // without noAuth, or a token with noAuth) or the port cannot be bound.
   ProbeServer(const ServerConfig& config, ProbeHub& hub);
   ~ProbeServer();
   ProbeServer(const ProbeServer&) = delete;
