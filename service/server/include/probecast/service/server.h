@@ -18,8 +18,10 @@ struct ServerConfig {
   std::string tlsKeyPem;
   bool plaintext = false;               // must be set to serve without TLS
   uint32_t maxSubscribers = 1024;
-  uint32_t maxViews = 64;               // per view update
-  uint32_t maxMessageBytes = 64 * 1024; // largest client message accepted
+  uint32_t maxViews = kMaxViewsPerSet;  // per view update: any view set a renderer draws
+  // Largest client message accepted. A view is about 83 bytes on the wire (16 packed floats and
+  // three eye floats), so kMaxViewsPerSet views take about 21 KiB.
+  uint32_t maxMessageBytes = 64 * 1024;
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
   static constexpr int kTickMs = 50;
