@@ -153,8 +153,10 @@ struct ServerOptions {
     cmd->add_option("--tls-key", tlsKey, "PEM private key file")->check(CLI::ExistingFile);
     cmd->add_flag("--plaintext", plaintext, "serve without TLS (trusted networks only)");
     CLI::Option* t = cmd->add_option("--token", token, "bearer token every call must present");
-    CLI::Option* f = cmd->add_option("--token-file", tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
-    CLI::Option* n = cmd->add_flag("--no-auth", noAuth, "serve without a token: anyone who reaches the port may subscribe");
+    CLI::Option* f =
+        cmd->add_option("--token-file", tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
+    CLI::Option* n =
+        cmd->add_flag("--no-auth", noAuth, "serve without a token: anyone who reaches the port may subscribe");
     t->excludes(f);
     n->excludes(t)->excludes(f);
   }
@@ -174,7 +176,8 @@ struct ServerOptions {
       throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
     if (sc.noAuth && !sc.token.empty()) throw std::runtime_error("--no-auth and a token contradict each other");
     if (!sc.noAuth && sc.token.empty())
-      throw std::runtime_error("give --token or --token-file, or --no-auth to let anyone who reaches the port subscribe");
+      throw std::runtime_error(
+          "give --token or --token-file, or --no-auth to let anyone who reaches the port subscribe");
     return sc;
   }
 };

@@ -24,6 +24,10 @@ namespace pb = probecast::v1;
 
 std::string address(int port) { return "127.0.0.1:" + std::to_string(port); }
 
+std::unique_ptr<pb::ProbeStream::Stub> stubFor(int port) {
+  return pb::ProbeStream::NewStub(grpc::CreateChannel(address(port), grpc::InsecureChannelCredentials()));
+}
+
 pb::ClientMessage helloMessage() {
   pb::ClientMessage m;
   m.mutable_hello()->set_protocol_version(1);
@@ -154,7 +158,7 @@ TEST(ServiceHardening, FarViewsStillReceiveEveryBrick) {
   EXPECT_FALSE(absurd.stats().fatal) << absurd.stats().lastError;
 
   // Non-finite views are refused, naming the problem.
-  auto stub = pb::ProbeStream::NewStub(grpc::CreateChannel(address(server.port()), grpc::InsecureChannelCredentials()));
+  auto stub = stubFor(server.port());
   for (float bad : {INFINITY, -INFINITY, NAN}) {
     pb::ClientMessage views;
     View v = viewFrom(0.0, 0.0, 20.0);
@@ -174,7 +178,7 @@ TEST(ServiceHardening, FarViewsStillReceiveEveryBrick) {
 TEST(ServiceHardening, HalfClosedSubscriberKeepsReceivingAndConverges) {
   ProbeHub hub(volumeConfig());
   auto server = std::make_unique<ProbeServer>(plaintextConfig(), hub);
-  auto stub = pb::ProbeStream::NewStub(grpc::CreateChannel(address(server->port()), grpc::InsecureChannelCredentials()));
+  auto stub = stubFor(server->port());
   grpc::ClientContext ctx;
   ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
   ctx.set_deadline(std::chrono::system_clock::now() + 15s);
@@ -213,7 +217,7 @@ TEST(ServiceHardening, HalfClosedSubscriberKeepsReceivingAndConverges) {
 
   // A stream closed before any hello has nothing to wait for: it is refused.
   ProbeServer again(plaintextConfig(), hub);
-  auto stub2 = pb::ProbeStream::NewStub(grpc::CreateChannel(address(again.port()), grpc::InsecureChannelCredentials()));
+  auto stub2 = stubFor(again.port());
   grpc::ClientContext ctx2;
   ctx2.AddMetadata("authorization", std::string("Bearer ") + kToken);
   ctx2.set_deadline(std::chrono::system_clock::now() + 5s);
@@ -259,7 +263,7 @@ TEST(ServiceHardening, UnknownRepresentationIsRefusedByNumber) {
   hc.layout.repr = Representation::L2;
   ProbeHub hub(hc);
   ProbeServer server(plaintextConfig(), hub);
-  auto stub = pb::ProbeStream::NewStub(grpc::CreateChannel(address(server.port()), grpc::InsecureChannelCredentials()));
+  auto stub = stubFor(server.port());
   for (int value : {260, 4 + 256 * 1000, -252, 6}) {
     pb::ClientMessage hello = helloMessage();
     hello.mutable_hello()->set_representation(static_cast<pb::Representation>(value));

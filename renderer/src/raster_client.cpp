@@ -434,7 +434,8 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
 
 std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& views) {
   Impl& s = *impl_;
-  if (views.size() > Impl::kMaxViews) throw std::invalid_argument("at most " + std::to_string(Impl::kMaxViews) + " views per view set");
+  if (views.size() > Impl::kMaxViews)
+    throw std::invalid_argument("at most " + std::to_string(Impl::kMaxViews) + " views per view set");
   std::vector<Image> out(views.size());
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;

@@ -253,8 +253,10 @@ class SubscribeReactor : public RawReactor {
   std::optional<grpc::Status> pendingFinish_;
 };
 
-class Service final
-    : public pb::ProbeStream::WithRawCallbackMethod_Subscribe<pb::ProbeStream::WithCallbackMethod_GetVolume<pb::ProbeStream::Service>> {
+using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<
+    pb::ProbeStream::WithCallbackMethod_GetVolume<pb::ProbeStream::Service>>;
+
+class Service final : public RawSubscribeService {
  public:
   Service(ProbeHub& hub, const ServerConfig& config) : hub_(hub), config_(config) {}
 

@@ -35,10 +35,12 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
                  std::to_string(kFormatVersion), false;
   // Range-check every number before narrowing it: 70000 must not wrap to a small grid.
   const uint32_t grid[3] = {in.grid_x(), in.grid_y(), in.grid_z()};
+  const auto gridText = [&] {
+    return "volume grid " + std::to_string(grid[0]) + "x" + std::to_string(grid[1]) + "x" + std::to_string(grid[2]);
+  };
   for (uint32_t g : grid)
     if (g < 1 || g > static_cast<uint32_t>(kMaxGridDim))
-      return why = "volume grid " + std::to_string(grid[0]) + "x" + std::to_string(grid[1]) + "x" +
-                   std::to_string(grid[2]) + " is outside 1.." + std::to_string(kMaxGridDim) + " per axis", false;
+      return why = gridText() + " is outside 1.." + std::to_string(kMaxGridDim) + " per axis", false;
   if (in.brick_size() < static_cast<uint32_t>(kMinBrickDim) || in.brick_size() > static_cast<uint32_t>(kMaxBrickDim))
     return why = "brick size " + std::to_string(in.brick_size()) + " is outside " + std::to_string(kMinBrickDim) +
                  ".." + std::to_string(kMaxBrickDim), false;
@@ -50,8 +52,7 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
   l.brickDim = static_cast<uint8_t>(in.brick_size());
   l.repr = static_cast<Representation>(repr);
   if (!isValidLayout(l))
-    return why = "volume grid " + std::to_string(grid[0]) + "x" + std::to_string(grid[1]) + "x" + std::to_string(grid[2]) +
-                 " holds more than " + std::to_string(kMaxProbes) + " probes", false;
+    return why = gridText() + " holds more than " + std::to_string(kMaxProbes) + " probes", false;
   if (in.bounds_min_size() != 3 || in.bounds_max_size() != 3) return why = "volume bounds need 3 values each", false;
   for (int a = 0; a < 3; ++a) {
     bounds.min[a] = in.bounds_min(a);
