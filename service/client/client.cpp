@@ -60,14 +60,15 @@ struct ProbeClient::Impl {
     return grpc::CreateCustomChannel(config.address, creds, args);
   }
 
-  void onVolume(const pb::VolumeDescription& v) {
+  // False for a description the client cannot use: the connection is dropped and retried later.
+  bool onVolume(const pb::VolumeDescription& v) {
     StreamLayout l;
     GridBounds b;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
     if (!volumeFromWire(v, l, b, why)) {
       stats.lastError = "bad volume description: " + why;
-      return;
+      return false;
     }
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
@@ -80,6 +81,7 @@ struct ProbeClient::Impl {
     epoch = v.stream_epoch();
     stats.connected = true;
     stats.connects += 1;
+    return true;
   }
 
   // Returns false when the connection should be dropped (the server and we disagree on state).
@@ -150,11 +152,14 @@ struct ProbeClient::Impl {
         write(vm);
       }
       pb::ServerMessage msg;
-      bool gotVolume = false;
+      bool dropped = false;  // by us, for a reason already in lastError
       while (rw->Read(&msg)) {
         if (msg.has_volume()) {
-          onVolume(msg.volume());
-          gotVolume = true;
+          if (!onVolume(msg.volume())) {
+            dropped = true;
+            ctx.TryCancel();
+            break;
+          }
           backoff = config.reconnectMinMs;
         } else if (msg.has_stats()) {
           std::lock_guard<std::mutex> lock(mutex);
@@ -165,6 +170,7 @@ struct ProbeClient::Impl {
           stats.serverAckRttUs = msg.stats().ack_rtt_us();
         } else if (msg.has_frame()) {
           if (!onFrame(msg.frame())) {
+            dropped = true;
             ctx.TryCancel();
             break;
           }
@@ -183,7 +189,7 @@ struct ProbeClient::Impl {
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
-        if (!status.ok() && !stopping) stats.lastError = status.error_message();
+        if (!status.ok() && !stopping && !dropped) stats.lastError = status.error_message();
         const auto code = status.error_code();
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {
@@ -191,7 +197,6 @@ struct ProbeClient::Impl {
           return;  // retrying would be refused the same way
         }
       }
-      (void)gotVolume;
       if (stopping) return;
       std::unique_lock<std::mutex> lock(mutex);
       wakeup.wait_for(lock, std::chrono::milliseconds(backoff), [&] { return stopping.load(); });

@@ -169,7 +169,9 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
   scoreBricks(config_.layout, config_.bounds, s.views, candidates_, config_.priority, scores_.data());
   const double cap = static_cast<double>(s.budget) * config_.burstSeconds;
   // A full bucket may always send the best brick, so one larger than the bucket still goes out.
-  uint64_t allowance = s.budget == 0 ? UINT64_MAX : static_cast<uint64_t>(std::max(0.0, s.tokens));
+  // Saturating: a bucket of 2^64 bytes or more cannot bind, and converting it would overflow.
+  const uint64_t allowance = s.budget == 0 || s.tokens >= 0x1p64 ? UINT64_MAX
+                                                                   : static_cast<uint64_t>(std::max(0.0, s.tokens));
   size_t n = selectBricks(scores_, candidates_, allowance, chosen_.data());
   if (n == 0 && s.budget != 0 && s.tokens >= cap) {
     uint32_t best = 0;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include <fmt/format.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
@@ -21,8 +22,12 @@ namespace {
 
 namespace pb = probecast::v1;
 
-bool authorized(grpc::CallbackServerContext* ctx, const std::string& token) {
-  if (token.empty()) return true;
+// The service reads and writes raw bytes so that it parses client messages itself: a message that
+// does not parse is refused, where the generated code would end the stream as if it were closed.
+using RawReactor = grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>;
+
+bool authorized(grpc::CallbackServerContext* ctx, const std::string& token, bool noAuth) {
+  if (token.empty()) return noAuth;  // the constructor refuses an empty token without noAuth
   const auto& md = ctx->client_metadata();
   const auto it = md.find("authorization");
   if (it == md.end()) return false;
@@ -34,7 +39,7 @@ bool authorized(grpc::CallbackServerContext* ctx, const std::string& token) {
   return diff == 0;
 }
 
-class RejectReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage> {
+class RejectReactor : public RawReactor {
  public:
   explicit RejectReactor(const grpc::Status& status) { Finish(status); }
   void OnDone() override { delete this; }
@@ -71,27 +76,30 @@ struct ReactorLink {
   SubscribeReactor* reactor = nullptr;
 };
 
-class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage> {
+class SubscribeReactor : public RawReactor {
  public:
   SubscribeReactor(ProbeHub& hub, const ServerConfig& config, std::atomic<uint32_t>& subscribers,
-                   FrameWriteTimes& writeTimes)
-      : hub_(hub), config_(config), subscribers_(subscribers), writeTimes_(writeTimes),
+                   FrameWriteTimes& writeTimes, std::string peer)
+      : hub_(hub), config_(config), subscribers_(subscribers), writeTimes_(writeTimes), peer_(std::move(peer)),
         link_(std::make_shared<ReactorLink>()) {
     link_->reactor = this;
-    StartRead(&in_);
+    StartRead(&inBytes_);
   }
 
   void OnReadDone(bool ok) override {
-    if (!ok) {  // the client closed its side or the call broke
-      finish(grpc::Status::OK);
+    if (!ok) {
+      // The client closed its side (a receive-only viewer does so after its hello) or the call
+      // broke. A half-closed subscriber keeps its stream: it ends when the client cancels, the
+      // call breaks (OnCancel) or the server shuts down. One that never said hello gets nothing.
+      if (!id_) finish(invalid("the stream was closed before a hello"));
       return;
     }
-    const grpc::Status status = handle(in_);
+    const grpc::Status status = handleBytes();
     if (!status.ok()) {
       finish(status);
       return;
     }
-    StartRead(&in_);
+    StartRead(&inBytes_);
   }
 
   void OnWriteDone(bool ok) override {
@@ -136,8 +144,7 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
       s->set_server_frame(hub_.serverFrame());
       s->set_frames_acked(st.framesAcked);
       s->set_ack_rtt_us(st.ackRttUs);
-      writing_ = true;
-      StartWrite(&out_);
+      startWriteLocked();
       return;
     }
     std::optional<OutgoingFrame> frame = hub_.nextFrame(id_);
@@ -151,17 +158,38 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     f->set_deltas(frame->deltas);
     ++framesSinceStats_;
     frameServerTimeUs_ = frame->serverTimeUs;
-    writing_ = true;
-    StartWrite(&out_);
+    startWriteLocked();
   }
 
  private:
-  grpc::Status invalid(const std::string& why) { return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, why); }
+  // A client's mistake: refused with INVALID_ARGUMENT and logged, so a broken client is visible on
+  // both ends.
+  grpc::Status invalid(const std::string& why) {
+    fmt::print(stderr, "probecast server: refusing subscriber {}: {}\n", peer_, why);
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, why);
+  }
+
+  // Serialises out_ and writes it; the link is locked, no write is in flight.
+  void startWriteLocked() {
+    bool own = false;
+    outBytes_.Clear();
+    grpc::SerializationTraits<pb::ServerMessage>::Serialize(out_, &outBytes_, &own);
+    writing_ = true;
+    StartWrite(&outBytes_);
+  }
+
+  grpc::Status handleBytes() {
+    const size_t size = inBytes_.Length();
+    if (size > config_.maxMessageBytes)
+      return invalid("message of " + std::to_string(size) + " bytes exceeds the limit of " +
+                     std::to_string(config_.maxMessageBytes));
+    in_.Clear();
+    if (!grpc::SerializationTraits<pb::ClientMessage>::Deserialize(&inBytes_, &in_).ok())
+      return invalid("a message of " + std::to_string(size) + " bytes is not a valid probecast.v1.ClientMessage");
+    return handle(in_);
+  }
 
   grpc::Status handle(const pb::ClientMessage& m) {
-    if (m.ByteSizeLong() > config_.maxMessageBytes)
-      return invalid("message of " + std::to_string(m.ByteSizeLong()) + " bytes exceeds the limit of " +
-                     std::to_string(config_.maxMessageBytes));
     if (!id_) {
       if (!m.has_hello()) return invalid("the first message must be hello");
       return handleHello(m.hello());
@@ -188,10 +216,14 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     if (h.protocol_version() != kProtocolVersion)
       return invalid("protocol version " + std::to_string(h.protocol_version()) + " not supported (server speaks " +
                      std::to_string(kProtocolVersion) + ")");
-    const auto repr = static_cast<uint8_t>(hub_.layout().repr);
-    if (h.representation() != pb::REPRESENTATION_UNSPECIFIED && static_cast<uint8_t>(h.representation()) != repr)
+    // An open enum: any int32 may arrive, and a narrowing cast would read 260 as 4 (l2).
+    const int wanted = h.representation();
+    if (!pb::Representation_IsValid(wanted))
+      return invalid("representation " + std::to_string(wanted) + " is not a known Representation");
+    const int served = static_cast<int>(hub_.layout().repr);
+    if (wanted != pb::REPRESENTATION_UNSPECIFIED && wanted != served)
       return invalid("representation " + pb::Representation_Name(h.representation()) + " is not served (this server "
-                     "streams " + pb::Representation_Name(static_cast<pb::Representation>(repr)) + ")");
+                     "streams " + pb::Representation_Name(static_cast<pb::Representation>(served)) + ")");
     const uint32_t bricks = brickCount(hub_.layout());
     if (static_cast<uint32_t>(h.held_size()) > bricks) return invalid("more held bricks than the volume has");
     std::vector<HeldBrick> held;
@@ -215,8 +247,7 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     id_ = id;
     out_.Clear();
     volumeToWire(hub_.layout(), hub_.bounds(), hub_.epoch(), *out_.mutable_volume());
-    writing_ = true;
-    StartWrite(&out_);  // the volume description first; frames follow from OnWriteDone
+    startWriteLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }
 
@@ -238,7 +269,9 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   const ServerConfig& config_;
   std::atomic<uint32_t>& subscribers_;
   FrameWriteTimes& writeTimes_;
+  const std::string peer_;
   std::shared_ptr<ReactorLink> link_;
+  grpc::ByteBuffer inBytes_, outBytes_;
   pb::ClientMessage in_;
   pb::ServerMessage out_;
   static constexpr uint32_t kFramesPerStats = 16;
@@ -251,20 +284,23 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   std::optional<grpc::Status> pendingFinish_;
 };
 
-class Service final : public pb::ProbeStream::CallbackService {
+using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<
+    pb::ProbeStream::WithCallbackMethod_GetVolume<pb::ProbeStream::Service>>;
+
+class Service final : public RawSubscribeService {
  public:
   Service(ProbeHub& hub, const ServerConfig& config) : hub_(hub), config_(config) {}
 
-  grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage>* Subscribe(grpc::CallbackServerContext* ctx) override {
-    if (!authorized(ctx, config_.token))
+  RawReactor* Subscribe(grpc::CallbackServerContext* ctx) override {
+    if (!authorized(ctx, config_.token, config_.noAuth))
       return new RejectReactor(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
-    return new SubscribeReactor(hub_, config_, subscribers_, writeTimes_);
+    return new SubscribeReactor(hub_, config_, subscribers_, writeTimes_, ctx->peer());
   }
 
   grpc::ServerUnaryReactor* GetVolume(grpc::CallbackServerContext* ctx, const pb::GetVolumeRequest*,
                                       pb::VolumeDescription* response) override {
     grpc::ServerUnaryReactor* reactor = ctx->DefaultReactor();
-    if (!authorized(ctx, config_.token)) {
+    if (!authorized(ctx, config_.token, config_.noAuth)) {
       reactor->Finish(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
       return reactor;
     }
@@ -299,6 +335,9 @@ struct ProbeServer::Impl {
 ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.config = config;
+  if (config.token.empty() && !config.noAuth)
+    throw std::runtime_error("refusing to serve without authentication: give a token, or ask for noAuth");
+  if (!config.token.empty() && config.noAuth) throw std::runtime_error("a token and noAuth contradict each other");
   std::shared_ptr<grpc::ServerCredentials> creds;
   const bool tls = !config.tlsCertPem.empty() || !config.tlsKeyPem.empty();
   if (tls) {
