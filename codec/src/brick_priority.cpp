@@ -99,7 +99,12 @@ void scoreBricks(const StreamLayout& layout, const GridBounds& bounds, std::span
     const double changeTerm = std::max(double(c.change), double(params.minChange));
     const double ageTerm = 1.0 + double(params.ageWeight) * c.ageFrames;
     const double score = (visible ? 1.0 : double(params.outOfViewWeight)) * changeTerm * distanceTerm * ageTerm;
-    scores[b] = score >= FLT_MAX ? FLT_MAX : score >= FLT_MIN ? static_cast<float>(score) : FLT_MIN;
+    // A brick out of view that weighs nothing (or a non-positive age term) stays at 0; any other
+    // score is a normal positive float.
+    if (!(score > 0.0))
+      scores[b] = 0.0f;
+    else
+      scores[b] = score >= FLT_MAX ? FLT_MAX : score >= FLT_MIN ? static_cast<float>(score) : FLT_MIN;
   }
 }
 
