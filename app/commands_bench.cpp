@@ -115,7 +115,7 @@ void addBenchUpdate(CLI::App* bench) {
     bench::UpdateBenchOptions o;
     o.scene = ut->scene.load();
     o.grid = ut->grid.resolve(o.scene);
-    o.updater = ut->tracer.options();
+    o.updater = ut->updater(ut->scene.environment.load());
     o.context = ut->gpu.context();
     o.updates = uo->updates;
     o.referenceSamples = uo->referenceSamples;
@@ -151,7 +151,7 @@ void addBenchRaster(CLI::App* bench) {
   raster->callback([=] {
     ro->bench.scene = rt->scene.load();
     ro->bench.grid = rt->grid.resolve(ro->bench.scene);
-    ro->bench.updater = rt->tracer.options();
+    ro->bench.updater = rt->updater(rt->scene.environment.load());  // the reference and background too
     ro->bench.context = rt->gpu.context();
     ro->bench.width = ro->size[0];
     ro->bench.height = ro->size[1];
@@ -194,6 +194,7 @@ void addBenchPipeline(CLI::App* bench) {
     po->bench.t = pt->scene.t;
     po->bench.grid = pt->grid.resolve(po->bench.scene);
     po->bench.context = pt->gpu.context();
+    po->bench.environment = pt->scene.environment.load();
     po->bench.width = po->size[0];
     po->bench.height = po->size[1];
     po->bench.command = commandLine();
