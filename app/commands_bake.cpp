@@ -18,9 +18,9 @@ void addBakeCommand(CLI::App& app) {
   bake->add_option("--out", *out, "probe volume file to write")->required();
   bake->callback([=] {
     const scene::Scene s = tr->scene.load();
+    const auto env = tr->scene.environment.load();
     renderer::VulkanContext context(tr->gpu.context());
     const ProbeGrid g = tr->grid.resolve(s);
-    const auto env = tr->scene.environment.load();
     renderer::ProbeUpdater updater(context, s, g, tr->updater(env));
     fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe, environment {}\n", s.name,
                s.triangleCount(), context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp,

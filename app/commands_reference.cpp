@@ -38,6 +38,7 @@ void addReferenceCommand(CLI::App& app) {
   cmd->add_option("--exposure", o->exposure, "scale applied to the PNG preview only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->callback([=] {
     const scene::Scene s = scene->load();
+    const auto environment = scene->environment.load();  // before the device: bad input fails fast
     renderer::CameraView camera = renderer::CameraView::fromScene(s);
     if (o->eye.size() == 3) camera.position = {o->eye[0], o->eye[1], o->eye[2]};
     if (o->target.size() == 3) {
@@ -54,7 +55,7 @@ void addReferenceCommand(CLI::App& app) {
     ro.samplesPerPixel = o->spp;
     ro.maxBounces = o->bounces;
     ro.seed = o->seed;
-    ro.environment = scene->environment.load();
+    ro.environment = environment;
     auto progress = std::make_shared<Progress>("render-reference", /*bar=*/false);
     ro.progress = [progress](uint32_t done, uint32_t total) {
       progress->update(static_cast<double>(done) / total,
