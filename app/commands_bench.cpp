@@ -1,4 +1,4 @@
-// `probecast bench codec|update|raster|pipeline|stability|stream`.
+// `probecast bench codec|update|raster|pipeline|environment|stability|stream`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "codec_bench.h"
+#include "environment_bench.h"
 #include "probecast/codec/probe_file.h"
 #include "commands.h"
 #include "progress.h"
@@ -210,6 +211,45 @@ void addBenchPipeline(CLI::App* bench) {
   });
 }
 
+// `probecast bench environment`: environment importance sampling against BSDF-only sampling.
+void addBenchEnvironment(CLI::App* bench) {
+  CLI::App* cmd = bench->add_subcommand(
+      "environment", "reference tracer convergence under a small sun: environment importance sampling vs BSDF only");
+  struct EnvironmentCli {
+    SceneOptions scene;
+    GpuOptions gpu;
+    std::string json, chart;
+    std::vector<uint32_t> size{48, 32};
+    bench::EnvironmentBenchOptions bench;
+  };
+  auto eo = std::make_shared<EnvironmentCli>();
+  eo->scene.add(cmd);
+  eo->gpu.add(cmd);
+  addSizeOption(cmd, eo->size, "image size WxH", 4, 1024);
+  addReferenceSppOption(cmd, eo->bench.referenceSpp, 1u << 20);
+  cmd->add_option("--spps", eo->bench.spps, "samples per pixel to measure")->delimiter(',')->check(CLI::Range(1, 1 << 16));
+  cmd->add_option("--bounces", eo->bench.maxBounces, "surface interactions per path")->check(CLI::Range(1, 16));
+  addJsonOption(cmd, eo->json);
+  cmd->add_option("--chart", eo->chart, "write an SVG chart of RMS error against spp here");
+  cmd->callback([eo, cmd] {
+    // Without --scene: a sunlit yard built in; without --environment or --sky: the built-in sunny sky.
+    if (cmd->get_option("--scene")->count() > 0) {
+      eo->bench.scene = eo->scene.load();
+      eo->bench.camera = renderer::CameraView::fromScene(eo->bench.scene);
+    } else {
+      eo->bench.scene = bench::sunlitYard(eo->bench.camera);
+    }
+    eo->bench.environment = eo->scene.environment.given() ? eo->scene.environment.load() : bench::builtinSunSky();
+    eo->bench.context = eo->gpu.context();
+    eo->bench.width = eo->size[0];
+    eo->bench.height = eo->size[1];
+    eo->bench.command = commandLine();
+    eo->bench.progress = progressLine;
+    const bench::EnvironmentBenchResult r = bench::runEnvironmentBench(eo->bench);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", eo->json, r.svg, eo->chart);
+  });
+}
+
 // `probecast bench stability`: the stability suite.
 void addBenchStability(CLI::App* bench) {
   CLI::App* stability = bench->add_subcommand("stability", "the stability suite: where probe lighting fails, measured");
@@ -265,6 +305,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchUpdate(bench);
   addBenchRaster(bench);
   addBenchPipeline(bench);
+  addBenchEnvironment(bench);
   addBenchStability(bench);
   addBenchStream(bench);
 }

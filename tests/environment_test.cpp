@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <stdexcept>
 
 #include "brdf_quadrature.h"
 #include "probecast/codec/equirect.h"
@@ -66,6 +67,13 @@ scene::Scene whitePlane(float half, float roughness) {
   scene::addQuad(s, {-half, 0, half}, {half, 0, half}, {half, 0, -half}, {-half, 0, -half}, 0);
   scene::finalizeScene(s);
   return s;
+}
+
+std::shared_ptr<Environment> uniformSky(const glm::vec3& radiance) {
+  auto sky = std::make_shared<Environment>();
+  std::string error;
+  if (!makeUniformSky(radiance, *sky, error)) throw std::invalid_argument(error);
+  return sky;
 }
 
 CameraView lookAlong(const glm::vec3& dir, float yfov, const glm::vec3& from = glm::vec3(0.0f)) {
@@ -251,10 +259,7 @@ TEST(Environment, FurnaceReferenceCameraReturnsSkyTimesAlbedo) {
   o.height = 8;
   o.samplesPerPixel = 2048;
   o.maxBounces = 2;
-  auto sky = std::make_shared<Environment>();
-  std::string error;
-  ASSERT_TRUE(makeUniformSky(glm::vec3(0.5f), *sky, error));
-  o.environment = sky;
+  o.environment = uniformSky(glm::vec3(0.5f));
   ReferenceStats stats;
   const Image img = renderReference(context, s, lookAlong({0, -1, 0}, 0.02f, {0, 1, 0}), o, &stats);
   const double expected = 0.5 * test::directionalAlbedo(1.0, roughness, 1.0);
@@ -276,10 +281,7 @@ TEST(Environment, FurnaceProbeAbovePlaneSeesSkyAndAlbedo) {
   o.indirectClamp = 0.0f;
   o.classify = false;
   o.minBlendWeight = 0.0f;  // a plain mean over the updates
-  auto sky = std::make_shared<Environment>();
-  std::string error;
-  ASSERT_TRUE(makeUniformSky(glm::vec3(2.0f), *sky, error));
-  o.environment = sky;
+  o.environment = uniformSky(glm::vec3(2.0f));
   ProbeUpdater u(context, s, ProbeGrid{{1, 1, 1}, {{0, 1, 0}, {0, 1, 0}}}, o);
   for (int k = 0; k < 8; ++k) EXPECT_EQ(u.update().droppedSamples, 0u);
   double meanAlbedo = 0;
@@ -345,10 +347,7 @@ TEST(Environment, RasterDrawsTheEnvironmentBehindTheScene) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = whitePlane(1.0f, 1.0f);
   RasterOptions ro;
-  auto sky = std::make_shared<Environment>();
-  std::string error;
-  ASSERT_TRUE(makeUniformSky({0.25f, 0.5f, 1.0f}, *sky, error));
-  ro.environment = sky;
+  ro.environment = uniformSky({0.25f, 0.5f, 1.0f});
   RasterRenderer raster(context, s, 16, 16, ro);
   const CameraView up = lookAlong({0, 1, 0}, 1.0f, {0, 0.5f, 0});
   const Image sky1 = raster.render(raster.viewProjection(up), up.position);

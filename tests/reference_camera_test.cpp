@@ -75,25 +75,32 @@ TEST(ReferenceCamera, EmissiveBoxConvergesToOneBounceAnswer) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+// A square of half-size `half` at y = 0 in material `m`, under a 3 lx sun travelling along `sunPath`.
+scene::Scene planeUnderSun(const scene::Material& m, float half, const glm::vec3& sunPath) {
+  scene::Scene s;
+  s.materials.push_back(m);
+  scene::addQuad(s, {-half, 0, half}, {half, 0, half}, {half, 0, -half}, {-half, 0, -half}, 0);
+  scene::Light sun;
+  sun.type = scene::LightType::Directional;
+  sun.direction = glm::normalize(sunPath);
+  sun.intensity = 3.0f;
+  s.lights.push_back(sun);
+  scene::finalizeScene(s);
+  return s;
+}
+
 TEST(ReferenceCamera, RetroreflectionNeverMakesNonFiniteSamples) {
   // The camera looks straight down the sun's path onto a plane, so wo ≈ wi at every pixel: v·h
   // rounds past 1 for many samples, and the Fresnel term's pow(1 − v·h, 5) was undefined there
   // (NaN on llvmpipe) — the cause of the NaN pixels in Sponza renders. No sample may be dropped.
   VulkanContext context(test::validatedContext());
-  scene::Scene s;
   scene::Material m;
   m.baseColor = glm::vec3(0.8f);
   m.roughness = 0.9f;
-  s.materials.push_back(m);
-  scene::addQuad(s, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, 0);
-  scene::Light sun;
-  sun.type = scene::LightType::Directional;
-  sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.15f));  // Sponza's sun: no component rounds away
-  sun.intensity = 3.0f;
-  s.lights.push_back(sun);
-  scene::finalizeScene(s);
+  const glm::vec3 sunPath = glm::normalize(glm::vec3(0.3f, -1.0f, 0.15f));  // Sponza's sun: no component rounds away
+  const scene::Scene s = planeUnderSun(m, 1.0f, sunPath);
   CameraView cam;
-  cam.forward = sun.direction;
+  cam.forward = sunPath;
   cam.position = -cam.forward;  // one metre up the sun's path from the plane's centre
   cam.up = {0, 1, 0};
   cam.yfov = 1e-5f;
@@ -116,16 +123,9 @@ TEST(ReferenceCamera, NonFiniteSamplesAreDroppedAndCountedInBothTracers) {
   // A NaN base colour (a scene built in code; the glTF loader refuses such files) poisons every
   // lit sample: the tracers must drop them, count them, and write only finite numbers.
   VulkanContext context(test::validatedContext());
-  scene::Scene s;
   scene::Material m;
   m.baseColor = glm::vec3(std::nanf(""));
-  s.materials.push_back(m);
-  scene::addQuad(s, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, {-10, 0, -10}, 0);
-  scene::Light sun;
-  sun.type = scene::LightType::Directional;
-  sun.direction = {0, -1, 0};
-  s.lights.push_back(sun);
-  scene::finalizeScene(s);
+  const scene::Scene s = planeUnderSun(m, 10.0f, {0, -1, 0});
   CameraView cam;
   cam.position = {0, 1, 0};
   cam.forward = {0, -1, 0};
