@@ -18,11 +18,13 @@ void addBakeCommand(CLI::App& app) {
   bake->add_option("--out", *out, "probe volume file to write")->required();
   bake->callback([=] {
     const scene::Scene s = tr->scene.load();
+    const auto env = tr->scene.environment.load();
     renderer::VulkanContext context(tr->gpu.context());
     const ProbeGrid g = tr->grid.resolve(s);
-    renderer::ProbeUpdater updater(context, s, g, tr->tracer.options());
-    fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe\n", s.name, s.triangleCount(),
-               context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp);
+    renderer::ProbeUpdater updater(context, s, g, tr->updater(env));
+    fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe, environment {}\n", s.name,
+               s.triangleCount(), context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp,
+               env ? env->name : "none");
     uint32_t active = 0;
     for (uint8_t a : updater.volume().active) active += a;
     fmt::print("bake: {} of {} probes active ({} inside geometry)\n", active, g.count(), g.count() - active);
@@ -30,6 +32,8 @@ void addBakeCommand(CLI::App& app) {
       const renderer::UpdateStats st = updater.update();
       fmt::print("bake: update {}/{}: {:.1f} ms, {} paths, {:.2f} M rays/s\n", u + 1, *updates, st.milliseconds, st.paths,
                  static_cast<double>(st.closestHitRays + st.shadowRays) / st.milliseconds / 1e3);
+      if (st.droppedSamples > 0)
+        fmt::print(stderr, "bake: update {}: {} non-finite path samples dropped\n", u + 1, st.droppedSamples);
     }
     ProbeVolume volume = updater.volume();
     volume.samplesPerProbe = tr->tracer.spp;  // as asked for (the updater traces it rounded up to 32s)

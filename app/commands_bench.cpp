@@ -1,4 +1,4 @@
-// `probecast bench codec|update|raster|pipeline|stability|stream`.
+// `probecast bench codec|update|raster|pipeline|environment|stability|stream`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "codec_bench.h"
+#include "environment_bench.h"
 #include "probecast/codec/probe_file.h"
 #include "commands.h"
 #include "progress.h"
@@ -115,7 +116,7 @@ void addBenchUpdate(CLI::App* bench) {
     bench::UpdateBenchOptions o;
     o.scene = ut->scene.load();
     o.grid = ut->grid.resolve(o.scene);
-    o.updater = ut->tracer.options();
+    o.updater = ut->updater(ut->scene.environment.load());
     o.context = ut->gpu.context();
     o.updates = uo->updates;
     o.referenceSamples = uo->referenceSamples;
@@ -151,7 +152,7 @@ void addBenchRaster(CLI::App* bench) {
   raster->callback([=] {
     ro->bench.scene = rt->scene.load();
     ro->bench.grid = rt->grid.resolve(ro->bench.scene);
-    ro->bench.updater = rt->tracer.options();
+    ro->bench.updater = rt->updater(rt->scene.environment.load());  // the reference and background too
     ro->bench.context = rt->gpu.context();
     ro->bench.width = ro->size[0];
     ro->bench.height = ro->size[1];
@@ -194,6 +195,7 @@ void addBenchPipeline(CLI::App* bench) {
     po->bench.t = pt->scene.t;
     po->bench.grid = pt->grid.resolve(po->bench.scene);
     po->bench.context = pt->gpu.context();
+    po->bench.environment = pt->scene.environment.load();
     po->bench.width = po->size[0];
     po->bench.height = po->size[1];
     po->bench.command = commandLine();
@@ -206,6 +208,45 @@ void addBenchPipeline(CLI::App* bench) {
         writeTextFile(po->chart + suffix, *svg);
         fmt::print("wrote {}{}\n", po->chart, suffix);
       }
+  });
+}
+
+// `probecast bench environment`: environment importance sampling against BSDF-only sampling.
+void addBenchEnvironment(CLI::App* bench) {
+  CLI::App* cmd = bench->add_subcommand(
+      "environment", "reference tracer convergence under a small sun: environment importance sampling vs BSDF only");
+  struct EnvironmentCli {
+    SceneOptions scene;
+    GpuOptions gpu;
+    std::string json, chart;
+    std::vector<uint32_t> size{48, 32};
+    bench::EnvironmentBenchOptions bench;
+  };
+  auto eo = std::make_shared<EnvironmentCli>();
+  eo->scene.add(cmd);
+  eo->gpu.add(cmd);
+  addSizeOption(cmd, eo->size, "image size WxH", 4, 1024);
+  addReferenceSppOption(cmd, eo->bench.referenceSpp, 1u << 20);
+  cmd->add_option("--spps", eo->bench.spps, "samples per pixel to measure")->delimiter(',')->check(CLI::Range(1, 1 << 16));
+  cmd->add_option("--bounces", eo->bench.maxBounces, "surface interactions per path")->check(CLI::Range(1, 16));
+  addJsonOption(cmd, eo->json);
+  cmd->add_option("--chart", eo->chart, "write an SVG chart of RMS error against spp here");
+  cmd->callback([eo, cmd] {
+    // Without --scene: a sunlit yard built in; without --environment or --sky: the built-in sunny sky.
+    if (cmd->get_option("--scene")->count() > 0) {
+      eo->bench.scene = eo->scene.load();
+      eo->bench.camera = renderer::CameraView::fromScene(eo->bench.scene);
+    } else {
+      eo->bench.scene = bench::sunlitYard(eo->bench.camera);
+    }
+    eo->bench.environment = eo->scene.environment.given() ? eo->scene.environment.load() : bench::builtinSunSky();
+    eo->bench.context = eo->gpu.context();
+    eo->bench.width = eo->size[0];
+    eo->bench.height = eo->size[1];
+    eo->bench.command = commandLine();
+    eo->bench.progress = progressLine;
+    const bench::EnvironmentBenchResult r = bench::runEnvironmentBench(eo->bench);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", eo->json, r.svg, eo->chart);
   });
 }
 
@@ -264,6 +305,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchUpdate(bench);
   addBenchRaster(bench);
   addBenchPipeline(bench);
+  addBenchEnvironment(bench);
   addBenchStability(bench);
   addBenchStream(bench);
 }

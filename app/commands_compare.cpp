@@ -1,4 +1,5 @@
 // `probecast compare A.exr B.exr`: PSNR and SSIM after gamma 2.2, and a false-colour difference.
+// Images holding NaN or infinite pixels are refused with their count and first position.
 #include <fmt/format.h>
 
 #include "commands.h"
@@ -27,6 +28,16 @@ void addCompareCommand(CLI::App& app) {
       throw std::runtime_error(error);
     if (wa != wb || ha != hb)
       throw std::runtime_error(fmt::format("sizes differ: {}x{} against {}x{}", wa, ha, wb, hb));
+    // A NaN or infinite pixel has no place in PSNR or SSIM: name the images and refuse, rather
+    // than score it as black.
+    std::string bad;
+    for (const auto& [path, rgb] : {std::pair{&o->test, &a}, std::pair{&o->reference, &b}}) {
+      const imaging::NonFinitePixels nf = imaging::findNonFinitePixels(*rgb);
+      if (nf.count > 0)
+        bad += fmt::format("{}{}: {} non-finite pixels (NaN or infinite; the first at x {}, y {})", bad.empty() ? "" : "; ",
+                           *path, nf.count, nf.first % static_cast<size_t>(wa), nf.first / static_cast<size_t>(wa));
+    }
+    if (!bad.empty()) throw std::runtime_error(bad + "; not comparing: the metrics would be meaningless");
     const imaging::ImageMetrics m = imaging::compareImages(a, b, wa, ha);
     fmt::print("PSNR {:.2f} dB, SSIM {:.4f} (both after plain gamma 2.2, no clamping; SSIM on luminance)\n", m.psnrDb,
                m.ssim);

@@ -1,4 +1,6 @@
 // `probecast render-reference`: ground-truth camera path tracing to EXR.
+#include <chrono>
+
 #include <fmt/format.h>
 
 #include "commands.h"
@@ -36,6 +38,7 @@ void addReferenceCommand(CLI::App& app) {
   cmd->add_option("--exposure", o->exposure, "scale applied to the PNG preview only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->callback([=] {
     const scene::Scene s = scene->load();
+    const auto environment = scene->environment.load();  // before the device: bad input fails fast
     renderer::CameraView camera = renderer::CameraView::fromScene(s);
     if (o->eye.size() == 3) camera.position = {o->eye[0], o->eye[1], o->eye[2]};
     if (o->target.size() == 3) {
@@ -52,14 +55,21 @@ void addReferenceCommand(CLI::App& app) {
     ro.samplesPerPixel = o->spp;
     ro.maxBounces = o->bounces;
     ro.seed = o->seed;
+    ro.environment = environment;
     auto progress = std::make_shared<Progress>("render-reference", /*bar=*/false);
     ro.progress = [progress](uint32_t done, uint32_t total) {
       progress->update(static_cast<double>(done) / total,
                        fmt::format("{}/{} spp ({:.0f}%)", done, total, 100.0 * done / total));
       if (done == total) progress->finish();
     };
-    fmt::print("render-reference: {} on {}, {}x{}, {} spp\n", s.name, context.deviceName(), ro.width, ro.height, ro.samplesPerPixel);
-    const renderer::Image image = renderer::renderReference(context, s, camera, ro);
+    fmt::print("render-reference: {} on {}, {}x{}, {} spp, environment {}\n", s.name, context.deviceName(), ro.width,
+               ro.height, ro.samplesPerPixel, ro.environment ? ro.environment->name : "none");
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer::ReferenceStats stats;
+    const renderer::Image image = renderer::renderReference(context, s, camera, ro, &stats);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    fmt::print("render-reference: {:.1f} s, {} samples, {} non-finite dropped\n", seconds, stats.samples,
+               stats.droppedSamples);
     std::string error;
     if (!imaging::writeExr(o->out, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), error))
       throw std::runtime_error(error);

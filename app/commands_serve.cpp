@@ -36,6 +36,8 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   scene::Scene s;
   ProbeGrid g;
   if (!o.probes.empty()) {
+    if (tr.scene.environment.given())
+      throw std::runtime_error("--environment and --sky light live tracing; a --probes file was traced already");
     std::string error;
     orThrow(readProbeFile(o.probes, file, error), error);
     hub = service::hubConfigFor(file.grid, repr, o.brick, o.deadzone);
@@ -55,7 +57,7 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     animation.start = tr.scene.t;
     animation.perStep = static_cast<float>(o.animate / o.hz);
     animation.reloadScene = session::sceneAnimates(tr.scene.scene);  // a glTF file is the same at every t
-    producer->traceScene(*context, tr.scene.scene, s, g, tr.tracer.options(), animation);
+    producer->traceScene(*context, tr.scene.scene, s, g, tr.updater(tr.scene.environment.load()), animation);
   }
   return producer;
 }

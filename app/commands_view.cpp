@@ -65,7 +65,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
                      const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
   ProbeVolume volume;
   if (o.probes == "live") {
-    renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), o.tracing.tracer.options());
+    renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), o.tracing.updater(ro.environment));
     Progress progress("view", /*bar=*/false);
     for (uint32_t u = 0; u < o.updates; ++u) {
       updater.update();
@@ -132,12 +132,14 @@ void addViewCommand(CLI::App& app) {
     std::string error;
     orThrow(renderer::parseViewSet(o->views, spec, error), error);
     const scene::Scene s = o->tracing.scene.load();
+    const auto environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
         renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
     renderer::VulkanContext context(o->tracing.gpu.context());
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
+    ro.environment = environment;
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);
     writeViews(*o, r, views, spec);

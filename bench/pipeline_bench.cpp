@@ -81,9 +81,12 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   ro.width = o.width;
   ro.height = o.height;
   ro.samplesPerPixel = o.referenceSpp;
+  ro.environment = o.environment;
   say(fmt::format("pipeline bench: reference ({} spp)", o.referenceSpp));
   const renderer::Image reference = renderer::renderReference(context, finalScene, camera, ro);
-  renderer::RasterRenderer raster(context, finalScene, o.width, o.height);
+  renderer::RasterOptions rasterOptions;
+  rasterOptions.environment = o.environment;
+  renderer::RasterRenderer raster(context, finalScene, o.width, o.height, rasterOptions);
   const auto score = [&](const ProbeVolume& v, Point& p) {
     raster.setProbes(v);
     const renderer::Image img = raster.render(raster.viewProjection(camera), camera.position);
@@ -113,6 +116,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
       renderer::UpdaterOptions uo;
       uo.samplesPerProbe = spp;
       uo.maxBounces = b;
+      uo.environment = o.environment;
       renderer::ProbeUpdater u(context, finalScene, o.grid, uo);
       std::vector<double> ms;
       for (uint32_t k = 0; k < o.updates; ++k) ms.push_back(u.update().milliseconds);
@@ -127,6 +131,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   // (c) Representation: one well-converged volume through each record type.
   renderer::UpdaterOptions good;
   good.samplesPerProbe = 128;
+  good.environment = o.environment;
   renderer::ProbeUpdater converged(context, finalScene, o.grid, good);
   for (int k = 0; k < 8; ++k) converged.update();
   const ProbeVolume volume = converged.volume();
@@ -149,6 +154,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
     renderer::UpdaterOptions uo;
     uo.samplesPerProbe = 64;
     uo.minBlendWeight = 0.25f;
+    uo.environment = o.environment;
     renderer::ProbeUpdater u(context, sceneAt(o.t), o.grid, uo);
     for (uint32_t f = 0; f < o.streamFrames; ++f) {
       const float t = o.t - 0.004f * static_cast<float>(o.streamFrames - 1 - f);

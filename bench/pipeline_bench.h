@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@ struct PipelineBenchOptions {
   std::vector<uint32_t> bounces = {1, 2, 4};
   std::vector<int> deadzones = {0, 1, 4, 16};
   uint32_t updates = 4;        // updates per configuration of the update-cost part
+  std::shared_ptr<const renderer::Environment> environment;  // lights every tracer; the raster's background
   std::string command;
   std::function<void(const std::string&)> progress;
 };

@@ -72,6 +72,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   ro.width = o.width;
   ro.height = o.height;
   ro.samplesPerPixel = o.referenceSpp;
+  ro.environment = o.updater.environment;  // the same light as the probes
   ro.progress = [&](uint32_t done, uint32_t total) {
     if (done == total || done % 64 == 0) say(fmt::format("raster bench: reference {}/{} spp", done, total));
   };
@@ -98,6 +99,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
                                              {"l2", true, probecast::Representation::L2},
                                              {"fp16", true, probecast::Representation::Fp16}};
   renderer::RasterOptions perView = o.raster;
+  perView.environment = o.updater.environment;
   perView.passes = renderer::ViewPasses::PerView;
   renderer::RasterRenderer raster(context, o.scene, o.width, o.height, perView);
   imaging::ChartSeries qualitySeries{"representations (mono view)", {}, false};
@@ -128,7 +130,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   // Speed per view set, both ways of drawing several views.
   const ProbeVolume l2 = decodeAs(volume, probecast::Representation::L2, /*zh3PerPixel=*/true);
   raster.setProbes(l2);
-  renderer::RasterOptions multi = o.raster;
+  renderer::RasterOptions multi = perView;
   multi.passes = renderer::ViewPasses::Multiview;
   renderer::RasterRenderer multiview(context, o.scene, o.width, o.height, multi);
   multiview.setProbes(l2);

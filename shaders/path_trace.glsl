@@ -1,6 +1,9 @@
 // The path loop shared by the probe tracer and the reference camera: emission, next-event
-// estimation to punctual lights and to emissive triangles (multiple importance sampling with the
-// BSDF, power heuristic), Lambert + GGX sampling, Russian roulette, bounce limit, clamp.
+// estimation to punctual lights, to emissive triangles and to the environment (the last two by
+// multiple importance sampling with the BSDF, power heuristic), Lambert + GGX sampling, Russian
+// roulette, bounce limit, clamp. Misses return the environment (black when there is none).
+// Nothing here divides by a quantity that can reach zero or takes pow/normalize of something that
+// can leave its domain: a non-finite sample is a defect (the raygens still drop and count one).
 // The including raygen declares the bindings, the payloads `hit` (location 0) and `visible`
 // (location 1), and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES, PATH_INDIRECT_CLAMP,
 // PATH_EMITTER_COUNT and PATH_EMITTER_POWER.
@@ -60,14 +63,18 @@ void onb(vec3 n, out vec3 t, out vec3 b) {
 vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) {
   float nl = dot(n, wi), nv = dot(n, wo);
   if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
-  vec3 h = normalize(wo + wi);
-  float nh = max(dot(n, h), 0.0), vh = max(dot(wo, h), 0.0);
+  vec3 h = normalize(wo + wi);  // nonzero: wo and wi lie on the same side of n
+  // Dot products of unit vectors can round past 1; pow() of the negative 1 − v·h that follows is
+  // undefined (NaN on llvmpipe), so clamp both into [0, 1] and expand the powers as products.
+  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(wo, h), 0.0, 1.0);
   float a2 = alpha * alpha;
-  float d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+  float dd = nh * nh * (a2 - 1.0) + 1.0;
+  float d = a2 / (PI * dd * dd);
   float k = alpha * 0.5;
   float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
   vec3 f0 = mix(vec3(0.04), base, metallic);
-  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
+  float x = 1.0 - vh, x2 = x * x;
+  vec3 f = f0 + (1.0 - f0) * (x2 * x2 * x);
   vec3 spec = d * g * f / max(4.0 * nl * nv, 1e-6);
   vec3 diffuse = base * (1.0 - metallic) / PI;
   return diffuse + spec;
@@ -76,10 +83,14 @@ vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) 
 float pdfBsdf(vec3 n, vec3 wo, vec3 wi, float alpha, float specProb) {
   float nl = dot(n, wi);
   if (nl <= 0.0) return 0.0;
-  vec3 h = normalize(wo + wi);
-  float nh = max(dot(n, h), 0.0), vh = max(dot(wo, h), 1e-6);
+  vec3 hv = wo + wi;
+  float hl = dot(hv, hv);
+  if (hl < 1e-12) return (1.0 - specProb) * nl / PI;  // wi opposite wo: no half vector, no GGX sample
+  vec3 h = hv * inversesqrt(hl);
+  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(wo, h), 1e-6, 1.0);
   float a2 = alpha * alpha;
-  float d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+  float dd = nh * nh * (a2 - 1.0) + 1.0;
+  float d = a2 / (PI * dd * dd);
   return specProb * d * nh / (4.0 * vh) + (1.0 - specProb) * nl / PI;
 }
 
@@ -140,6 +151,82 @@ vec3 directLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, fl
 
 float luminance(vec3 c) { return dot(c, LUMA); }
 
+// MIS weight of a sample drawn with pdf `a` against a second strategy of pdf `b` (power
+// heuristic a² / (a² + b²)), written as a ratio: no overflow of the squares, no 0/0. a > 0.
+float powerHeuristic(float a, float b) {
+  float r = b / a;
+  return 1.0 / (1.0 + r * r);
+}
+
+// The environment (renderer/environment.h): nearest texel of an equirect map, map direction =
+// R_y(−rotation) · world direction, top row +Y, centre −Z, u = 0.75 toward +X.
+vec3 envTexel(uint x, uint y) {
+  uint i = 3u * (y * environment.width + x);
+  return vec3(envData[i], envData[i + 1u], envData[i + 2u]);
+}
+
+vec3 environmentRadiance(vec3 w) {
+  if (environment.mode == PT_ENV_NONE) return vec3(0.0);
+  float c = environment.cosRotation, s = environment.sinRotation;
+  vec3 m = vec3(c * w.x - s * w.z, w.y, s * w.x + c * w.z);
+  float theta = acos(clamp(m.y, -1.0, 1.0));
+  float phi = abs(m.x) + abs(m.z) > 0.0 ? atan(m.x, -m.z) : 0.0;  // atan(0, 0) is undefined
+  float u = phi / (2.0 * PI) + 0.5, v = theta / PI;
+  int x = clamp(int(u * float(environment.width)), 0, int(environment.width) - 1);
+  int y = clamp(int(v * float(environment.height)), 0, int(environment.height) - 1);
+  return envTexel(uint(x), uint(y));
+}
+
+// Solid-angle pdf with which environment sampling draws w (0 when it does not sample).
+float environmentPdf(vec3 w) {
+  if (environment.sampling == 0u) return 0.0;
+  return luminance(environmentRadiance(w)) / environment.total;
+}
+
+// First index in CDF envData[offset, offset + count) whose inclusive value exceeds u ∈ [0, 1).
+uint envSearch(uint offset, uint count, float u) {
+  uint lo = 0u, hi = count - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi) / 2u;
+    if (envData[offset + mid] <= u) lo = mid + 1u; else hi = mid;
+  }
+  return lo;
+}
+
+// Draws a world direction with probability ∝ luminance × solid angle: a row by the marginal CDF,
+// a column by that row's conditional CDF, then uniform in solid angle within the texel (φ
+// uniform, cos θ uniform over the band). Returns the texel's radiance; pdf = luminance / total.
+vec3 sampleEnvironment(inout uint rng, out vec3 wi, out float pdf) {
+  uint W = environment.width, H = environment.height;
+  uint y = envSearch(environment.rowsOffset, H, rnd(rng));
+  uint x = envSearch(environment.columnsOffset + y * W, W, rnd(rng));
+  float cos0 = cos(PI * float(y) / float(H)), cos1 = cos(PI * float(y + 1u) / float(H));
+  float cosT = mix(cos0, cos1, rnd(rng));
+  float sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
+  float phi = 2.0 * PI * ((float(x) + rnd(rng)) / float(W) - 0.5);
+  vec3 m = vec3(sinT * sin(phi), cosT, -sinT * cos(phi));
+  float c = environment.cosRotation, s = environment.sinRotation;
+  wi = vec3(c * m.x + s * m.z, m.y, -s * m.x + c * m.z);
+  vec3 le = envTexel(x, y);
+  pdf = luminance(le) / environment.total;
+  return le;
+}
+
+// One environment sample for next-event estimation, MIS-weighted against BSDF sampling.
+vec3 environmentLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha, float specProb,
+                      inout uint rng) {
+  if (environment.mode == PT_ENV_NONE || environment.sampling == 0u) return vec3(0.0);
+  vec3 wi;
+  float pdfLight;
+  vec3 le = sampleEnvironment(rng, wi, pdfLight);
+  float cosSurface = dot(n, wi);
+  if (!(pdfLight > 0.0) || cosSurface <= 0.0 || dot(ng, wi) <= 0.0) return vec3(0.0);
+  vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+  if (!unoccluded(origin, wi, 1e30)) return vec3(0.0);
+  float weight = powerHeuristic(pdfLight, pdfBsdf(n, wo, wi, alpha, specProb));
+  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * (weight / pdfLight);
+}
+
 // Solid-angle pdf with which emitter sampling picks a direction that reaches a point of triangle
 // `tri` (emission `le`, area `area`) at distance `dist`, seen at cosine `cosLight` from its front.
 float emitterPdf(vec3 le, float dist, float cosLight) {
@@ -183,8 +270,7 @@ vec3 emitterLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, f
   if (pdfLight <= 0.0) return vec3(0.0);
   vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
   if (!unoccluded(origin, wi, dist * (1.0 - 1e-3))) return vec3(0.0);
-  float pdfBsdfValue = pdfBsdf(n, wo, wi, alpha, specProb);
-  float weight = pdfLight * pdfLight / (pdfLight * pdfLight + pdfBsdfValue * pdfBsdfValue);
+  float weight = powerHeuristic(pdfLight, pdfBsdf(n, wo, wi, alpha, specProb));
   return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * (weight / pdfLight);
 }
 
@@ -200,11 +286,21 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
   for (uint bounce = 0u; bounce < PATH_MAX_BOUNCES; ++bounce) {
     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, origin, 0.0, dir, 1e30, 0);
     ++gClosestRays;
-    if (hit.t < 0.0) break;  // the environment is black
+    if (hit.t < 0.0) {
+      // The environment, weighted against environment sampling when a BSDF sample got here
+      // (the first segment is no BSDF sample: a probe or camera sees the sky directly).
+      if (environment.mode != PT_ENV_NONE) {
+        float weight = lastBsdfPdf > 0.0 ? powerHeuristic(lastBsdfPdf, environmentPdf(dir)) : 1.0;
+        radiance += clampIndirect(throughput * environmentRadiance(dir) * weight, bounce);
+      }
+      break;
+    }
     uint tri = hit.primitive;
     vec3 p0 = vertexPosition(indices[3 * tri]), p1 = vertexPosition(indices[3 * tri + 1]),
          p2 = vertexPosition(indices[3 * tri + 2]);
-    vec3 ng = normalize(cross(p1 - p0, p2 - p0));
+    vec3 cr = cross(p1 - p0, p2 - p0);
+    float crLen = length(cr);
+    vec3 ng = crLen > 0.0 ? cr / crLen : -dir;  // a degenerate (sliver) triangle faces the ray
     PtMaterial m = materials[triangleMaterial[tri]];
     vec3 p = origin + dir * hit.t;
     uint i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
@@ -218,7 +314,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
       float weight = 1.0;
       if (lastBsdfPdf > 0.0) {
         float pdfLight = emitterPdf(leFactor, hit.t, abs(dot(ng, dir)));
-        weight = lastBsdfPdf * lastBsdfPdf / (lastBsdfPdf * lastBsdfPdf + pdfLight * pdfLight);
+        weight = powerHeuristic(lastBsdfPdf, pdfLight);
       }
       radiance += clampIndirect(throughput * le * weight, bounce);
     }
@@ -236,6 +332,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     radiance += clampIndirect(throughput * directLight(p, n, ngf, wo, base, metallic, alpha), bounce);
     if (bounce + 1u >= PATH_MAX_BOUNCES) break;
     radiance += clampIndirect(throughput * emitterLight(p, n, ngf, wo, base, metallic, alpha, specProb, rng), bounce);
+    radiance += clampIndirect(throughput * environmentLight(p, n, ngf, wo, base, metallic, alpha, specProb, rng), bounce);
     vec3 wi = sampleBsdf(n, wo, alpha, specProb, rng);
     float pdf = pdfBsdf(n, wo, wi, alpha, specProb);
     if (pdf <= 1e-8) break;
@@ -253,3 +350,6 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
   return radiance;
 }
 
+
+// A path sample the raygens may add: every component finite (they drop and count any other).
+bool finiteRadiance(vec3 c) { return !any(isnan(c)) && !any(isinf(c)); }

@@ -3,7 +3,7 @@
 #define PROBECAST_PROBE_TRACE_SHARED_H
 
 #define PT_LANES_PER_PROBE 32   // invocations per probe; each sums its samples into one partial SH
-#define PT_PARTIAL_FLOATS 30    // 27 SH floats, back-face hits, closest-hit rays, shadow rays per lane
+#define PT_PARTIAL_FLOATS 31    // 27 SH floats, back-face hits, closest-hit rays, shadow rays, dropped samples
 #define PT_MAX_BOUNCES_LIMIT 16
 
 #define PT_MODE_TRACE 0u        // full paths, projected to SH
@@ -23,7 +23,12 @@
 #define PT_BINDING_TEXCOORDS 11 // float[2 * vertices]
 #define PT_BINDING_TEXELS 12    // uint[]: every texture's sRGB RGBA8 texels, packed
 #define PT_BINDING_TEXTURES 13  // PtTexture[]
-#define PT_BINDING_COUNT 14
+#define PT_BINDING_ENVIRONMENT 14 // PtEnvironment (one): how to read PT_BINDING_ENV_DATA
+#define PT_BINDING_ENV_DATA 15  // float[]: radiance rgb per texel, then the row CDF, then the column CDFs
+#define PT_BINDING_COUNT 16
+
+#define PT_ENV_NONE 0u          // misses are black
+#define PT_ENV_MAP 1u           // misses return the equirect map (environment.h's convention)
 
 #define PT_LIGHT_POINT 0u
 #define PT_LIGHT_SPOT 1u
@@ -72,6 +77,24 @@ struct PtEmitter {
   float pad;
 };
 
+// The environment (renderer/environment.h): a width × height equirect map rotated about +Y; a
+// uniform sky is a 1 × 1 map. The pdf of a direction drawn by importance sampling is
+// luminance(texel) / total.
+struct PtEnvironment {
+  uint mode;                // PT_ENV_*
+  uint width;
+  uint height;
+  uint sampling;            // 1: next-event estimation samples it (MIS with the BSDF); 0: BSDF sampling only
+  float cosRotation;        // world = R_y(rotation) · map direction
+  float sinRotation;
+  float total;              // Σ luminance × solid angle over the texels
+  uint rowsOffset;          // first float of the row CDF (height floats) in PT_BINDING_ENV_DATA
+  uint columnsOffset;       // first float of the column CDFs (height × width floats)
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
 struct PtPushConstants {
   mat4 rotation;            // random rotation of the sample set for this update
   uint sampleCount;         // samples per probe (multiple of LANES)
@@ -117,6 +140,7 @@ static_assert(sizeof(PtMaterial) == 48);
 static_assert(sizeof(PtTexture) == 16);
 static_assert(sizeof(PtLight) == 64);
 static_assert(sizeof(PtPushConstants) == 112);
+static_assert(sizeof(PtEnvironment) == 48);
 }  // namespace probecast::shaders
 #endif
 

@@ -48,13 +48,16 @@ vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) 
   float nl = dot(n, wi), nv = dot(n, wo);
   if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
   vec3 h = normalize(wo + wi);
-  float nh = max(dot(n, h), 0.0), vh = max(dot(wo, h), 0.0);
+  // As path_trace.glsl: v·h can round past 1, and pow() of a negative base is undefined.
+  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(wo, h), 0.0, 1.0);
   float a2 = alpha * alpha;
-  float d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+  float dd = nh * nh * (a2 - 1.0) + 1.0;
+  float d = a2 / (PI * dd * dd);
   float k = alpha * 0.5;
   float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
   vec3 f0 = mix(vec3(0.04), base, metallic);
-  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
+  float x = 1.0 - vh, x2 = x * x;
+  vec3 f = f0 + (1.0 - f0) * (x2 * x2 * x);
   return base * (1.0 - metallic) / PI + d * g * f / max(4.0 * nl * nv, 1e-6);
 }
 

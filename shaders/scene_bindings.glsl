@@ -10,6 +10,8 @@ layout(std430, binding = PT_BINDING_NORMALS) readonly buffer Normals { float nor
 layout(std430, binding = PT_BINDING_TEXCOORDS) readonly buffer Texcoords { float texcoords[]; };
 layout(std430, binding = PT_BINDING_TEXELS) readonly buffer Texels { uint texels[]; };
 layout(std430, binding = PT_BINDING_TEXTURES) readonly buffer Textures { PtTexture textures[]; };
+layout(std430, binding = PT_BINDING_ENVIRONMENT) readonly buffer EnvironmentHeader { PtEnvironment environment; };
+layout(std430, binding = PT_BINDING_ENV_DATA) readonly buffer EnvironmentData { float envData[]; };
 
 layout(location = 0) rayPayloadEXT HitPayload hit;
 layout(location = 1) rayPayloadEXT uint visible;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "probecast/imaging/image_metrics.h"
@@ -10,6 +11,18 @@ namespace probecast::imaging {
 namespace {
 
 std::vector<float> constant(int w, int h, float v) { return std::vector<float>(static_cast<size_t>(w) * h * 3, v); }
+
+TEST(ImageMetrics, NonFinitePixelsAreFoundAndCounted) {
+  // compareImages scores NaN as 0; callers judge images only after this finds none.
+  std::vector<float> img(6 * 4 * 3, 0.5f);
+  EXPECT_EQ(findNonFinitePixels(img).count, 0u);
+  img[(2 * 6 + 3) * 3 + 1] = std::nanf("");
+  img[(3 * 6 + 0) * 3 + 2] = -std::numeric_limits<float>::infinity();
+  img[(3 * 6 + 0) * 3] = std::nanf("");  // the same pixel again: still one pixel
+  const NonFinitePixels nf = findNonFinitePixels(img);
+  EXPECT_EQ(nf.count, 2u);
+  EXPECT_EQ(nf.first, 2u * 6 + 3);
+}
 
 TEST(ImageMetrics, IdenticalImagesArePerfect) {
   std::mt19937 rng(1);

@@ -1,6 +1,9 @@
 // Writes the test image into DIR in the named compressions (OpenEXR names, e.g. DWAB PIZ B44), as
-// DIR/test_<NAME>.exr, for the command-line test of `probecast bench codec --envmaps DIR`.
+// DIR/test_<NAME>.exr, for the command-line test of `probecast bench codec --envmaps DIR`; the name
+// NONFINITE writes the image with NaN and infinite pixels (for compare and --environment checks).
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <cstring>
 #include <exception>
 
@@ -16,6 +19,14 @@ int main(int argc, char** argv) {
   const std::vector<float> image = exrTestImage(width, height);
   try {
     for (int i = 2; i < argc; ++i) {
+      if (std::strcmp(argv[i], "NONFINITE") == 0) {  // uncompressed float, two NaN pixels and an infinite one
+        std::vector<float> bad = image;
+        bad[(3 * width + 5) * 3] = std::nanf("");
+        bad[(7 * width + 1) * 3 + 2] = std::nanf("");
+        bad[(9 * width + 9) * 3 + 1] = std::numeric_limits<float>::infinity();
+        writeTestExr(std::string(argv[1]) + "/test_NONFINITE.exr", bad, width, height, 0, false);
+        continue;
+      }
       const ExrCompressionCase* found = nullptr;
       for (const ExrCompressionCase& c : exrCompressionCases())
         if (std::strcmp(c.name, argv[i]) == 0) found = &c;

@@ -13,6 +13,18 @@ void equirectDirection(int width, int height, int x, int y, float dir[3]) {
   dir[2] = -std::sin(theta) * std::cos(phi);
 }
 
+void equirectPixel(int width, int height, const float dir[3], int& x, int& y) {
+  const float theta = std::acos(std::clamp(dir[1], -1.0f, 1.0f));
+  const float phi = std::atan2(dir[0], -dir[2]);
+  const float u = phi / (2.0f * kPi) + 0.5f, v = theta / kPi;
+  if (!std::isfinite(u) || !std::isfinite(v)) {  // not a direction: the first pixel, never out of range
+    x = y = 0;
+    return;
+  }
+  x = std::clamp(static_cast<int>(u * static_cast<float>(width)), 0, width - 1);
+  y = std::clamp(static_cast<int>(v * static_cast<float>(height)), 0, height - 1);
+}
+
 float equirectPixelSolidAngle(int width, int height, int y) {
   const float t0 = kPi * static_cast<float>(y) / static_cast<float>(height);
   const float t1 = kPi * static_cast<float>(y + 1) / static_cast<float>(height);

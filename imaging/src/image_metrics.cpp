@@ -53,6 +53,15 @@ std::vector<double> blur(const std::vector<double>& in, int w, int h) {
 
 }  // namespace
 
+NonFinitePixels findNonFinitePixels(const std::vector<float>& rgb) {
+  NonFinitePixels r;
+  for (size_t i = 0; i < rgb.size() / 3; ++i)
+    if (!std::isfinite(rgb[i * 3]) || !std::isfinite(rgb[i * 3 + 1]) || !std::isfinite(rgb[i * 3 + 2])) {
+      if (r.count++ == 0) r.first = i;
+    }
+  return r;
+}
+
 ImageMetrics compareImages(const std::vector<float>& a, const std::vector<float>& b, int width, int height) {
   ImageMetrics m;
   const size_t n = static_cast<size_t>(width) * height;

@@ -54,6 +54,32 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   }
 }
 
+void uploadGpuEnvironment(VulkanDevice& d, const Environment* env, bool sampling, GpuScene& g) {
+  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  destroyBuffer(d, g.environment);
+  destroyBuffer(d, g.environmentData);
+  shaders::PtEnvironment header{};
+  std::vector<float> data;
+  if (env && !env->empty()) {
+    const EnvironmentDistribution dist = buildEnvironmentDistribution(*env);
+    header.mode = PT_ENV_MAP;
+    header.width = static_cast<uint32_t>(env->width);
+    header.height = static_cast<uint32_t>(env->height);
+    header.sampling = sampling && dist.total > 0.0 ? 1u : 0u;
+    header.cosRotation = std::cos(env->rotation);
+    header.sinRotation = std::sin(env->rotation);
+    header.total = static_cast<float>(dist.total);
+    data = env->rgb;
+    header.rowsOffset = static_cast<uint32_t>(data.size());
+    data.insert(data.end(), dist.rows.begin(), dist.rows.end());
+    header.columnsOffset = static_cast<uint32_t>(data.size());
+    data.insert(data.end(), dist.columns.begin(), dist.columns.end());
+  }
+  if (data.empty()) data.assign(4, 0.0f);  // a valid binding for PT_ENV_NONE
+  g.environment = createBufferWithData(d, &header, sizeof header, kStorage);
+  g.environmentData = createBufferWithData(d, data.data(), data.size() * sizeof(float), kStorage);
+}
+
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   if (g.accel.tlas.handle) destroySceneAccel(d, g.accel);
@@ -77,6 +103,7 @@ void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   g.texels = createBufferWithData(d, texels.data(), texels.size() * 4, kStorage);
   g.textures = createBufferWithData(d, infos.data(), infos.size() * sizeof(shaders::PtTexture), kStorage);
   uploadGpuShading(d, s, g);
+  if (!g.environment.buffer) uploadGpuEnvironment(d, nullptr, false, g);
 }
 
 void destroyGpuScene(VulkanDevice& d, GpuScene& g) {
@@ -85,7 +112,8 @@ void destroyGpuScene(VulkanDevice& d, GpuScene& g) {
   destroyBuffer(d, g.materials);
   destroyBuffer(d, g.lights);
   destroyBuffer(d, g.emitters);
-  for (Buffer* b : {&g.normals, &g.texcoords, &g.texels, &g.textures}) destroyBuffer(d, *b);
+  for (Buffer* b : {&g.normals, &g.texcoords, &g.texels, &g.textures, &g.environment, &g.environmentData})
+    destroyBuffer(d, *b);
   g.lightCount = 0;
   g.emitterCount = 0;
 }

@@ -1,6 +1,7 @@
 // A scene on the device: acceleration structures plus the shading buffers the raygens read.
 #pragma once
 
+#include "probecast/renderer/environment.h"
 #include "probecast/scene/scene.h"
 #include "vk_acceleration.h"
 
@@ -16,6 +17,8 @@ struct GpuScene {
   Buffer texcoords;         // float2 per vertex
   Buffer texels;            // packed sRGB RGBA8 of every texture
   Buffer textures;          // PtTexture[]
+  Buffer environment;       // PtEnvironment
+  Buffer environmentData;   // radiance, row CDF, column CDFs (PT_BINDING_ENV_DATA)
   uint32_t lightCount = 0;
   uint32_t emitterCount = 0;
   float emitterPower = 0.0f;
@@ -23,6 +26,9 @@ struct GpuScene {
 
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);  // geometry + shading
 void uploadGpuShading(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);  // materials, lights only
+// The environment the ray-tracing passes see (none when `env` is null or empty); `sampling`:
+// next-event estimation importance-samples it. uploadGpuScene starts with none.
+void uploadGpuEnvironment(VulkanDevice& d, const Environment* env, bool sampling, GpuScene& out);
 void destroyGpuScene(VulkanDevice& d, GpuScene& g);
 
 }  // namespace probecast::renderer

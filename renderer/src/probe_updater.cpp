@@ -187,6 +187,7 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   const auto cdirs = coherentFibonacci(roundUpLanes(options.classifySamples));
   s.classifyDirections = createBufferWithData(*s.d, cdirs.data(), cdirs.size() * sizeof(shaders::vec4), kStorage);
   s.setGeometry(scene);
+  uploadGpuEnvironment(*s.d, options.environment.get(), options.environmentSampling, s.gpu);
   s.classify();
 }
 
@@ -229,6 +230,7 @@ UpdateStats ProbeUpdater::update() {
         for (int k = 0; k < 27; ++k) sum[k] += src[k];
         stats.closestHitRays += static_cast<uint64_t>(src[28]);
         stats.shadowRays += static_cast<uint64_t>(src[29]);
+        stats.droppedSamples += static_cast<uint64_t>(src[30]);
       }
       const uint32_t n = ++s.blendCount[p];
       const float w = std::max(1.0f / static_cast<float>(n), s.options.minBlendWeight);
@@ -255,7 +257,7 @@ uint64_t ProbeUpdater::deviceBytes() const {
   uint64_t total = 0;
   for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.gpu.triangleMaterial,
                           &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.normals, &s.gpu.texcoords, &s.gpu.texels,
-                          &s.gpu.textures, &s.gpu.accel.positions, &s.gpu.accel.indices,
+                          &s.gpu.textures, &s.gpu.environment, &s.gpu.environmentData, &s.gpu.accel.positions, &s.gpu.accel.indices,
                           &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.tlas.storage, &s.pass.sbt})
     total += b->size;
   return total;

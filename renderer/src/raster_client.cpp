@@ -127,6 +127,28 @@ struct RasterRenderer::Impl {
   shaders::RsPushConstants push{};
   uint32_t indexCount = 0;
   glm::vec3 sceneMin{0.0f}, sceneMax{0.0f};
+  std::vector<glm::mat4> inverseViewProj;  // of the views being rendered, for the background
+
+  // Pixels the pass left clear (alpha 0: no surface) take the environment's radiance along the
+  // pixel centre's ray, unprojected from the view's near and far planes (off-axis views too).
+  void drawBackground(Image& img, const glm::mat4& inverse) const {
+    if (!options.environment || options.environment->empty()) return;
+    for (uint32_t y = 0; y < img.height; ++y)
+      for (uint32_t x = 0; x < img.width; ++x) {
+        const size_t i = static_cast<size_t>(y) * img.width + x;
+        if (coverage[i] != 0) continue;
+        const float nx = (static_cast<float>(x) + 0.5f) / static_cast<float>(img.width) * 2.0f - 1.0f;
+        const float ny = (static_cast<float>(y) + 0.5f) / static_cast<float>(img.height) * 2.0f - 1.0f;
+        const glm::vec4 nearPoint = inverse * glm::vec4(nx, ny, 0.0f, 1.0f);
+        const glm::vec4 farPoint = inverse * glm::vec4(nx, ny, 1.0f, 1.0f);
+        const glm::vec3 dir = glm::vec3(farPoint) / farPoint.w - glm::vec3(nearPoint) / nearPoint.w;
+        const float len = glm::length(dir);
+        if (!(len > 0.0f) || !std::isfinite(len)) continue;
+        const glm::vec3 L = environmentRadiance(*options.environment, dir / len);
+        for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = L[c];
+      }
+  }
+  std::vector<uint8_t> coverage;  // per pixel of the view being read back: 1 where a surface was drawn
 
   void writeDescriptors() {
     const Buffer* buffers[8] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
@@ -295,8 +317,12 @@ struct RasterRenderer::Impl {
       img.height = height;
       img.rgb.resize(pixels * 3);
       const float* layer = src + v * pixels * 4;
-      for (size_t i = 0; i < pixels; ++i)
+      coverage.resize(pixels);
+      for (size_t i = 0; i < pixels; ++i) {
         for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer[i * 4 + c];
+        coverage[i] = layer[i * 4 + 3] > 0.0f ? 1 : 0;  // the fragment shader writes alpha 1
+      }
+      drawBackground(img, inverseViewProj[first + v]);
     }
   }
 };
@@ -441,7 +467,9 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   s.timings.shadowMs = s.shadows.lastDrawMs;
   const auto t0 = Clock::now();
   auto* dst = static_cast<shaders::RsView*>(s.views.mapped);
+  s.inverseViewProj.resize(views.size());
   for (size_t k = 0; k < views.size(); ++k) {
+    s.inverseViewProj[k] = glm::inverse(views[k].viewProj);
     std::memcpy(&dst[k].viewProj, &views[k].viewProj[0][0], sizeof(float) * 16);
     dst[k].eye = {views[k].eye.x, views[k].eye.y, views[k].eye.z, 1.0f};
   }

@@ -26,7 +26,7 @@ CameraView CameraView::fromScene(const scene::Scene& s) {
 }
 
 Image renderReference(VulkanContext& context, const scene::Scene& scene, const CameraView& camera,
-                      const ReferenceOptions& options) {
+                      const ReferenceOptions& options, ReferenceStats* stats) {
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   if (options.width == 0 || options.height == 0 || options.samplesPerPixel == 0)
     throw std::invalid_argument("reference image needs a size and samples");
@@ -39,6 +39,7 @@ Image renderReference(VulkanContext& context, const scene::Scene& scene, const C
   Image image;
   try {
     uploadGpuScene(d, scene, gpu);
+    uploadGpuEnvironment(d, options.environment.get(), options.environmentSampling, gpu);
     createRayTracingPass(d, kReferenceCameraRgen, sizeof kReferenceCameraRgen, sizeof(shaders::PtCameraPushConstants),
                          pass);
     std::fill_n(static_cast<float*>(accumulation.mapped), pixels * 4, 0.0f);
@@ -75,8 +76,15 @@ Image renderReference(VulkanContext& context, const scene::Scene& scene, const C
     image.height = options.height;
     image.rgb.resize(pixels * 3);
     const float* acc = static_cast<const float*>(accumulation.mapped);
-    for (size_t i = 0; i < pixels; ++i)
+    uint64_t kept = 0;
+    for (size_t i = 0; i < pixels; ++i) {
+      kept += static_cast<uint64_t>(acc[i * 4 + 3]);  // exact: counts stay far below 2^24
       for (int c = 0; c < 3; ++c) image.rgb[i * 3 + c] = acc[i * 4 + 3] > 0 ? acc[i * 4 + c] / acc[i * 4 + 3] : 0.0f;
+    }
+    if (stats) {
+      stats->samples = static_cast<uint64_t>(pixels) * options.samplesPerPixel;
+      stats->droppedSamples = stats->samples - std::min(kept, stats->samples);
+    }
   } catch (...) {
     destroyRayTracingPass(d, pass);
     destroyGpuScene(d, gpu);

@@ -122,6 +122,8 @@ void runRayTracingPass(VulkanDevice& d, RayTracingPass& pass, const RayTracingIn
   buffers[PT_BINDING_TEXCOORDS] = &g.texcoords;
   buffers[PT_BINDING_TEXELS] = &g.texels;
   buffers[PT_BINDING_TEXTURES] = &g.textures;
+  buffers[PT_BINDING_ENVIRONMENT] = &g.environment;
+  buffers[PT_BINDING_ENV_DATA] = &g.environmentData;
   VkDescriptorBufferInfo infos[PT_BINDING_COUNT];
   VkWriteDescriptorSet writes[PT_BINDING_COUNT];
   for (uint32_t b = 0; b < PT_BINDING_COUNT; ++b) {

@@ -15,6 +15,9 @@ namespace probecast {
 
 // Direction of the centre of pixel (x, y).
 void equirectDirection(int width, int height, int x, int y, float dir[3]);
+// The pixel whose solid angle holds unit direction `dir` (the inverse of equirectDirection):
+// θ = acos(y), φ = atan2(x, −z), column ⌊(φ/2π + 0.5) W⌋, row ⌊θ/π H⌋, both clamped into the map.
+void equirectPixel(int width, int height, const float dir[3], int& x, int& y);
 // Solid angle of a pixel in row y, steradians (exact band area 2π/W · (cos θ0 − cos θ1)).
 float equirectPixelSolidAngle(int width, int height, int y);
 

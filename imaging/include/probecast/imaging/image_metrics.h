@@ -13,8 +13,15 @@ struct ImageMetrics {
   double mse = 0;
 };
 
-// Both images: width × height × 3 linear floats. Non-finite values count as 0.
+// Both images: width × height × 3 linear floats. Non-finite values count as 0 here, so callers
+// that judge images check findNonFinitePixels first (`probecast compare` refuses such images).
 ImageMetrics compareImages(const std::vector<float>& a, const std::vector<float>& b, int width, int height);
+
+struct NonFinitePixels {
+  size_t count = 0;  // pixels with a NaN or infinite channel
+  size_t first = 0;  // index (y × width + x) of the first one, when count > 0
+};
+NonFinitePixels findNonFinitePixels(const std::vector<float>& rgb);
 
 // Per-pixel absolute luminance difference after gamma, as a false-colour PNG (black → blue →
 // green → yellow → red at `scale`).

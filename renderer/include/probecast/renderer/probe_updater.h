@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "probecast/codec/probe_volume.h"
+#include "probecast/renderer/environment.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
 
@@ -30,6 +31,10 @@ struct UpdaterOptions {
   bool classify = true;            // mark probes inside geometry inactive
   uint32_t classifySamples = 64;
   float backFaceThreshold = 0.25f; // inactive above this back-face hit ratio (RTXGI's rule)
+  // Distant light: misses return it and next-event estimation importance-samples it (MIS with
+  // the BSDF); none: misses are black. Probes see it directly, like any distant light.
+  std::shared_ptr<const Environment> environment;
+  bool environmentSampling = true;  // false: reach the environment by BSDF sampling only
 };
 
 struct UpdateStats {
@@ -38,6 +43,7 @@ struct UpdateStats {
   uint64_t closestHitRays = 0;  // path segments (rays that need the closest hit)
   uint64_t shadowRays = 0;      // next-event rays (first hit ends them)
   uint32_t activeProbes = 0;
+  uint64_t droppedSamples = 0;  // non-finite path samples replaced by 0 (a defect if ever nonzero)
 };
 
 class ProbeUpdater {

@@ -4,7 +4,8 @@
 // probe activity, so probes inside walls never darken their active neighbours; inactive probes are
 // also filled from active neighbours for places no active probe reaches). Offscreen, dynamic
 // rendering, linear radiance out. A view set renders with its shadow maps drawn once, in chunks
-// of views: one pass per view, or one multiview pass per chunk.
+// of views: one pass per view, or one multiview pass per chunk. Pixels no surface covers show the
+// environment (black without one).
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "probecast/codec/probe_volume.h"
+#include "probecast/renderer/environment.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/renderer/vulkan_context.h"
@@ -31,6 +33,9 @@ struct RasterOptions {
   uint32_t maxShadowLayers = 24;  // point lights take 6, spot and directional lights 1; lights past
                                   // the budget (in scene order) are lit unshadowed
   ViewPasses passes = ViewPasses::PerView;
+  // Drawn as background where no surface covers a pixel (linear radiance like the rest, so the
+  // same exposure and tone map apply); its light reaches surfaces through the probes only.
+  std::shared_ptr<const Environment> environment;
 };
 
 struct RasterTimings {

@@ -4,10 +4,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "probecast/renderer/environment.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
 
@@ -32,6 +34,8 @@ struct ReferenceOptions {
   uint32_t maxBounces = 8;
   uint32_t seed = 1;
   float indirectClamp = 0.0f;  // off: the reference is unbiased
+  std::shared_ptr<const Environment> environment;  // none: misses are black
+  bool environmentSampling = true;  // false: reach the environment by BSDF sampling only
   std::function<void(uint32_t done, uint32_t total)> progress;  // samples per pixel done
 };
 
@@ -41,7 +45,13 @@ struct Image {
   std::vector<float> rgb;  // linear radiance, row-major from the top
 };
 
+struct ReferenceStats {
+  uint64_t samples = 0;         // path samples traced (pixels × spp)
+  uint64_t droppedSamples = 0;  // non-finite samples left out of their pixel's mean (a defect if nonzero)
+};
+
+// Each pixel is the mean of its finite samples; `stats` (optional) counts the rest.
 Image renderReference(VulkanContext& context, const scene::Scene& scene, const CameraView& camera,
-                      const ReferenceOptions& options);
+                      const ReferenceOptions& options, ReferenceStats* stats = nullptr);
 
 }  // namespace probecast::renderer
