@@ -32,6 +32,11 @@ bool authorized(grpc::CallbackServerContext* ctx, const std::string& token) {
   return diff == 0;
 }
 
+// An edge that has not yet heard from its producer: another edge may have (the client moves on).
+grpc::Status notReady() {
+  return grpc::Status(grpc::StatusCode::UNAVAILABLE, "no volume yet: this edge has not heard from its producer");
+}
+
 class RejectReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage> {
  public:
   explicit RejectReactor(const grpc::Status& status) { Finish(status); }
@@ -97,6 +102,11 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   // Called by the hub's wake-up with the link locked.
   void tryWriteLocked() {
     if (writing_ || finished_ || pendingFinish_ || !id_) return;
+    if (hub_.streamEnded(id_)) {  // an edge whose producer restarted: what we sent belongs to another epoch
+      finishLocked(grpc::Status(grpc::StatusCode::ABORTED, "the stream epoch changed (the producer restarted); "
+                                                           "subscribe again"));
+      return;
+    }
     if (framesSinceStats_ >= kFramesPerStats) {  // a Stats message every kFramesPerStats frames
       framesSinceStats_ = 0;
       const SubscriberStats st = hub_.stats(id_);
@@ -158,11 +168,13 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     if (h.protocol_version() != kProtocolVersion)
       return invalid("protocol version " + std::to_string(h.protocol_version()) + " not supported (server speaks " +
                      std::to_string(kProtocolVersion) + ")");
-    const auto repr = static_cast<uint8_t>(hub_.layout().repr);
+    if (!hub_.ready()) return notReady();
+    const StreamLayout layout = hub_.layout();
+    const auto repr = static_cast<uint8_t>(layout.repr);
     if (h.representation() != pb::REPRESENTATION_UNSPECIFIED && static_cast<uint8_t>(h.representation()) != repr)
       return invalid("representation " + pb::Representation_Name(h.representation()) + " is not served (this server "
                      "streams " + pb::Representation_Name(static_cast<pb::Representation>(repr)) + ")");
-    const uint32_t bricks = brickCount(hub_.layout());
+    const uint32_t bricks = brickCount(layout);
     if (static_cast<uint32_t>(h.held_size()) > bricks) return invalid("more held bricks than the volume has");
     std::vector<HeldBrick> held;
     for (const auto& b : h.held()) {
@@ -184,7 +196,8 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
     out_.Clear();
-    volumeToWire(hub_.layout(), hub_.bounds(), hub_.epoch(), *out_.mutable_volume());
+    const bus::Volume v = hub_.volume();
+    volumeToWire(v.layout, v.bounds, v.epoch, *out_.mutable_volume());
     writing_ = true;
     StartWrite(&out_);  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
@@ -236,7 +249,12 @@ class Service final : public pb::ProbeStream::CallbackService {
       reactor->Finish(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
       return reactor;
     }
-    volumeToWire(hub_.layout(), hub_.bounds(), hub_.epoch(), *response);
+    if (!hub_.ready()) {
+      reactor->Finish(notReady());
+      return reactor;
+    }
+    const bus::Volume v = hub_.volume();
+    volumeToWire(v.layout, v.bounds, v.epoch, *response);
     reactor->Finish(grpc::Status::OK);
     return reactor;
   }
