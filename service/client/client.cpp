@@ -45,7 +45,7 @@ struct ProbeClient::Impl {
     return s && s->Write(m);
   }
 
-  std::shared_ptr<grpc::Channel> channel() const {
+  std::shared_ptr<grpc::Channel> channel(const std::string& address) const {
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(256 << 20);
     std::shared_ptr<grpc::ChannelCredentials> creds;
@@ -57,10 +57,10 @@ struct ProbeClient::Impl {
     } else {
       creds = grpc::InsecureChannelCredentials();
     }
-    return grpc::CreateCustomChannel(config.address, creds, args);
+    return grpc::CreateCustomChannel(address, creds, args);
   }
 
-  void onVolume(const pb::VolumeDescription& v) {
+  void onVolume(const pb::VolumeDescription& v, const std::string& address) {
     StreamLayout l;
     GridBounds b;
     std::string why;
@@ -80,6 +80,7 @@ struct ProbeClient::Impl {
     epoch = v.stream_epoch();
     stats.connected = true;
     stats.connects += 1;
+    stats.address = address;
   }
 
   // Returns false when the connection should be dropped (the server and we disagree on state).
@@ -98,6 +99,8 @@ struct ProbeClient::Impl {
     }
     stats.framesApplied += 1;
     stats.bytesReceived += f.payload().size();
+    stats.keyframesReceived += f.keyframes();
+    stats.deltasReceived += f.deltas();
     const uint64_t now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
                                                    std::chrono::system_clock::now().time_since_epoch())
                                                    .count());
@@ -128,11 +131,15 @@ struct ProbeClient::Impl {
   }
 
   void run() {
+    const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
+                                                                      : config.addresses;
+    size_t at = 0;
+    size_t failedInTurn = 0;  // servers tried since the last one that answered
     int backoff = config.reconnectMinMs;
     while (!stopping) {
       grpc::ClientContext ctx;
       if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
-      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel());
+      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel(servers[at]));
       std::unique_ptr<Stream> rw = stub->Subscribe(&ctx);
       {
         std::lock_guard<std::mutex> lock(mutex);
@@ -153,8 +160,9 @@ struct ProbeClient::Impl {
       bool gotVolume = false;
       while (rw->Read(&msg)) {
         if (msg.has_volume()) {
-          onVolume(msg.volume());
+          onVolume(msg.volume(), servers[at]);
           gotVolume = true;
+          failedInTurn = 0;
           backoff = config.reconnectMinMs;
         } else if (msg.has_stats()) {
           std::lock_guard<std::mutex> lock(mutex);
@@ -180,19 +188,31 @@ struct ProbeClient::Impl {
         context = nullptr;
       }
       const grpc::Status status = rw->Finish();
+      const auto code = status.error_code();
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
-        if (!status.ok() && !stopping) stats.lastError = status.error_message();
-        const auto code = status.error_code();
+        if (!status.ok() && !stopping) stats.lastError = servers[at] + ": " + status.error_message();
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {
           stats.fatal = true;
           return;  // retrying would be refused the same way
         }
       }
-      (void)gotVolume;
       if (stopping) return;
+      // ABORTED: the server's stream epoch changed (its producer restarted); subscribe there
+      // again at once. Anything else (unavailable, a dead connection): the next server, at once,
+      // until every one has failed in turn; then back off.
+      if (code == grpc::StatusCode::ABORTED && gotVolume) continue;
+      const bool moved = servers.size() > 1 && code != grpc::StatusCode::ABORTED;
+      if (moved) {
+        at = (at + 1) % servers.size();
+        std::lock_guard<std::mutex> lock(mutex);
+        stats.failovers += 1;
+      }
+      if (!gotVolume) ++failedInTurn;
+      if (moved && failedInTurn < servers.size()) continue;
+      failedInTurn = 0;
       std::unique_lock<std::mutex> lock(mutex);
       wakeup.wait_for(lock, std::chrono::milliseconds(backoff), [&] { return stopping.load(); });
       backoff = std::min(backoff * 2, config.reconnectMaxMs);

@@ -129,6 +129,7 @@ BrickVersionBytes ProbeHub::versionBytes(uint32_t brick) {
   v.brick = brick;
   v.version = e.brickVersion(brick);
   v.producerFrame = frame_;
+  v.publishedUs = publishedUs_;
   v.change = e.brickChange(brick);
   const std::span<const uint8_t> key = e.keyframeSection(brick), delta = e.deltaSection(brick);
   v.keyframe.assign(key.begin(), key.end());

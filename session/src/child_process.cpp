@@ -81,6 +81,10 @@ bool ChildProcess::readLine(std::string& line) {
   return true;
 }
 
+void ChildProcess::signal(int sig) {
+  if (pid_ > 0) kill(pid_, sig);
+}
+
 int ChildProcess::wait() {
   if (pid_ <= 0) return -1;
   int status = 0;

@@ -27,6 +27,8 @@ class ChildProcess {
   bool readLine(std::string& line);
   // Waits for the child to end; its exit status (-1 when it did not exit normally).
   int wait();
+  // Sends the child a signal (SIGKILL: it dies as a crashed machine would); nothing once it has been waited for.
+  void signal(int sig);
 
  private:
   pid_t pid_ = -1;

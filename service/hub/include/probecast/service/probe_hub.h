@@ -46,6 +46,7 @@ struct BrickVersionBytes {
   uint32_t brick = 0;
   uint32_t version = 0;
   uint32_t producerFrame = 0;
+  uint64_t publishedUs = 0;  // when the lighting of this version was published (wall clock)
   float change = 0.0f;
   std::vector<uint8_t> keyframe, delta;
 };
