@@ -21,6 +21,7 @@ std::atomic<bool> gInterrupted{false};
 struct ServeOptions {
   TracingOptions tracing;
   std::string probes, repr = "zh3", listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
+  std::string publish, stream = "probes";
   bool plaintext = false;
   int brick = 4, deadzone = 1;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
@@ -92,6 +93,9 @@ void addServeCommand(CLI::App& app) {
   serve->add_flag("--plaintext", o->plaintext, "serve without TLS (trusted networks only)");
   serve->add_option("--token", o->token, "bearer token every call must present");
   serve->add_option("--token-file", o->tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
+  CLI::Option* publish =
+      serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
+  serve->add_option("--stream", o->stream, "the volume's name on the bus (letters, digits, - and _)")->needs(publish);
   serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
   serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
@@ -103,6 +107,14 @@ void addServeCommand(CLI::App& app) {
     std::string what;
     const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what);
     const int port = producer->serve(sc);
+    if (!o->publish.empty()) {
+      service::BusConfig bus;
+      bus.url = o->publish;
+      bus.stream = o->stream;
+      producer->publishTo(bus);
+      fmt::print("serve: publishing to {} as stream {} (subjects {})\n", bus.url, service::busStreamName(bus.stream),
+                 service::busSubjects(bus.stream));
+    }
     fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}\n", what, port,
                sc.tlsCertPem.empty() ? "plaintext" : "TLS", representationName(hc.layout.repr), hc.layout.grid[0],
                hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file");
@@ -117,8 +129,13 @@ void addServeCommand(CLI::App& app) {
     double lastReport = 0.0;
     producer->run(pacing, &gInterrupted, [&](double seconds) {
       if (seconds - lastReport < 5.0) return;
-      fmt::print("serve: {:.0f} s, {} updates, {} subscribers\n", seconds, producer->stats().updates,
-                 producer->hub().subscriberCount());
+      const service::PublisherStats bus = producer->busStats();
+      fmt::print("serve: {:.0f} s, {} updates, {} subscribers{}\n", seconds, producer->stats().updates,
+                 producer->hub().subscriberCount(),
+                 o->publish.empty() ? std::string()
+                                    : fmt::format(", bus {} ({} messages, {} bytes{})",
+                                                  bus.connected ? "connected" : "away", bus.messages, bus.bytes,
+                                                  bus.lastError.empty() ? "" : ", last error: " + bus.lastError));
       std::fflush(stdout);
       lastReport = seconds;
     });
@@ -136,7 +153,7 @@ void addSubscribeCommand(CLI::App& app) {
     double seconds = 5.0;
   };
   auto so = std::make_shared<SubOptions>();
-  so->connection.add(sub, "server address host:port", true, true);
+  so->connection.add(sub, "server address host:port (several comma-separated: edges to fail over between)", true, true);
   sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
   sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
   sub->add_option("--out", so->out, "write the received volume here (probe volume file)");

@@ -63,7 +63,7 @@ struct BusPublisher::Impl {
   }
 
   // Publishes the batch (and the volume first when `withVolume`), then waits for every acknowledgement.
-  bool publish(const std::map<uint32_t, BrickVersionBytes>& batch, bool withVolume, uint64_t& bytes, uint64_t& count,
+  bool publish(const std::map<uint32_t, BrickVersionBytes>& batch, bool withVolume, PublisherStats& sent,
                std::string& why) {
     bus::Volume volume = hub.volume();
     std::vector<uint8_t> message;
@@ -74,8 +74,8 @@ struct BusPublisher::Impl {
       const natsStatus s = js_PublishAsync(link->jetStream(), subject.c_str(), message.data(),
                                            static_cast<int>(message.size()), &po);
       if (s != NATS_OK) return why = "publish on " + subject + ": " + natsErrorText(s), false;
-      bytes += message.size();
-      ++count;
+      sent.bytes += message.size();
+      ++sent.messages;
       return true;
     };
     if (withVolume) {
@@ -94,6 +94,8 @@ struct BusPublisher::Impl {
       volume.publishedUs = v.publishedUs;
       bus::writeBrickMessage(volume, b, --left == 0 ? bus::kEndOfBatch : 0, message);
       if (!send(brickSubject(config.stream, brick))) return false;
+      sent.keyframeBytes += v.keyframe.size();
+      sent.deltaBytes += v.delta.size();
     }
     const natsStatus s = js_PublishAsyncComplete(link->jetStream(), &po);
     if (s != NATS_OK) {
@@ -145,15 +147,17 @@ struct BusPublisher::Impl {
           auto it = batch.find(v.brick);
           if (it == batch.end() || it->second.version < v.version) batch[v.brick] = std::move(v);
         }
-      uint64_t bytes = 0, count = 0;
+      PublisherStats sent;
       std::string why;
-      const bool ok = publish(batch, all, bytes, count, why);
+      const bool ok = publish(batch, all, sent, why);
       lock.lock();
       busy = false;
       if (all) ++stats.resyncs;
       if (ok) {
-        stats.messages += count;
-        stats.bytes += bytes;
+        stats.messages += sent.messages;
+        stats.bytes += sent.bytes;
+        stats.keyframeBytes += sent.keyframeBytes;
+        stats.deltaBytes += sent.deltaBytes;
       } else {  // the stream may be gone or the server away: make sure of the stream, then send all again
         stats.lastError = why;
         needStream = true;

@@ -20,9 +20,6 @@
 extern char** environ;
 
 namespace probecast::session {
-namespace {
-
-// A port the kernel hands out for loopback now; free when returned (nats-server binds it next).
 int freeLoopbackPort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   if (fd < 0) throw std::runtime_error("socket failed");
@@ -36,6 +33,8 @@ int freeLoopbackPort() {
   if (!ok) throw std::runtime_error("no free loopback port");
   return ntohs(a.sin_port);
 }
+
+namespace {
 
 bool accepts(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);

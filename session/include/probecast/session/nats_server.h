@@ -9,6 +9,9 @@
 
 namespace probecast::session {
 
+// A loopback port free now (the kernel's pick); a server told to listen there next gets it.
+int freeLoopbackPort();
+
 class NatsServer {
  public:
   // nats-server on PATH, else in /usr/sbin or /usr/bin; empty when there is none.

@@ -37,6 +37,7 @@ struct PublisherStats {
   bool connected = false;
   uint64_t messages = 0;   // brick and volume messages the bus acknowledged
   uint64_t bytes = 0;      // their bytes
+  uint64_t keyframeBytes = 0, deltaBytes = 0;  // of which brick sections: keyframes, deltas
   uint64_t superseded = 0; // brick versions replaced by a newer one before they went out
   uint32_t resyncs = 0;    // times every brick was published again (after a reconnect or a failure)
   std::string lastError;
