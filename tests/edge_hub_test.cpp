@@ -257,5 +257,30 @@ TEST(EdgeHub, AKeyframeThatDoesNotDecodeIsRefusedAndNothingChanges) {
   EXPECT_EQ(edge.reconstruction().probes, before.probes);
 }
 
+TEST(EdgeHub, ASubscriberAheadOfALaggingEdgeIsSentNothingOlderThanItHolds) {
+  Producer p;
+  ProbeHub ahead(gridConfig(), FromBus{}), lagging(gridConfig(), FromBus{});
+  p.publish();
+  const size_t first = p.messages.size();
+  p.publish();
+  feedAll(ahead, p.messages);
+  feedAll(lagging, std::vector<std::vector<uint8_t>>(p.messages.begin(), p.messages.begin() + first));
+  const uint64_t onAhead = ahead.addSubscriber(0, 0, {}, nullptr);
+  StreamDecoder dec(ahead.layout());
+  drain(ahead, onAhead, dec);  // holds version 2 of every brick; the lagging edge has version 1
+  const uint64_t moved = lagging.addSubscriber(0, ahead.epoch(), heldBy(dec), nullptr);
+  EXPECT_FALSE(lagging.nextFrame(moved).has_value());  // an older keyframe would be refused by its decoder
+  feedAll(lagging, p.messages, first);  // the lagging edge catches up to what it holds: still nothing to send
+  EXPECT_FALSE(lagging.nextFrame(moved).has_value());
+  const size_t seen = p.messages.size();
+  p.publish();
+  feedAll(lagging, p.messages, seen);
+  const auto frame = lagging.nextFrame(moved);
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->deltas, 4u);
+  EXPECT_EQ(dec.apply(frame->payload.data(), frame->payload.size()), CodecStatus::Ok);
+  EXPECT_TRUE(same(p.hub.reconstruction(), dec.probes(), 256 * kProbeFloats));
+}
+
 }  // namespace
 }  // namespace probecast::service

@@ -120,7 +120,7 @@ void ProbeHub::publish(const float* probes, const uint8_t* active) {
 void ProbeHub::markStale(uint32_t brick) {
   const uint32_t current = source_->version(brick);
   for (auto& [id, s] : subscribers_)
-    if (!s.ended && s.held[brick] != current && s.staleSince[brick] == UINT32_MAX) s.staleSince[brick] = frame_;
+    if (!s.ended && s.held[brick] < current && s.staleSince[brick] == UINT32_MAX) s.staleSince[brick] = frame_;
 }
 
 BrickVersionBytes ProbeHub::versionBytes(uint32_t brick) {
@@ -240,9 +240,12 @@ uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, 
   s.staleSince.assign(bricks, UINT32_MAX);
   if (epoch == epoch_)
     for (const HeldBrick& h : held)
-      if (h.brick < bricks && h.version <= source_->version(h.brick)) s.held[h.brick] = h.version;
+      // On an edge a subscriber may come from a faster edge and hold versions this one has yet
+      // to receive: it is sent nothing of those bricks until they move past what it holds. A
+      // producer has made every version there is, so a later one is nonsense there.
+      if (h.brick < bricks && (fromBus_ || h.version <= source_->version(h.brick))) s.held[h.brick] = h.version;
   for (uint32_t b = 0; b < bricks; ++b)
-    if (s.held[b] != source_->version(b)) s.staleSince[b] = frame_;
+    if (s.held[b] < source_->version(b)) s.staleSince[b] = frame_;
   s.wake = std::move(wake);
   const uint64_t id = nextId_++;
   subscribers_.emplace(id, std::move(s));
@@ -292,7 +295,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
   uint32_t behind = 0;
   for (uint32_t b = 0; b < bricks; ++b) {
     const uint32_t current = source_->version(b);
-    if (s.held[b] == current) continue;
+    if (s.held[b] >= current) continue;  // current, or ahead of a lagging edge
     ++behind;
     BrickCandidate& c = candidates_[b];
     c.change = std::max(source_->changeSince(b, s.held[b]), 1e-3f);
