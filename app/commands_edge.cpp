@@ -67,7 +67,7 @@ void addEdgeCommand(CLI::App& app) {
     ec.server = o->server.config();
     ec.server.maxSubscribers = o->maxSubscribers;
     std::string why;
-    orThrow(service::checkBusConfig(ec.bus, why), why);
+    if (!service::checkBusConfig(ec.bus, why)) throw std::runtime_error("--nats/--stream: " + why);
     service::EdgeServer server(ec);
     fmt::print("edge: stream {} from {} on port {} ({})\n", service::busStreamName(ec.bus.stream), ec.bus.url,
                server.port(), ec.server.tlsCertPem.empty() ? "plaintext" : "TLS");

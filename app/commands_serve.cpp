@@ -101,6 +101,11 @@ void addServeCommand(CLI::App& app) {
   serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
   serve->callback([o] {
     const service::ServerConfig sc = serverConfig(*o);
+    service::BusConfig bus;
+    bus.url = o->publish;
+    bus.stream = o->stream;
+    std::string why;
+    if (!o->publish.empty() && !service::checkBusConfig(bus, why)) throw std::runtime_error("--publish/--stream: " + why);
     ProbeVolume file;
     std::unique_ptr<renderer::VulkanContext> context;
     service::HubConfig hc;
@@ -108,9 +113,6 @@ void addServeCommand(CLI::App& app) {
     const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what);
     const int port = producer->serve(sc);
     if (!o->publish.empty()) {
-      service::BusConfig bus;
-      bus.url = o->publish;
-      bus.stream = o->stream;
       producer->publishTo(bus);
       fmt::print("serve: publishing to {} as stream {} (subjects {})\n", bus.url, service::busStreamName(bus.stream),
                  service::busSubjects(bus.stream));
@@ -129,13 +131,13 @@ void addServeCommand(CLI::App& app) {
     double lastReport = 0.0;
     producer->run(pacing, &gInterrupted, [&](double seconds) {
       if (seconds - lastReport < 5.0) return;
-      const service::PublisherStats bus = producer->busStats();
+      const service::PublisherStats sent = producer->busStats();
       fmt::print("serve: {:.0f} s, {} updates, {} subscribers{}\n", seconds, producer->stats().updates,
                  producer->hub().subscriberCount(),
                  o->publish.empty() ? std::string()
                                     : fmt::format(", bus {} ({} messages, {} bytes{})",
-                                                  bus.connected ? "connected" : "away", bus.messages, bus.bytes,
-                                                  bus.lastError.empty() ? "" : ", last error: " + bus.lastError));
+                                                  sent.connected ? "connected" : "away", sent.messages, sent.bytes,
+                                                  sent.lastError.empty() ? "" : ", last error: " + sent.lastError));
       std::fflush(stdout);
       lastReport = seconds;
     });
