@@ -14,19 +14,8 @@
 namespace probecast::service {
 namespace {
 
-HubConfig gridConfig() {
-  // 16 × 4 × 4 probes in bricks of 4: four bricks.
-  HubConfig c;
-  c.layout.grid[0] = 16;
-  c.layout.grid[1] = 4;
-  c.layout.grid[2] = 4;
-  c.layout.brickDim = 4;
-  c.layout.repr = Representation::Zh3;
-  c.bounds.max[0] = 15;
-  c.bounds.max[1] = 3;
-  c.bounds.max[2] = 3;
-  return c;
-}
+// 16 × 4 × 4 probes 1 m apart in bricks of 4: four bricks.
+HubConfig gridConfig() { return hubConfigFor(ProbeGrid{{16, 4, 4}, {{0, 0, 0}, {15, 3, 3}}}, Representation::Zh3); }
 
 // A producer's hub whose bus output is kept as encoded messages.
 struct Producer {
@@ -40,15 +29,8 @@ struct Producer {
     });
   }
   std::vector<uint8_t> encode(const BrickVersionBytes& v, bool last) const {
-    bus::Brick b;
-    b.brick = v.brick;
-    b.version = v.version;
-    b.producerFrame = v.producerFrame;
-    b.change = v.change;
-    b.keyframe = v.keyframe;
-    b.delta = v.delta;
     std::vector<uint8_t> out;
-    bus::writeBrickMessage(hub.volume(), b, last ? bus::kEndOfBatch : 0, out);
+    bus::writeBrickMessage(hub.volume(), busBrick(v), last ? bus::kEndOfBatch : 0, out);
     return out;
   }
   void publish() { hub.publish(test::movingLightFrame(256, 10 * frame++, 0.01f, rng).data(), nullptr); }

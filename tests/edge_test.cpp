@@ -24,20 +24,9 @@ using namespace std::chrono_literals;
 
 constexpr char kToken[] = "edge-token";
 
+// 16 × 4 × 16 probes in bricks of 4 (16 bricks), the moving-light generator's layout.
 HubConfig volumeConfig() {
-  // 16 × 4 × 16 probes in bricks of 4: 16 bricks.
-  HubConfig c;
-  c.layout.grid[0] = 16;
-  c.layout.grid[1] = 4;
-  c.layout.grid[2] = 16;
-  c.layout.brickDim = 4;
-  c.layout.repr = Representation::Zh3;
-  c.bounds.min[0] = -2.0f;
-  c.bounds.max[0] = 1.5f;
-  c.bounds.max[1] = 1.5f;
-  c.bounds.min[2] = -2.0f;
-  c.bounds.max[2] = 5.5f;
-  return c;
+  return hubConfigFor(ProbeGrid{{16, 4, 16}, {{-2.0f, 0.0f, -2.0f}, {1.5f, 1.5f, 5.5f}}}, Representation::Zh3);
 }
 
 template <typename Pred>
@@ -129,14 +118,19 @@ TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyfra
   Producer producer(bus);
   auto a = std::make_unique<EdgeServer>(edgeConfig());
   EdgeServer b(edgeConfig());
-  const std::string onB = "127.0.0.1:" + std::to_string(b.port());
+  const std::string onA = "127.0.0.1:" + std::to_string(a->port()), onB = "127.0.0.1:" + std::to_string(b.port());
+  producer.publish(1);  // edges without a volume answer UNAVAILABLE: the clients would start elsewhere
+  ASSERT_TRUE(waitFor([&] { return a->hub().ready() && b.hub().ready(); }, 10s));
   std::vector<std::unique_ptr<ProbeClient>> clients;
   for (int i = 0; i < 4; ++i) {
     clients.push_back(std::make_unique<ProbeClient>(clientFor({a->port(), b.port()})));
     clients.back()->start();
   }
   producer.publish(20);
-  for (auto& c : clients) ASSERT_TRUE(waitFor([&] { return matches(*c, producer.hub); }, 10s));
+  for (auto& c : clients) {
+    ASSERT_TRUE(waitFor([&] { return matches(*c, producer.hub); }, 10s));
+    ASSERT_EQ(c->stats().address, onA);
+  }
   // What a subscriber that holds nothing needs: every brick's keyframe.
   ProbeHub& hub = producer.hub;
   const uint64_t fresh = hub.addSubscriber(0, 0, {}, nullptr);

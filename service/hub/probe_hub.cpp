@@ -29,6 +29,17 @@ bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBoun
 
 }  // namespace
 
+bus::Brick busBrick(const BrickVersionBytes& v) {
+  bus::Brick b;
+  b.brick = v.brick;
+  b.version = v.version;
+  b.producerFrame = v.producerFrame;
+  b.change = v.change;
+  b.keyframe = v.keyframe;
+  b.delta = v.delta;
+  return b;
+}
+
 ProbeHub::ProbeHub(const HubConfig& config) : config_(config), epoch_(randomEpoch()) {
   auto source = std::make_unique<EncoderBricks>(config.layout, config.encoder);
   encoder_ = source.get();

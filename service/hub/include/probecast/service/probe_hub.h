@@ -51,6 +51,9 @@ struct BrickVersionBytes {
   std::vector<uint8_t> keyframe, delta;
 };
 
+// The bus message fields of a version (its sections view `v`).
+bus::Brick busBrick(const BrickVersionBytes& v);
+
 // Tag of an edge's hub, fed from the bus.
 struct FromBus {};
 
