@@ -167,7 +167,7 @@ struct BusPublisher::Impl {
   }
 };
 
-BusPublisher::BusPublisher(const BusConfig& config, ProbeHub& hub) : impl_(std::make_unique<Impl>(config, hub)) {
+BusPublisher::BusPublisher(const BusConfig& config, ProbeHub& hub) : impl_(std::make_shared<Impl>(config, hub)) {
   std::string why;
   if (!checkBusConfig(config, why)) throw std::invalid_argument(why);
   Impl& s = *impl_;
@@ -180,14 +180,14 @@ BusPublisher::BusPublisher(const BusConfig& config, ProbeHub& hub) : impl_(std::
       },
       [&s] { s.wake.notify_all(); }, &Impl::refused, &s);
   s.worker = std::thread([&s] { s.run(); });
-  hub.setBusOutput([&s](std::vector<BrickVersionBytes> made) {
-    std::lock_guard<std::mutex> lock(s.mutex);
-    for (BrickVersionBytes& v : made) {
-      auto [it, fresh] = s.pending.insert_or_assign(v.brick, std::move(v));
-      if (!fresh) ++s.stats.superseded;
-      (void)it;
-    }
-    s.wake.notify_all();
+  hub.setBusOutput([weak = std::weak_ptr<Impl>(impl_)](std::vector<BrickVersionBytes> made) {
+    const std::shared_ptr<Impl> self = weak.lock();
+    if (!self) return;
+    std::lock_guard<std::mutex> lock(self->mutex);
+    if (self->stopping) return;
+    for (BrickVersionBytes& v : made)
+      if (!self->pending.insert_or_assign(v.brick, std::move(v)).second) ++self->stats.superseded;
+    self->wake.notify_all();
   });
 }
 

@@ -53,7 +53,9 @@ class BusPublisher {
  public:
   // Throws std::invalid_argument for a bad config (checkBusConfig). The hub must outlive this.
   BusPublisher(const BusConfig& config, ProbeHub& hub);
-  ~BusPublisher();  // detaches from the hub, stops, closes the connection
+  // Detaches from the hub, stops, closes the connection (a publish running meanwhile on another
+  // thread hands its versions to nothing).
+  ~BusPublisher();
   BusPublisher(const BusPublisher&) = delete;
   BusPublisher& operator=(const BusPublisher&) = delete;
 
@@ -63,7 +65,7 @@ class BusPublisher {
 
  private:
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::shared_ptr<Impl> impl_;  // shared with the hub's output while a publish hands it versions
 };
 
 }  // namespace probecast::service
