@@ -226,7 +226,8 @@ void addBenchStability(CLI::App* bench) {
 
 // `probecast bench stream`: the service under N subscribers.
 void addBenchStream(CLI::App* bench) {
-  CLI::App* stream = bench->add_subcommand("stream", "the service under N subscribers on loopback");
+  CLI::App* stream = bench->add_subcommand(
+      "stream", "the service under N subscribers on loopback: server and light load clients in processes of their own");
   struct StreamOptions {
     std::string json, chart;
     bench::StreamBenchOptions bench;
@@ -238,6 +239,11 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--hz", so->bench.hz, "lighting updates per second")->check(CLI::Range(0.5, 240.0));
   stream->add_option("--seconds", so->bench.seconds, "measured time per subscriber count")->check(CLI::Range(2.0, 3600.0));
   stream->add_option("--budget", so->bench.budgetBytesPerSecond, "bytes per second per subscriber (0 = unlimited)");
+  stream->add_option("--per-process", so->bench.subscribersPerLoadProcess, "subscribers per load process")
+      ->check(CLI::Range(1, 5000));
+  stream->add_option("--sample-every", so->bench.sampleEvery,
+                     "1 in this many subscribers decodes in full and is checked bit for bit")
+      ->check(CLI::Range(1, 5000));
   addRepresentationOption(stream, so->bench.repr, "l1, zh3h, zh3, l2 or fp16");
   addJsonOption(stream, so->json);
   stream->add_option("--chart", so->chart, "write an SVG chart here");
@@ -246,6 +252,7 @@ void addBenchStream(CLI::App* bench) {
     so->bench.progress = progressLine;
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
+    if (!r.failure.empty()) throw std::runtime_error("the stream was wrong: " + r.failure);
   });
 }
 

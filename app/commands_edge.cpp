@@ -15,41 +15,12 @@ namespace {
 
 std::atomic<bool> gEdgeInterrupted{false};
 
-// The edge's listening side, with the same names and checks as `serve`'s.
-struct EdgeListenOptions {
-  std::string listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
-  bool plaintext = false;
-  void add(CLI::App* cmd) {
-    cmd->add_option("--listen", listen, "address to listen on (host:port)");
-    cmd->add_option("--tls-cert", tlsCert, "PEM certificate file")->check(CLI::ExistingFile);
-    cmd->add_option("--tls-key", tlsKey, "PEM private key file")->check(CLI::ExistingFile);
-    cmd->add_flag("--plaintext", plaintext, "serve without TLS (trusted networks only)");
-    cmd->add_option("--token", token, "bearer token every call must present");
-    cmd->add_option("--token-file", tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
-  }
-  service::ServerConfig config() const {
-    service::ServerConfig sc;
-    sc.listen = listen;
-    sc.token = tokenFrom(token, tokenFile);
-    sc.plaintext = plaintext;
-    if (tlsCert.empty() != tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
-    if (!tlsCert.empty()) {
-      sc.tlsCertPem = readTextFile(tlsCert);
-      sc.tlsKeyPem = readTextFile(tlsKey);
-    } else if (!plaintext) {
-      throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
-    }
-    if (sc.token.empty()) fmt::print(stderr, "edge: warning: no --token, anyone who reaches the port may subscribe\n");
-    return sc;
-  }
-};
-
 }  // namespace
 
 void addEdgeCommand(CLI::App& app) {
   CLI::App* edge = app.add_subcommand("edge", "serve a producer's probe stream from NATS JetStream (a stateless edge)");
   struct EdgeOptions {
-    EdgeListenOptions server;
+    ServerOptions server;
     service::BusConfig bus;
     uint32_t maxSubscribers = 1024;
     double seconds = 0.0;

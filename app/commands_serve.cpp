@@ -20,29 +20,12 @@ std::atomic<bool> gInterrupted{false};
 
 struct ServeOptions {
   TracingOptions tracing;
-  std::string probes, repr = "zh3", listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
+  ServerOptions server;
+  std::string probes, repr = "zh3";
   std::string publish, stream = "probes";
-  bool plaintext = false;
   int brick = 4, deadzone = 1;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
-
-// TLS and the token, checked: TLS or an explicit --plaintext.
-service::ServerConfig serverConfig(const ServeOptions& o) {
-  service::ServerConfig sc;
-  sc.listen = o.listen;
-  sc.token = tokenFrom(o.token, o.tokenFile);
-  sc.plaintext = o.plaintext;
-  if (!o.tlsCert.empty() || !o.tlsKey.empty()) {
-    if (o.tlsCert.empty() || o.tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
-    sc.tlsCertPem = readTextFile(o.tlsCert);
-    sc.tlsKeyPem = readTextFile(o.tlsKey);
-  }
-  if (sc.tlsCertPem.empty() && !sc.plaintext)
-    throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
-  if (sc.token.empty()) fmt::print(stderr, "serve: warning: no --token, anyone who reaches the port may subscribe\n");
-  return sc;
-}
 
 // The producer of a serve: the baked file (published once, then budget ticks) or the scene traced
 // live, its t advanced by --animate per second at --hz. `hub` and `what` describe it.
@@ -87,12 +70,7 @@ void addServeCommand(CLI::App& app) {
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
   serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
       ->check(CLI::Range(0, 127));
-  serve->add_option("--listen", o->listen, "address to listen on (host:port)");
-  serve->add_option("--tls-cert", o->tlsCert, "PEM certificate file")->check(CLI::ExistingFile);
-  serve->add_option("--tls-key", o->tlsKey, "PEM private key file")->check(CLI::ExistingFile);
-  serve->add_flag("--plaintext", o->plaintext, "serve without TLS (trusted networks only)");
-  serve->add_option("--token", o->token, "bearer token every call must present");
-  serve->add_option("--token-file", o->tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
+  o->server.add(serve);
   CLI::Option* publish =
       serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
   serve->add_option("--stream", o->stream, "the volume's name on the bus (letters, digits, - and _)")->needs(publish);
@@ -100,7 +78,7 @@ void addServeCommand(CLI::App& app) {
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
   serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
   serve->callback([o] {
-    const service::ServerConfig sc = serverConfig(*o);
+    const service::ServerConfig sc = o->server.config();
     service::BusConfig bus;
     bus.url = o->publish;
     bus.stream = o->stream;

@@ -48,6 +48,9 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   viewer.waitFor(o.waitSeconds);
   viewer.stop();
   const service::ClientStats st = viewer.clientStats();
+  // A refused subscription (bad token, too many views) may have delivered part of a volume:
+  // rendering it would pass a wrong picture off as the server's.
+  if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
   service::VolumeSnapshot held;
   if (!viewer.snapshot(held))
     throw std::runtime_error("no probe volume from " + o.connection.connect + ": " + st.lastError);

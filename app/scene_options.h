@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/service/client.h"
+#include "probecast/service/server.h"
 #include "probecast/scene/scene.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/scene_loading.h"
@@ -121,13 +122,65 @@ struct TracerOptions {
   }
 };
 
-// A bearer token given inline or in a file (trailing newlines and spaces dropped).
+// A bearer token given inline or in a file, surrounding whitespace dropped. A token that is empty
+// after trimming is an error, never "no token": an empty file must not open a server to everyone.
 inline std::string tokenFrom(const std::string& token, const std::string& file) {
-  if (file.empty()) return token;
-  std::string t = readTextFile(file);
-  while (!t.empty() && (t.back() == '\n' || t.back() == '\r' || t.back() == ' ')) t.pop_back();
+  const bool fromFile = !file.empty();
+  const std::string raw = fromFile ? readTextFile(file) : token;
+  const size_t first = raw.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) {
+    if (!fromFile && token.empty()) return {};  // none given
+    throw std::runtime_error(fromFile ? "--token-file " + file + " holds no token (empty or only whitespace)"
+                                      : std::string("--token is empty or only whitespace"));
+  }
+  const std::string t = raw.substr(first, raw.find_last_not_of(" \t\r\n") + 1 - first);
+  for (char c : t)  // it travels as an HTTP/2 header value
+    if (c < 0x20 || c > 0x7e)
+      throw std::runtime_error(std::string(fromFile ? "--token-file " + file : "--token") +
+                               ": the token must be printable ASCII on one line");
   return t;
 }
+
+// The listening side of a service: --listen, TLS (--tls-cert, --tls-key) or an explicit
+// --plaintext, a bearer token (--token, --token-file) or an explicit --no-auth. Shared by the
+// commands that serve.
+struct ServerOptions {
+  std::string listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
+  bool plaintext = false, noAuth = false;
+  void add(CLI::App* cmd) {
+    cmd->add_option("--listen", listen, "address to listen on (host:port)");
+    cmd->add_option("--tls-cert", tlsCert, "PEM certificate file")->check(CLI::ExistingFile);
+    cmd->add_option("--tls-key", tlsKey, "PEM private key file")->check(CLI::ExistingFile);
+    cmd->add_flag("--plaintext", plaintext, "serve without TLS (trusted networks only)");
+    CLI::Option* t = cmd->add_option("--token", token, "bearer token every call must present");
+    CLI::Option* f =
+        cmd->add_option("--token-file", tokenFile, "file holding the bearer token")->check(CLI::ExistingFile);
+    CLI::Option* n =
+        cmd->add_flag("--no-auth", noAuth, "serve without a token: anyone who reaches the port may subscribe");
+    t->excludes(f);
+    n->excludes(t)->excludes(f);
+  }
+  // The checked configuration: TLS or --plaintext, a non-empty token or --no-auth.
+  service::ServerConfig config() const {
+    service::ServerConfig sc;
+    sc.listen = listen;
+    sc.token = tokenFrom(token, tokenFile);
+    sc.noAuth = noAuth;
+    sc.plaintext = plaintext;
+    if (!tlsCert.empty() || !tlsKey.empty()) {
+      if (tlsCert.empty() || tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
+      sc.tlsCertPem = readTextFile(tlsCert);
+      sc.tlsKeyPem = readTextFile(tlsKey);
+    }
+    if (sc.tlsCertPem.empty() && !sc.plaintext)
+      throw std::runtime_error("give --tls-cert and --tls-key, or --plaintext to serve without TLS");
+    if (sc.noAuth && !sc.token.empty()) throw std::runtime_error("--no-auth and a token contradict each other");
+    if (!sc.noAuth && sc.token.empty())
+      throw std::runtime_error(
+          "give --token or --token-file, or --no-auth to let anyone who reaches the port subscribe");
+    return sc;
+  }
+};
 
 // A client's connection to a server: --connect, --token (and --token-file), --tls-ca, --tls-name.
 struct ConnectOptions {

@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cinttypes>
 #include <cstdio>
 #include <chrono>
 #include <cmath>
@@ -12,7 +13,7 @@
 
 #include <fmt/format.h>
 
-#include "probecast/service/client.h"
+#include "load_client.h"
 #include "probecast/service/server.h"
 #include "probecast/session/child_process.h"
 #include "probecast/session/probe_producer.h"
@@ -24,7 +25,7 @@ namespace probecast::bench {
 namespace {
 
 using namespace std::chrono_literals;
-using session::percentile;
+constexpr const char* kBenchToken = "bench";  // the server requires one; loopback only
 
 double cpuSeconds() {
   rusage u{};
@@ -60,44 +61,137 @@ void lightingFrame(int frame, std::vector<float>& probes) {
 
 namespace {
 
-struct ServerReport {
+// What the server side of a run is made of; the direct topology is one server process, and a
+// relayed one (an origin, a message bus, edges) adds processes whose CPU and memory count too.
+struct ProcessSample {
   double cpuSeconds = 0;
-  double encodeMsPerFrame = 0;
-  int frames = 0;
+  double rssKb = 0;
 };
 
-// The server side, in a process of its own: a producer of lighting frames served for `seconds`;
-// says "port N", then "report CPU_SECONDS ENCODE_MS_PER_FRAME FRAMES".
-int serveLightingFrames(double hz, double seconds, const std::string& repr, const session::ChildProcess::Say& say) {
+uint64_t rssKb() {
+  FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return 0;
+  char line[256];
+  uint64_t kb = 0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "VmRSS: %" SCNu64, &kb) == 1) break;
+  std::fclose(f);
+  return kb;
+}
+
+std::string sampleLine() { return fmt::format("sample {:.6f} {}", cpuSeconds(), rssKb()); }
+
+// A child's answer to `command`: its next line, which must start with `expect`; the rest of it.
+std::string ask(session::ChildProcess& child, const std::string& command, const std::string& expect,
+                const std::string& who) {
+  std::string line;
+  if (!child.tell(command) || !child.readLine(line))
+    throw std::runtime_error(who + " ended before answering '" + command + "'");
+  if (line.rfind(expect + " ", 0) != 0 && line != expect)
+    throw std::runtime_error(who + " answered '" + command + "' with '" + line.substr(0, 200) + "'");
+  return line.size() > expect.size() ? line.substr(expect.size() + 1) : std::string();
+}
+
+ProcessSample parseSample(const std::string& text, const std::string& who) {
+  ProcessSample s;
+  if (std::sscanf(text.c_str(), "%lf %lf", &s.cpuSeconds, &s.rssKb) != 2)
+    throw std::runtime_error(who + " sent a bad sample: " + text);
+  return s;
+}
+
+// The server process: a producer of lighting frames at `hz`, served over gRPC, driven by the
+// parent's commands (sample, latency, stop, quit) so that baseline and load are measured apart.
+int serveLightingFrames(double hz, const std::string& repr, const session::ChildProcess::Say& say,
+                        const session::ChildProcess::Hear& hear) {
   session::ProbeProducer producer(service::hubConfigFor(
       session::unitGrid({kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]}),
       parseRepresentation(repr).value_or(Representation::Zh3), 4, 1));
   service::ServerConfig sc;
   sc.plaintext = true;
-  sc.token = "bench";
+  sc.token = kBenchToken;
   sc.maxSubscribers = 100000;
   say(fmt::format("port {}", producer.serve(sc)));
-  const double cpu0 = cpuSeconds();
   producer.generate([](uint32_t frame, std::vector<float>& probes) { lightingFrame(static_cast<int>(frame), probes); });
   session::Pacing pacing;
   pacing.mode = session::Pacing::Mode::FixedRate;
   pacing.hz = hz;
-  pacing.seconds = seconds;
-  producer.run(pacing);
-  producer.shutdownServer();
-  const session::ProducerStats st = producer.stats();
-  say(fmt::format("report {:.6f} {:.6f} {}", cpuSeconds() - cpu0, st.publishMs / std::max<double>(st.updates, 1),
-                  st.updates));
-  return 0;
+  producer.start(pacing, [&say](const std::string& error) { say("error " + error); });
+  for (std::string command; hear(command);) {
+    if (command == "sample") {
+      say(sampleLine());
+    } else if (command == "latency") {
+      say("latency " + producer.server()->takeFrameWriteLatency().toText());
+    } else if (command == "stop") {  // the lighting holds still: subscribers converge to it
+      producer.stop();
+      const ProbeVolume v = producer.hub().reconstruction();
+      const session::ProducerStats st = producer.stats();
+      say(fmt::format("final {} {} {:.6f}", volumeHash(v.probes.data(), v.active.data(), v.count()), st.updates,
+                      st.publishMs / std::max<double>(st.updates, 1)));
+    } else if (command == "quit") {
+      producer.stop();
+      producer.shutdownServer();
+      return 0;
+    } else {
+      say("unknown command " + command);
+    }
+  }
+  return 1;  // the parent went away
 }
 
-}  // namespace
+struct LoadReport {
+  ProcessSample process;
+  LoadFigures figures;
+};
 
-namespace {
+// A load process: `config`'s subscribers, driven by the parent's commands (take, check, quit).
+int runLoad(const LoadClientConfig& config, const session::ChildProcess::Say& say,
+            const session::ChildProcess::Hear& hear) {
+  LoadClient load(config);
+  load.start();
+  say(fmt::format("connected {}", load.waitConnected(std::chrono::seconds(20))));
+  for (std::string command; hear(command);) {
+    if (command == "take") {
+      const LoadFigures f = load.take();
+      say(fmt::format("figures {:.6f} {} {} {} {} {} {} {} | {} | {}", cpuSeconds(), rssKb(), f.frames, f.bytes,
+                      f.sequenceErrors, f.crcErrors, f.decodeErrors, f.streamErrors, f.latency.toText(),
+                      f.lastError));
+    } else if (command.rfind("check ", 0) == 0) {
+      const SampleCheck c = load.checkSamples(std::stoull(command.substr(6)), std::chrono::seconds(10));
+      say(fmt::format("samples {} {}", c.sampled, c.identical));
+    } else if (command == "quit") {
+      load.stop();
+      return 0;
+    } else {
+      say("unknown command " + command);
+    }
+  }
+  return 1;
+}
+
+LoadReport parseFigures(const std::string& text, const std::string& who) {
+  LoadReport r;
+  LoadFigures& f = r.figures;
+  const size_t bar1 = text.find(" | "), bar2 = bar1 == std::string::npos ? bar1 : text.find(" | ", bar1 + 3);
+  unsigned long long n[6];
+  if (bar2 == std::string::npos ||
+      std::sscanf(text.c_str(), "%lf %lf %llu %llu %llu %llu %llu %llu", &r.process.cpuSeconds, &r.process.rssKb,
+                  &n[0], &n[1], &n[2], &n[3], &n[4], &n[5]) != 8 ||
+      !service::LatencyHistogram::fromText(text.substr(bar1 + 3, bar2 - bar1 - 3), f.latency))
+    throw std::runtime_error(who + " sent bad figures: " + text.substr(0, 200));
+  f.frames = n[0];
+  f.bytes = n[1];
+  f.sequenceErrors = n[2];
+  f.crcErrors = n[3];
+  f.decodeErrors = n[4];
+  f.streamErrors = n[5];
+  f.lastError = text.substr(bar2 + 3);
+  return r;
+}
 
 // A top-down orthographic view of an 8 m patch from 20 m up: clip x = (x − cx)/4,
 // clip y = (z − cz)/4, clip z = (20 − y)/30 (column-major, m[col * 4 + row]).
-View randomView(std::mt19937& rng) {
+View randomView(uint32_t index) {
+  std::mt19937 rng(7 + index);
   std::uniform_real_distribution<float> u(0.0f, 31.0f);
   const float cx = u(rng), cz = u(rng), h = 4.0f;
   View v{};
@@ -114,94 +208,219 @@ View randomView(std::mt19937& rng) {
   return v;
 }
 
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The server side of a run: its processes and the addresses subscribers connect to.
+struct Topology {
+  std::vector<std::unique_ptr<session::ChildProcess>> servers;
+  std::vector<std::string> addresses;
+};
+
+// One server, subscribers connected straight to it.
+Topology directTopology(const StreamBenchOptions& o) {
+  Topology t;
+  t.servers.push_back(std::make_unique<session::ChildProcess>(
+      [&o](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
+        return serveLightingFrames(o.hz, o.repr, say, hear);
+      }));
+  t.servers.back()->go();
+  std::string line;
+  int port = 0;
+  if (!t.servers.back()->readLine(line) || std::sscanf(line.c_str(), "port %d", &port) != 1)
+    throw std::runtime_error("server process did not start");
+  t.addresses.push_back("127.0.0.1:" + std::to_string(port));
+  return t;
+}
+
+ProcessSample sampleAll(std::vector<std::unique_ptr<session::ChildProcess>>& processes, const std::string& who) {
+  ProcessSample total;
+  for (auto& p : processes) {
+    const ProcessSample s = parseSample(ask(*p, "sample", "sample", who), who);
+    total.cpuSeconds += s.cpuSeconds;
+    total.rssKb += s.rssKb;
+  }
+  return total;
+}
+
+service::LatencyHistogram takeWriteLatency(Topology& t) {
+  service::LatencyHistogram all;
+  for (auto& p : t.servers) {
+    service::LatencyHistogram h;
+    if (!service::LatencyHistogram::fromText(ask(*p, "latency", "latency", "server"), h))
+      throw std::runtime_error("server sent a bad latency histogram");
+    all.merge(h);
+  }
+  return all;
+}
+
+LoadReport takeAll(std::vector<std::unique_ptr<session::ChildProcess>>& loads) {
+  LoadReport total;
+  for (auto& l : loads) {
+    const LoadReport r = parseFigures(ask(*l, "take", "figures", "load process"), "load process");
+    total.process.cpuSeconds += r.process.cpuSeconds;
+    total.process.rssKb += r.process.rssKb;
+    LoadFigures& f = total.figures;
+    f.frames += r.figures.frames;
+    f.bytes += r.figures.bytes;
+    f.sequenceErrors += r.figures.sequenceErrors;
+    f.crcErrors += r.figures.crcErrors;
+    f.decodeErrors += r.figures.decodeErrors;
+    f.streamErrors += r.figures.streamErrors;
+    f.latency.merge(r.figures.latency);
+    if (!r.figures.lastError.empty()) f.lastError = r.figures.lastError;
+  }
+  return total;
+}
+
 }  // namespace
 
 StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
   };
-  nlohmann::json runs = nlohmann::json::array();
-  imaging::ChartSeries bytesSeries{"bytes/s per subscriber (mean)", {}, true};
-  imaging::ChartSeries cpuSeries{"server CPU ms/s per subscriber", {}, true};
-  std::string table = fmt::format("{:>6} {:>16} {:>16} {:>12} {:>12} {:>16} {:>14}\n", "subs", "B/s/sub mean",
-                                  "B/s/sub p99", "lat p50 ms", "lat p99 ms", "server CPU %/sub", "encode ms/frm");
   for (int n : o.subscribers)
     if (n < 1) throw std::invalid_argument("subscriber counts must be positive");
-  const double serverSeconds = o.seconds + 2.0;  // margin for connecting
-  // One server process per run, all forked now, before this process starts gRPC.
-  std::vector<std::unique_ptr<session::ChildProcess>> servers;
-  for (size_t k = 0; k < o.subscribers.size(); ++k)
-    servers.push_back(std::make_unique<session::ChildProcess>(
-        [&o, serverSeconds](const session::ChildProcess::Say& tell) {
-          return serveLightingFrames(o.hz, serverSeconds, o.repr, tell);
-        }));
-  for (size_t k = 0; k < o.subscribers.size(); ++k) {
-    const int n = o.subscribers[k];
-    session::ChildProcess& server = *servers[k];
-    server.go();
-    int port = 0;
-    std::string line;
-    if (!server.readLine(line) || std::sscanf(line.c_str(), "port %d", &port) != 1)
-      throw std::runtime_error("server process did not start");
-    say(fmt::format("{} subscribers on port {}, {:.0f} s at {} Hz", n, port, o.seconds, o.hz));
-    std::mt19937 rng(7);
-    std::vector<std::unique_ptr<service::ProbeClient>> clients;
-    for (int i = 0; i < n; ++i) {
-      service::ClientConfig cc;
-      cc.address = "127.0.0.1:" + std::to_string(port);
-      cc.token = "bench";
-      cc.budgetBytesPerSecond = o.budgetBytesPerSecond;
-      clients.push_back(std::make_unique<service::ProbeClient>(cc));
-      clients.back()->setViews({randomView(rng)});
-      clients.back()->start();
+  if (o.subscribersPerLoadProcess < 1 || o.sampleEvery < 1)
+    throw std::invalid_argument("subscribers per load process and the sampling interval must be positive");
+  nlohmann::json runs = nlohmann::json::array();
+  imaging::ChartSeries p50Series{"produce → receive p50", {}, true};
+  imaging::ChartSeries p99Series{"produce → receive p99", {}, true};
+  imaging::ChartSeries writeSeries{"server publish → write-done p99", {}, true};
+  std::string table = fmt::format("{:>6} {:>9} {:>8} {:>8} {:>8} {:>9} {:>9} {:>8} {:>10} {:>8} {:>9} {:>10} {:>8} {:>7}\n",
+                                  "subs", "frm/s/sub", "p50 ms", "p99 ms", "max ms", "wr p50", "wr p99", "srv cpu",
+                                  "cpu/sub", "rss MB", "KB/sub", "B/s/sub", "load cpu", "errors");
+  std::string failure;
+  for (const int n : o.subscribers) {
+    Topology topo = directTopology(o);
+    say(fmt::format("{} subscribers on {}, {:.0f} s at {} Hz", n, topo.addresses[0], o.seconds, o.hz));
+    // Baseline: the producer publishing to nobody.
+    const ProcessSample b0 = sampleAll(topo.servers, "server");
+    auto tb = std::chrono::steady_clock::now();
+    std::this_thread::sleep_for(1500ms);
+    const ProcessSample b1 = sampleAll(topo.servers, "server");
+    const double baselineCores = (b1.cpuSeconds - b0.cpuSeconds) / secondsSince(tb);
+    // Load: separate processes, a share of the subscribers each.
+    const int processes = (n + o.subscribersPerLoadProcess - 1) / o.subscribersPerLoadProcess;
+    std::vector<std::unique_ptr<session::ChildProcess>> loads;
+    for (int k = 0; k < processes; ++k) {
+      LoadClientConfig lc;
+      lc.addresses = topo.addresses;
+      lc.token = kBenchToken;
+      lc.firstIndex = static_cast<uint32_t>(static_cast<int64_t>(n) * k / processes);
+      lc.subscribers = static_cast<uint32_t>(static_cast<int64_t>(n) * (k + 1) / processes) - lc.firstIndex;
+      lc.sampleEvery = static_cast<uint32_t>(o.sampleEvery);
+      lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
+      lc.view = randomView;
+      loads.push_back(std::make_unique<session::ChildProcess>(
+          [lc](const session::ChildProcess::Say& s, const session::ChildProcess::Hear& h) { return runLoad(lc, s, h); }));
+      loads.back()->go();
     }
-    std::this_thread::sleep_for(1s);  // let everyone join and take the first keyframes
-    std::vector<uint64_t> bytes0(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) bytes0[i] = clients[i]->stats().bytesReceived;
+    uint32_t connected = 0;
+    for (auto& l : loads) {
+      std::string line;
+      unsigned c = 0;
+      if (!l->readLine(line) || std::sscanf(line.c_str(), "connected %u", &c) != 1)
+        throw std::runtime_error("load process did not start: " + line);
+      connected += c;
+    }
+    if (connected == 0) throw std::runtime_error("subscribers never connected to " + topo.addresses[0]);
+    if (connected < static_cast<uint32_t>(n))
+      say(fmt::format("only {} of {} subscribers connected", connected, n));
+    std::this_thread::sleep_for(1s);  // the first keyframes go out
+    takeAll(loads);
+    takeWriteLatency(topo);
+    const ProcessSample s0 = sampleAll(topo.servers, "server");
     const auto t0 = std::chrono::steady_clock::now();
-    std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds - 1.0));
-    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::vector<double> rates, latencies;
-    for (int i = 0; i < n; ++i) {
-      rates.push_back(static_cast<double>(clients[i]->stats().bytesReceived - bytes0[i]) / dt);
-      for (uint32_t l : clients[i]->latenciesUs()) latencies.push_back(l / 1000.0);
+    const LoadReport l0 = takeAll(loads);
+    std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds));
+    const LoadReport l1 = takeAll(loads);
+    const double dt = secondsSince(t0);
+    const ProcessSample s1 = sampleAll(topo.servers, "server");
+    const service::LatencyHistogram writes = takeWriteLatency(topo);
+    // The lighting stops; every decoding subscriber must come to hold the producer's volume.
+    std::string hash;
+    double encodeMs = 0;
+    uint32_t published = 0;
+    {
+      const std::string fin = ask(*topo.servers[0], "stop", "final", "server");
+      char h[32] = {};
+      if (std::sscanf(fin.c_str(), "%31s %u %lf", h, &published, &encodeMs) != 3)
+        throw std::runtime_error("server sent a bad final line: " + fin);
+      hash = h;
     }
-    uint32_t rejected = 0, connected = 0;
-    if (!clients.empty() && clients[0]->stats().connects == 0)
-      say("first subscriber never connected: " + clients[0]->stats().lastError);
-    for (auto& c : clients) {
-      rejected += c->stats().framesRejected;
-      connected += c->stats().connects > 0 ? 1 : 0;
-      c->stop();
+    SampleCheck samples;
+    for (auto& l : loads) {
+      unsigned sampled = 0, identical = 0;
+      const std::string r = ask(*l, "check " + hash, "samples", "load process");
+      if (std::sscanf(r.c_str(), "%u %u", &sampled, &identical) != 2) throw std::runtime_error("bad sample check: " + r);
+      samples.sampled += sampled;
+      samples.identical += identical;
     }
-    clients.clear();
-    ServerReport report;
-    if (!server.readLine(line) ||
-        std::sscanf(line.c_str(), "report %lf %lf %d", &report.cpuSeconds, &report.encodeMsPerFrame, &report.frames) !=
-            3)
-      throw std::runtime_error("server process did not report");
-    server.wait();
-    double mean = 0;
-    for (double r : rates) mean += r;
-    mean /= n;
-    const double cpuPerSub = report.cpuSeconds / serverSeconds / n;  // fraction of a core
-    const nlohmann::json run = {{"subscribers", n},
-                                {"connected", connected},
-                                {"bytes_per_s_per_sub", mean},
-                                {"bytes_per_s_per_sub_p99", percentile(rates, 0.99)},
-                                {"latency_ms_p50", percentile(latencies, 0.5)},
-                                {"latency_ms_p99", percentile(latencies, 0.99)},
-                                {"server_cpu_per_sub", cpuPerSub},
-                                {"server_cpu_total", report.cpuSeconds / serverSeconds},
-                                {"encode_ms_per_frame", report.encodeMsPerFrame},
-                                {"frames_published", report.frames},
-                                {"frames_rejected", rejected}};
+    for (auto& l : loads) {
+      l->tell("quit");
+      l->wait();
+    }
+    for (auto& s : topo.servers) {
+      s->tell("quit");
+      s->wait();
+    }
+    const LoadFigures& f = l1.figures;
+    const double serverCores = (s1.cpuSeconds - s0.cpuSeconds) / dt;
+    const double corePerSub = (serverCores - baselineCores) / n;
+    const double rssKbPerSub = (s1.rssKb - b1.rssKb) / n;
+    const double bytesPerSub = static_cast<double>(f.bytes) / dt / n;
+    const double loadCores = (l1.process.cpuSeconds - l0.process.cpuSeconds) / dt;
+    const bool identical = samples.sampled > 0 && samples.identical == samples.sampled;
+    const uint64_t errors = f.sequenceErrors + f.crcErrors + f.decodeErrors + f.streamErrors;
+    const nlohmann::json run = {
+        {"subscribers", n},
+        {"connected", connected},
+        {"hz", o.hz},
+        {"seconds", dt},
+        {"frames_received", f.frames},
+        {"frames_per_subscriber_per_s", static_cast<double>(f.frames) / dt / n},
+        {"produce_to_receive_ms_p50", f.latency.percentileMs(0.5)},
+        {"produce_to_receive_ms_p99", f.latency.percentileMs(0.99)},
+        {"produce_to_receive_ms_max", static_cast<double>(f.latency.maxUs()) / 1000.0},
+        {"publish_to_write_ms_p50", writes.percentileMs(0.5)},
+        {"publish_to_write_ms_p99", writes.percentileMs(0.99)},
+        {"frames_written", writes.count()},
+        {"server_cpu_cores", serverCores},
+        {"server_cpu_cores_baseline", baselineCores},
+        {"server_cpu_core_per_subscriber", corePerSub},
+        {"server_rss_mb", s1.rssKb / 1024.0},
+        {"server_rss_mb_baseline", b1.rssKb / 1024.0},
+        {"rss_kb_per_subscriber", rssKbPerSub},
+        {"bytes_per_subscriber_per_s", bytesPerSub},
+        {"load_client_cpu_cores", loadCores},
+        {"load_processes", processes},
+        {"encode_ms_per_frame", encodeMs},
+        {"frames_published", published},
+        {"sequence_errors", f.sequenceErrors},
+        {"crc_errors", f.crcErrors},
+        {"decode_errors", f.decodeErrors},
+        {"stream_errors", f.streamErrors},
+        {"sampled_subscribers", samples.sampled},
+        {"sample_bit_identical", identical}};
     runs.push_back(run);
-    table += fmt::format("{:>6} {:>16.0f} {:>16.0f} {:>12.2f} {:>12.2f} {:>16.3f} {:>14.2f}\n", n, mean,
-                         percentile(rates, 0.99), percentile(latencies, 0.5), percentile(latencies, 0.99),
-                         100 * cpuPerSub, report.encodeMsPerFrame);
-    bytesSeries.points.push_back({static_cast<double>(n), mean, ""});
-    cpuSeries.points.push_back({static_cast<double>(n), 1000 * cpuPerSub, ""});
+    table += fmt::format(
+        "{:>6} {:>9.1f} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>9.2f} {:>8.3f} {:>10.5f} {:>8.1f} {:>9.1f} {:>10.0f} "
+        "{:>8.3f} {:>7}\n",
+        n, static_cast<double>(f.frames) / dt / n, f.latency.percentileMs(0.5), f.latency.percentileMs(0.99),
+        static_cast<double>(f.latency.maxUs()) / 1000.0, writes.percentileMs(0.5), writes.percentileMs(0.99),
+        serverCores, corePerSub, s1.rssKb / 1024.0, rssKbPerSub, bytesPerSub, loadCores, errors);
+    p50Series.points.push_back({static_cast<double>(n), std::max(1e-3, f.latency.percentileMs(0.5)), ""});
+    p99Series.points.push_back({static_cast<double>(n), std::max(1e-3, f.latency.percentileMs(0.99)), ""});
+    writeSeries.points.push_back({static_cast<double>(n), std::max(1e-3, writes.percentileMs(0.99)), ""});
+    if (!identical)
+      failure += fmt::format("{} subscribers: {} of {} decoding subscribers hold the producer's volume; ", n,
+                             samples.identical, samples.sampled);
+    if (errors != 0)
+      failure += fmt::format("{} subscribers: {} sequence, {} CRC, {} decode, {} stream errors (last: {}); ", n,
+                             f.sequenceErrors, f.crcErrors, f.decodeErrors, f.streamErrors, f.lastError);
+    if (connected < static_cast<uint32_t>(n)) failure += fmt::format("{} subscribers: only {} connected; ", n, connected);
   }
   StreamBenchResult r;
   r.json = {{"command", o.command},
@@ -209,18 +428,27 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
             {"hz", o.hz},
             {"seconds", o.seconds},
             {"budget_bytes_per_s", o.budgetBytesPerSecond},
+            {"topology", "direct: one server process"},
             {"runs", runs},
-            {"notes", "loopback, server in a child process; latency = client decode time minus the server time of "
-                      "the frame's lighting; CPU as a fraction of one core"}};
+            {"notes",
+             "loopback; the server (producer, hub, gRPC) and the load clients run in separate processes, CPU from "
+             "getrusage in each, as a fraction of one core. produce → receive: a frame's server time (the hub's publish "
+             "of its newest lighting) to its arrival at a load client, same system clock. publish → write: the same "
+             "start to gRPC's write-done on the server. server_cpu_core_per_subscriber and rss_kb_per_subscriber are "
+             "the increase over the server's baseline (publishing to nobody) divided by subscribers. Load clients check "
+             "sequence and CRCs of every frame; 1 in " +
+                 std::to_string(o.sampleEvery) + " subscribers decodes in full and is compared bit for bit with the "
+                 "producer's reconstruction once the lighting stops."}};
   r.table = table;
+  r.failure = failure;
   imaging::ChartSpec spec;
-  spec.title = "probe stream: per-subscriber cost against subscribers";
+  spec.title = "probe stream: latency against subscribers";
   spec.xLabel = "subscribers";
-  spec.yLabel = "bytes/s per subscriber; server CPU ms/s per subscriber";
+  spec.yLabel = "latency, ms";
   spec.logX = true;
   spec.logY = true;
   spec.footnote = o.command;
-  r.svg = imaging::renderSvgChart(spec, {bytesSeries, cpuSeries});
+  r.svg = imaging::renderSvgChart(spec, {p50Series, p99Series, writeSeries});
   return r;
 }
 

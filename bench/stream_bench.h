@@ -1,6 +1,7 @@
 // `probecast bench stream`: the service under N subscribers on loopback, with a moving light.
-// The server (a probe producer: hub, encoder, gRPC) runs in a child process so its CPU time is its
-// own; call it before this process starts gRPC (the children are forked first).
+// The server (a probe producer: hub, encoder, gRPC) and the load (light subscribers, load_client.h)
+// run in processes of their own, so each one's CPU time and memory is its own. This process forks
+// them and never starts gRPC itself (gRPC cannot be forked once it runs).
 #pragma once
 
 #include <functional>
@@ -12,11 +13,13 @@
 namespace probecast::bench {
 
 struct StreamBenchOptions {
-  std::vector<int> subscribers = {1, 10, 100};
-  double hz = 10.0;
-  double seconds = 5.0;
+  std::vector<int> subscribers = {1, 100, 1000};
+  double hz = 30.0;
+  double seconds = 10.0;  // measured, per subscriber count
   uint64_t budgetBytesPerSecond = 0;  // per subscriber; 0 = unlimited
   std::string repr = "zh3";
+  int subscribersPerLoadProcess = 250;
+  int sampleEvery = 50;  // 1 in this many subscribers decodes fully (subscriber 0 always does)
   std::string command;
   std::function<void(const std::string&)> progress;
 };
@@ -25,6 +28,9 @@ struct StreamBenchResult {
   nlohmann::json json;
   std::string table;
   std::string svg;
+  // Empty, or what went wrong (wrong volumes, sequence or CRC errors): the outputs are still
+  // written, and the command then fails with this.
+  std::string failure;
 };
 
 StreamBenchResult runStreamBench(const StreamBenchOptions& options);

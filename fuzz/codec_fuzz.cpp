@@ -52,8 +52,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     if (control & fuzz::kRepairFlag) fuzz::repairChecksums(body);
     const std::vector<float> before(dec.probes(), dec.probes() + floats);
+    const CodecStatus verified = verifyFrame(body.data(), body.size());
     const CodecStatus st = dec.apply(body.data(), body.size());
     if (st != CodecStatus::Ok) require(std::memcmp(before.data(), dec.probes(), floats * sizeof(float)) == 0);
+    if (st == CodecStatus::Ok) require(verified == CodecStatus::Ok);  // the container check is never stricter
     require(finite(dec.probes(), floats));
   } else if (mode == fuzz::kRecord) {
     const size_t n = recordSize(repr);

@@ -7,8 +7,9 @@ work=$2
 mkdir -p "$work"
 port=$((20000 + RANDOM % 20000))
 "$probecast" bake --scene builtin:cornell --grid 6,6,6 --spp 32 --updates 1 --out "$work/served.pcpv" >/dev/null
+printf '  s3cret \n\n' >"$work/token"  # whitespace around the token is not part of it
 "$probecast" serve --probes "$work/served.pcpv" --repr l2 --deadzone 0 --listen "127.0.0.1:$port" --plaintext \
-  --token s3cret --seconds 20 >"$work/serve.log" 2>&1 &
+  --token-file "$work/token" --seconds 20 >"$work/serve.log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null || true' EXIT
 for _ in $(seq 50); do grep -q "on port" "$work/serve.log" && break; sleep 0.1; done
@@ -36,4 +37,7 @@ PY
 # The raster client fed by the stream.
 "$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views stereo --size 24x16 --out "$work/view" \
   | grep -q "2 views"
+# A 9x9 light field (81 views) subscribes over gRPC as well.
+"$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views lf:9x9 --size 8x8 --out "$work/view-lf" \
+  | grep -q "81 views"
 echo "serve/subscribe round trip ok"

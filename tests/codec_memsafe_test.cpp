@@ -68,6 +68,7 @@ TEST_P(MemorySafety, EveryTruncationIsRejected) {
     for (size_t len = 0; len < frame->size(); ++len) {
       std::vector<uint8_t> cut(frame->begin(), frame->begin() + static_cast<std::ptrdiff_t>(len));  // exact size: ASan sees overreads
       ASSERT_NE(dec.apply(cut.data(), cut.size()), CodecStatus::Ok) << "length " << len;
+      ASSERT_NE(verifyFrame(cut.data(), cut.size()), CodecStatus::Ok) << "length " << len;
     }
     EXPECT_EQ(before, snapshot(dec));
     ASSERT_EQ(dec.apply(frame->data(), frame->size()), CodecStatus::Ok);
@@ -85,6 +86,7 @@ TEST_P(MemorySafety, EverySingleByteCorruptionIsRejected) {
       std::vector<uint8_t> bad = s.delta;
       bad[i] = static_cast<uint8_t>(bad[i] ^ x);
       ASSERT_NE(dec.apply(bad.data(), bad.size()), CodecStatus::Ok) << "byte " << i << " xor " << x;
+      ASSERT_NE(verifyFrame(bad.data(), bad.size()), CodecStatus::Ok) << "byte " << i << " xor " << x;
     }
   }
   EXPECT_EQ(before, snapshot(dec));
@@ -107,6 +109,10 @@ TEST_P(MemorySafety, CorruptionWithRepairedChecksumsIsSafe) {
         bad[i] = static_cast<uint8_t>(bad[i] ^ x);
         repairChecksums(bad);
         const CodecStatus st = dec.apply(bad.data(), bad.size());
+        // What decodes has an intact container: verifyFrame never refuses a frame apply took.
+        if (st == CodecStatus::Ok) {
+          ASSERT_EQ(verifyFrame(bad.data(), bad.size()), CodecStatus::Ok) << "byte " << i;
+        }
         if (st != CodecStatus::Ok) {
           ++rejected;
           ASSERT_EQ(before, snapshot(dec)) << "failed apply changed state at byte " << i;
@@ -136,6 +142,34 @@ TEST(MemorySafety, TrailingBytesAndWrongVersionAreRejected) {
   repairChecksums(count);
   EXPECT_EQ(dec.apply(count.data(), count.size()), CodecStatus::BadBrickIndex);
   EXPECT_EQ(dec.apply(nullptr, 0), CodecStatus::Truncated);
+}
+
+TEST_P(MemorySafety, VerifyFrameChecksTheContainerWithoutDecoding) {
+  const Streams s = makeStreams(GetParam());
+  FrameHeader h;
+  ASSERT_EQ(verifyFrame(s.keyframe.data(), s.keyframe.size(), &h), CodecStatus::Ok);
+  EXPECT_EQ(h.layout.grid[0], 5);
+  EXPECT_EQ(h.layout.repr, GetParam());
+  EXPECT_GT(h.sectionCount, 0u);
+  // A delta checks out on its own: verifyFrame holds no brick versions, the decoder does.
+  ASSERT_EQ(verifyFrame(s.delta.data(), s.delta.size()), CodecStatus::Ok);
+  StreamDecoder fresh(s.layout);
+  EXPECT_EQ(fresh.apply(s.delta.data(), s.delta.size()), CodecStatus::BaseVersionMismatch);
+  std::vector<uint8_t> longer = s.delta;
+  longer.push_back(0);
+  EXPECT_EQ(verifyFrame(longer.data(), longer.size()), CodecStatus::TrailingBytes);
+  // The last byte of the first section's data: only that section's CRC can tell.
+  std::vector<uint8_t> bad = s.keyframe;
+  const size_t firstEnd = kFrameHeaderSize + kSectionHeaderSize +
+                          (bad[kFrameHeaderSize + 14] | bad[kFrameHeaderSize + 15] << 8 |
+                           bad[kFrameHeaderSize + 16] << 16 | static_cast<size_t>(bad[kFrameHeaderSize + 17]) << 24);
+  ASSERT_LE(firstEnd, bad.size());
+  bad[firstEnd - 1] = static_cast<uint8_t>(bad[firstEnd - 1] ^ 0x20);
+  EXPECT_EQ(verifyFrame(bad.data(), bad.size()), CodecStatus::SectionChecksum);
+  bad = s.keyframe;
+  bad[17] = static_cast<uint8_t>(bad[17] ^ 1);  // frame sequence, under the header CRC
+  EXPECT_EQ(verifyFrame(bad.data(), bad.size()), CodecStatus::HeaderChecksum);
+  EXPECT_EQ(verifyFrame(nullptr, 0), CodecStatus::Truncated);
 }
 
 INSTANTIATE_TEST_SUITE_P(AllRepresentations, MemorySafety, ::testing::ValuesIn(kAllRepresentations),

@@ -69,6 +69,42 @@ TEST(ProbeHub, InViewBricksComeFirstUnderABudget) {
   EXPECT_LT(got.size(), 4u);                                     // the budget held the rest back
 }
 
+TEST(ProbeHub, AnUnlimitedBudgetTakesEveryStaleBrickInOneFrameWhateverItsView) {
+  ProbeHub hub(rowConfig());
+  std::mt19937 rng(4);
+  hub.publish(test::movingLightFrame(256, 0, 0.01f, rng).data(), nullptr);
+  const uint64_t id = hub.addSubscriber(0, 0, {}, nullptr);
+  hub.setViews(id, {viewOver(13.5f, 1.0f)});  // sees brick 3 only
+  StreamDecoder dec(hub.layout());
+  auto first = hub.nextFrame(id);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(bricksIn(*first, dec), (std::vector<uint32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(first->keyframes + first->deltas, 4u);
+  EXPECT_FALSE(hub.nextFrame(id).has_value());  // holds everything
+  hub.publish(test::movingLightFrame(256, 6, 0.01f, rng).data(), nullptr);
+  auto second = hub.nextFrame(id);
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(bricksIn(*second, dec), (std::vector<uint32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(second->deltas, 4u);
+  EXPECT_EQ(hub.stats(id).bricksBehind, 0u);
+}
+
+TEST(ProbeHub, WhereBricksOutOfViewWeighNothingAnUnlimitedBudgetStillLeavesThemOut) {
+  HubConfig c = rowConfig();
+  c.priority.outOfViewWeight = 0.0f;
+  ProbeHub hub(c);
+  std::mt19937 rng(5);
+  hub.publish(test::movingLightFrame(256, 0, 0.01f, rng).data(), nullptr);
+  const uint64_t id = hub.addSubscriber(0, 0, {}, nullptr);
+  hub.setViews(id, {viewOver(13.5f, 1.0f)});
+  StreamDecoder dec(hub.layout());
+  auto first = hub.nextFrame(id);
+  ASSERT_TRUE(first.has_value());
+  const auto got = bricksIn(*first, dec);
+  EXPECT_NE(std::find(got.begin(), got.end(), 3u), got.end());
+  EXPECT_EQ(std::find(got.begin(), got.end(), 0u), got.end());
+}
+
 TEST(ProbeHub, EncodedOnceSameBytesForEverySubscriber) {
   ProbeHub hub(rowConfig());
   std::mt19937 rng(2);

@@ -19,6 +19,7 @@
 #include "probecast.grpc.pb.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
+#include "service_test_support.h"
 #include "test_probes.h"
 
 namespace probecast::service {
@@ -26,104 +27,6 @@ namespace {
 
 namespace pb = probecast::v1;
 using namespace std::chrono_literals;
-
-constexpr char kToken[] = "test-token";
-
-HubConfig volumeConfig() {
-  // 16 × 4 × 16 probes (the moving-light generator's layout), bricks of 4: 16 bricks.
-  HubConfig c;
-  c.layout.grid[0] = 16;
-  c.layout.grid[1] = 4;
-  c.layout.grid[2] = 16;
-  c.layout.brickDim = 4;
-  c.layout.repr = Representation::Zh3;
-  c.bounds.min[0] = -2.0f;
-  c.bounds.max[0] = 1.5f;
-  c.bounds.max[1] = 1.5f;
-  c.bounds.min[2] = -2.0f;
-  c.bounds.max[2] = 5.5f;
-  return c;
-}
-
-// Publishes `frames` moving-light frames, then keeps ticking until stopped.
-class Producer {
- public:
-  Producer(ProbeHub& hub, int frames, std::chrono::milliseconds interval) : hub_(hub) {
-    thread_ = std::thread([this, frames, interval] {
-      std::mt19937 rng(5);
-      for (int f = 0; !stop_; ++f) {
-        if (f < frames) hub_.publish(test::movingLightFrame(1024, f, 0.01f, rng).data(), nullptr);
-        else hub_.tick();
-        published_ = std::min(f + 1, frames);
-        std::this_thread::sleep_for(f < frames ? interval : 10ms);
-      }
-    });
-  }
-  ~Producer() { stop(); }
-  void stop() {
-    stop_ = true;
-    if (thread_.joinable()) thread_.join();
-  }
-  int published() const { return published_; }
-
- private:
-  ProbeHub& hub_;
-  std::atomic<bool> stop_{false};
-  std::atomic<int> published_{0};
-  std::thread thread_;
-};
-
-ServerConfig plaintextConfig() {
-  ServerConfig c;
-  c.listen = "127.0.0.1:0";
-  c.token = kToken;
-  c.plaintext = true;
-  return c;
-}
-
-ClientConfig clientFor(int port, uint64_t budget = 0) {
-  ClientConfig c;
-  c.address = "127.0.0.1:" + std::to_string(port);
-  c.token = kToken;
-  c.budgetBytesPerSecond = budget;
-  return c;
-}
-
-bool matchesServer(const ProbeClient& client, const ProbeHub& hub) {
-  VolumeSnapshot snap;
-  if (!client.snapshot(snap)) return false;
-  const ProbeVolume server = hub.reconstruction();
-  const std::vector<float>& probes = server.probes;
-  return snap.volume.probes.size() == probes.size() &&
-         std::memcmp(snap.volume.probes.data(), probes.data(), probes.size() * sizeof(float)) == 0 &&
-         snap.volume.active == server.active;
-}
-
-template <typename Pred>
-bool waitFor(Pred pred, std::chrono::milliseconds limit) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return pred();
-}
-
-View viewAt(float x, float z) {
-  // A narrow orthographic view down −z around (x, 0.75), depth 0..40 m from an eye at z + 20.
-  View v{};
-  v.viewProj[0] = 1.0f;
-  v.viewProj[5] = 1.0f;
-  v.viewProj[10] = -1.0f / 40.0f;
-  v.viewProj[12] = -x;
-  v.viewProj[13] = -0.75f;
-  v.viewProj[14] = (z + 20.0f) / 40.0f;
-  v.viewProj[15] = 1.0f;
-  v.eye[0] = x;
-  v.eye[1] = 0.75f;
-  v.eye[2] = z + 20.0f;
-  return v;
-}
 
 TEST(Service, TwentySubscribersConvergeBitIdentical) {
   ProbeHub hub(volumeConfig());
@@ -272,22 +175,6 @@ TEST(Service, WrongTokenIsUnauthenticatedAndGetsNoPayload) {
   EXPECT_TRUE(waitFor([&] { return client.stats().fatal; }, 5s));
   VolumeSnapshot snap;
   EXPECT_FALSE(client.snapshot(snap));
-}
-
-// Sends `first` (and `second` if given) and returns the stream's final status.
-grpc::Status statusAfter(pb::ProbeStream::Stub& stub, const pb::ClientMessage& first,
-                         const pb::ClientMessage* second = nullptr) {
-  grpc::ClientContext ctx;
-  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
-  ctx.set_deadline(std::chrono::system_clock::now() + 5s);
-  auto stream = stub.Subscribe(&ctx);
-  stream->Write(first);
-  if (second) stream->Write(*second);
-  stream->WritesDone();
-  pb::ServerMessage msg;
-  while (stream->Read(&msg)) {
-  }
-  return stream->Finish();
 }
 
 TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {

@@ -127,6 +127,43 @@ TEST(SessionChildProcess, RunsOnlyAfterGoAndPassesLinesAndStatus) {
   EXPECT_EQ(child.wait(), 3);
 }
 
+TEST(SessionChildProcess, TakesLinesOfAnyLengthBothWays) {
+  const std::string longLine(100000, 'x');  // a histogram or a list of samples is long
+  ChildProcess child([&longLine](const ChildProcess::Say& say, const ChildProcess::Hear& hear) {
+    std::string line;
+    while (hear(line)) {
+      if (line == "quit") return 5;
+      say(line == longLine ? "long ok" : "echo " + line);
+    }
+    return 1;  // the parent went away without "quit"
+  });
+  child.go();
+  std::string line;
+  ASSERT_TRUE(child.tell("ping"));
+  ASSERT_TRUE(child.readLine(line));
+  EXPECT_EQ(line, "echo ping");
+  ASSERT_TRUE(child.tell(longLine));
+  ASSERT_TRUE(child.readLine(line));
+  EXPECT_EQ(line, "long ok");
+  ASSERT_TRUE(child.tell("quit"));
+  EXPECT_FALSE(child.readLine(line));
+  EXPECT_EQ(child.wait(), 5);
+  EXPECT_FALSE(child.tell("after the end"));
+}
+
+TEST(SessionChildProcess, ALongLineFromTheChildArrivesWhole) {
+  ChildProcess child([](const ChildProcess::Say& say) {
+    say(std::string(5000, 'y'));
+    return 0;
+  });
+  child.go();
+  std::string line;
+  ASSERT_TRUE(child.readLine(line));
+  EXPECT_EQ(line, std::string(5000, 'y'));
+  EXPECT_FALSE(child.readLine(line));
+  EXPECT_EQ(child.wait(), 0);
+}
+
 TEST(SessionChildProcess, AChildDroppedBeforeGoEndsWithoutRunning) {
   auto first = std::make_unique<ChildProcess>([](const ChildProcess::Say&) { return 7; });
   ChildProcess second([](const ChildProcess::Say&) { return 0; });  // holds no copy of first's pipes

@@ -55,6 +55,24 @@ struct SectionView {
 CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
                          size_t* consumed);
 
+// Parses every section of a frame whose header checked out (`frame` points at the header), in
+// order, handing each to visit(const SectionView&) -> CodecStatus; stops at the first error, its
+// own or the visitor's, and refuses bytes left after the last section.
+template <typename Visit>
+CodecStatus forEachSection(const StreamLayout& layout, const uint8_t* frame, const FrameHeader& header, Visit&& visit) {
+  const uint8_t* p = frame + kFrameHeaderSize;
+  size_t left = header.sectionBytes;
+  for (uint32_t i = 0; i < header.sectionCount; ++i) {
+    SectionView view;
+    size_t consumed = 0;
+    if (CodecStatus st = parseSection(layout, p, left, &view, &consumed); st != CodecStatus::Ok) return st;
+    p += consumed;
+    left -= consumed;
+    if (CodecStatus st = visit(static_cast<const SectionView&>(view)); st != CodecStatus::Ok) return st;
+  }
+  return left == 0 ? CodecStatus::Ok : CodecStatus::TrailingBytes;
+}
+
 // Applies a decompressed payload to a brick's symbols. `active`/`symbols` hold the brick's state
 // on entry (the base) and the new state on success. `scratch` avoids allocation.
 CodecStatus applyPayload(Representation repr, uint32_t probes, SectionKind kind, const uint8_t* raw, size_t rawSize,

@@ -164,6 +164,16 @@ CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* heade
   return CodecStatus::Ok;
 }
 
+CodecStatus verifyFrame(const uint8_t* data, size_t size, FrameHeader* header) {
+  FrameHeader h;
+  if (CodecStatus st = readFrameHeader(data, size, &h); st != CodecStatus::Ok) return st;
+  if (CodecStatus st = forEachSection(h.layout, data, h, [](const SectionView&) { return CodecStatus::Ok; });
+      st != CodecStatus::Ok)
+    return st;
+  if (header) *header = h;
+  return CodecStatus::Ok;
+}
+
 void BrickTable::build(const StreamLayout& layout) {
   const uint32_t bricks = brickCount(layout);
   first.resize(bricks + 1);

@@ -67,14 +67,7 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
     s.stamp = 1;
   }
   s.staged.clear();
-  const uint8_t* p = data + kFrameHeaderSize;
-  size_t left = header.sectionBytes;
-  for (uint32_t i = 0; i < header.sectionCount; ++i) {
-    SectionView view;
-    size_t consumed = 0;
-    if (CodecStatus st = parseSection(s.layout, p, left, &view, &consumed); st != CodecStatus::Ok) return st;
-    p += consumed;
-    left -= consumed;
+  const CodecStatus parsed = forEachSection(s.layout, data, header, [&s](const SectionView& view) {
     if (s.seenInFrame[view.brick] == s.stamp) return CodecStatus::DuplicateBrick;
     s.seenInFrame[view.brick] = s.stamp;
 
@@ -113,8 +106,9 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
                                            s.zh3PerPixel))
         return CodecStatus::BadSymbol;
     s.staged.push_back(std::move(st));
-  }
-  if (left != 0) return CodecStatus::TrailingBytes;
+    return CodecStatus::Ok;
+  });
+  if (parsed != CodecStatus::Ok) return parsed;
 
   for (const Impl::Staged& st : s.staged) {
     const uint32_t first = s.table.first[st.brick];

@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gpu_scene.h"
+#include "probecast/codec/priority.h"
 #include "probecast/renderer/glossy_sh.h"
 #include "raster.frag.h"
 #include "raster.vert.h"
@@ -105,7 +106,7 @@ VkWriteDescriptorSet imageWrite(VkDescriptorSet set, uint32_t binding, const VkD
 }  // namespace
 
 struct RasterRenderer::Impl {
-  static constexpr uint32_t kMaxViews = 256;  // lf:16x16
+  static constexpr uint32_t kMaxViews = kMaxViewsPerSet;
   static constexpr int kEnvBrdfSize = 32;
   VulkanDevice* d = nullptr;
   RasterOptions options;
@@ -433,7 +434,8 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
 
 std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& views) {
   Impl& s = *impl_;
-  if (views.size() > Impl::kMaxViews) throw std::invalid_argument("at most 256 views per view set");
+  if (views.size() > Impl::kMaxViews)
+    throw std::invalid_argument("at most " + std::to_string(Impl::kMaxViews) + " views per view set");
   std::vector<Image> out(views.size());
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;

@@ -6,7 +6,15 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "probecast/codec/priority.h"
+
 namespace probecast::renderer {
+namespace {
+
+constexpr int kMaxSide = 16;  // views per light-field row or column
+static_assert(kMaxSide * kMaxSide <= static_cast<int>(kMaxViewsPerSet), "every lf:NxM set fits one view update");
+
+}  // namespace
 
 bool parseViewSet(const std::string& text, ViewSetSpec& spec, std::string& error) {
   if (text == "mono") {
@@ -19,11 +27,12 @@ bool parseViewSet(const std::string& text, ViewSetSpec& spec, std::string& error
   }
   int n = 0, m = 0;
   char tail = 0;
-  if (std::sscanf(text.c_str(), "lf:%dx%d%c", &n, &m, &tail) == 2 && n >= 1 && m >= 1 && n <= 16 && m <= 16) {
+  const auto sides = [&] { return n >= 1 && m >= 1 && n <= kMaxSide && m <= kMaxSide; };
+  if (std::sscanf(text.c_str(), "lf:%dx%d%c", &n, &m, &tail) == 2 && sides()) {
     spec = {ViewSetSpec::Kind::LightField, n, m};
     return true;
   }
-  if (std::sscanf(text.c_str(), "lfh:%dx%d%c", &n, &m, &tail) == 2 && n >= 1 && m >= 1 && n <= 16 && m <= 16) {
+  if (std::sscanf(text.c_str(), "lfh:%dx%d%c", &n, &m, &tail) == 2 && sides()) {
     spec = {ViewSetSpec::Kind::HorizontalLightField, n, m};
     return true;
   }

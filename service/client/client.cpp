@@ -60,14 +60,15 @@ struct ProbeClient::Impl {
     return grpc::CreateCustomChannel(address, creds, args);
   }
 
-  void onVolume(const pb::VolumeDescription& v, const std::string& address) {
+  // False for a description the client cannot use: the connection is dropped and retried later.
+  bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
     StreamLayout l;
     GridBounds b;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
     if (!volumeFromWire(v, l, b, why)) {
       stats.lastError = "bad volume description: " + why;
-      return;
+      return false;
     }
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
@@ -81,6 +82,7 @@ struct ProbeClient::Impl {
     stats.connected = true;
     stats.connects += 1;
     stats.address = address;
+    return true;
   }
 
   // Returns false when the connection should be dropped (the server and we disagree on state).
@@ -158,9 +160,14 @@ struct ProbeClient::Impl {
       }
       pb::ServerMessage msg;
       bool gotVolume = false;
+      bool dropped = false;  // by us, for a reason already in lastError
       while (rw->Read(&msg)) {
         if (msg.has_volume()) {
-          onVolume(msg.volume(), servers[at]);
+          if (!onVolume(msg.volume(), servers[at])) {
+            dropped = true;
+            ctx.TryCancel();
+            break;
+          }
           gotVolume = true;
           failedInTurn = 0;
           backoff = config.reconnectMinMs;
@@ -173,6 +180,7 @@ struct ProbeClient::Impl {
           stats.serverAckRttUs = msg.stats().ack_rtt_us();
         } else if (msg.has_frame()) {
           if (!onFrame(msg.frame())) {
+            dropped = true;
             ctx.TryCancel();
             break;
           }
@@ -192,7 +200,7 @@ struct ProbeClient::Impl {
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
-        if (!status.ok() && !stopping) stats.lastError = servers[at] + ": " + status.error_message();
+        if (!status.ok() && !stopping && !dropped) stats.lastError = servers[at] + ": " + status.error_message();
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {
           stats.fatal = true;

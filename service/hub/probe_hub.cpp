@@ -319,12 +319,22 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
     return std::nullopt;
   }
   refill(s, Clock::now());
+  chosen_.resize(bricks);
+  if (s.budget == 0 && everyStaleBrickScores()) {
+    // Unlimited: every brick it lacks goes in this frame, and their order within it does not
+    // matter, so the scoring (frustum tests per view and brick, a sort) is skipped.
+    size_t n = 0;
+    for (uint32_t b = 0; b < bricks; ++b)
+      if (s.held[b] < source_->version(b)) chosen_[n++] = b;
+    return buildFrame(s, n, behind);
+  }
   scores_.resize(bricks);
   scoreBricks(config_.layout, config_.bounds, s.views, candidates_, config_.priority, scores_.data());
   const double cap = static_cast<double>(s.budget) * config_.burstSeconds;
   // A full bucket may always send the best brick, so one larger than the bucket still goes out.
-  uint64_t allowance = s.budget == 0 ? UINT64_MAX : static_cast<uint64_t>(std::max(0.0, s.tokens));
-  chosen_.resize(bricks);
+  // Saturating: a bucket of 2^64 bytes or more cannot bind, and converting it would overflow.
+  const uint64_t allowance = s.budget == 0 || s.tokens >= 0x1p64 ? UINT64_MAX
+                                                                   : static_cast<uint64_t>(std::max(0.0, s.tokens));
   size_t n = selectBricks(scores_, candidates_, allowance, chosen_.data());
   if (n == 0 && s.budget != 0 && s.tokens >= cap) {
     uint32_t best = 0;
@@ -339,6 +349,16 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
     s.waiting = true;  // the producer's tick refills and wakes it
     return std::nullopt;
   }
+  return buildFrame(s, n, behind);
+}
+
+bool ProbeHub::everyStaleBrickScores() const {
+  // scoreBricks gives a stale brick (change >= 1e-3 here, bytes > 0) a positive score unless bricks
+  // out of view weigh nothing or age counts against it.
+  return config_.priority.outOfViewWeight > 0.0f && config_.priority.ageWeight >= 0.0f;
+}
+
+OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind) {
   OutgoingFrame frame;
   std::vector<std::span<const uint8_t>> sections;
   sections.reserve(n);

@@ -1,13 +1,16 @@
 // ProbeStream over gRPC's callback API: authentication, validation, one reactor per subscriber.
 #include "probecast/service/server.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
 
+#include <fmt/format.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
@@ -19,8 +22,12 @@ namespace {
 
 namespace pb = probecast::v1;
 
-bool authorized(grpc::CallbackServerContext* ctx, const std::string& token) {
-  if (token.empty()) return true;
+// The service reads and writes raw bytes so that it parses client messages itself: a message that
+// does not parse is refused, where the generated code would end the stream as if it were closed.
+using RawReactor = grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>;
+
+bool authorized(grpc::CallbackServerContext* ctx, const std::string& token, bool noAuth) {
+  if (token.empty()) return noAuth;  // the constructor refuses an empty token without noAuth
   const auto& md = ctx->client_metadata();
   const auto it = md.find("authorization");
   if (it == md.end()) return false;
@@ -37,7 +44,7 @@ grpc::Status notReady() {
   return grpc::Status(grpc::StatusCode::UNAVAILABLE, "no volume yet: this edge has not heard from its producer");
 }
 
-class RejectReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage> {
+class RejectReactor : public RawReactor {
  public:
   explicit RejectReactor(const grpc::Status& status) { Finish(status); }
   void OnDone() override { delete this; }
@@ -45,36 +52,66 @@ class RejectReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::Serv
 
 class SubscribeReactor;
 
+// Instrumentation: how long frames take from the publish of their newest lighting to gRPC's
+// OnWriteDone (the message handed to the transport), over all subscribers.
+class FrameWriteTimes {
+ public:
+  void written(uint64_t serverTimeUs) {
+    const uint64_t now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                                   std::chrono::system_clock::now().time_since_epoch())
+                                                   .count());
+    std::lock_guard<std::mutex> lock(mutex_);
+    histogram_.record(now - std::min(now, serverTimeUs));
+  }
+  LatencyHistogram take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    LatencyHistogram h = histogram_;
+    histogram_.clear();
+    return h;
+  }
+
+ private:
+  std::mutex mutex_;
+  LatencyHistogram histogram_;
+};
+
 // What the hub's wake-up may touch: the reactor, only while it is alive.
 struct ReactorLink {
   std::mutex mutex;
   SubscribeReactor* reactor = nullptr;
 };
 
-class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage> {
+class SubscribeReactor : public RawReactor {
  public:
-  SubscribeReactor(ProbeHub& hub, const ServerConfig& config, std::atomic<uint32_t>& subscribers)
-      : hub_(hub), config_(config), subscribers_(subscribers), link_(std::make_shared<ReactorLink>()) {
+  SubscribeReactor(ProbeHub& hub, const ServerConfig& config, std::atomic<uint32_t>& subscribers,
+                   FrameWriteTimes& writeTimes, std::string peer)
+      : hub_(hub), config_(config), subscribers_(subscribers), writeTimes_(writeTimes), peer_(std::move(peer)),
+        link_(std::make_shared<ReactorLink>()) {
     link_->reactor = this;
-    StartRead(&in_);
+    StartRead(&inBytes_);
   }
 
   void OnReadDone(bool ok) override {
-    if (!ok) {  // the client closed its side or the call broke
-      finish(grpc::Status::OK);
+    if (!ok) {
+      // The client closed its side (a receive-only viewer does so after its hello) or the call
+      // broke. A half-closed subscriber keeps its stream: it ends when the client cancels, the
+      // call breaks (OnCancel) or the server shuts down. One that never said hello gets nothing.
+      if (!id_) finish(invalid("the stream was closed before a hello"));
       return;
     }
-    const grpc::Status status = handle(in_);
+    const grpc::Status status = handleBytes();
     if (!status.ok()) {
       finish(status);
       return;
     }
-    StartRead(&in_);
+    StartRead(&inBytes_);
   }
 
   void OnWriteDone(bool ok) override {
     std::lock_guard<std::mutex> lock(link_->mutex);
     writing_ = false;
+    if (ok && frameServerTimeUs_) writeTimes_.written(frameServerTimeUs_);
+    frameServerTimeUs_ = 0;
     if (pendingFinish_) {  // a finish waited for this write, whether it went through or not
       finished_ = true;
       Finish(*pendingFinish_);
@@ -117,8 +154,7 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
       s->set_server_frame(hub_.serverFrame());
       s->set_frames_acked(st.framesAcked);
       s->set_ack_rtt_us(st.ackRttUs);
-      writing_ = true;
-      StartWrite(&out_);
+      startWriteLocked();
       return;
     }
     std::optional<OutgoingFrame> frame = hub_.nextFrame(id_);
@@ -131,17 +167,39 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     f->set_keyframes(frame->keyframes);
     f->set_deltas(frame->deltas);
     ++framesSinceStats_;
-    writing_ = true;
-    StartWrite(&out_);
+    frameServerTimeUs_ = frame->serverTimeUs;
+    startWriteLocked();
   }
 
  private:
-  grpc::Status invalid(const std::string& why) { return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, why); }
+  // A client's mistake: refused with INVALID_ARGUMENT and logged, so a broken client is visible on
+  // both ends.
+  grpc::Status invalid(const std::string& why) {
+    fmt::print(stderr, "probecast server: refusing subscriber {}: {}\n", peer_, why);
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, why);
+  }
+
+  // Serialises out_ and writes it; the link is locked, no write is in flight.
+  void startWriteLocked() {
+    bool own = false;
+    outBytes_.Clear();
+    grpc::SerializationTraits<pb::ServerMessage>::Serialize(out_, &outBytes_, &own);
+    writing_ = true;
+    StartWrite(&outBytes_);
+  }
+
+  grpc::Status handleBytes() {
+    const size_t size = inBytes_.Length();
+    if (size > config_.maxMessageBytes)
+      return invalid("message of " + std::to_string(size) + " bytes exceeds the limit of " +
+                     std::to_string(config_.maxMessageBytes));
+    in_.Clear();
+    if (!grpc::SerializationTraits<pb::ClientMessage>::Deserialize(&inBytes_, &in_).ok())
+      return invalid("a message of " + std::to_string(size) + " bytes is not a valid probecast.v1.ClientMessage");
+    return handle(in_);
+  }
 
   grpc::Status handle(const pb::ClientMessage& m) {
-    if (m.ByteSizeLong() > config_.maxMessageBytes)
-      return invalid("message of " + std::to_string(m.ByteSizeLong()) + " bytes exceeds the limit of " +
-                     std::to_string(config_.maxMessageBytes));
     if (!id_) {
       if (!m.has_hello()) return invalid("the first message must be hello");
       return handleHello(m.hello());
@@ -170,10 +228,14 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
                      std::to_string(kProtocolVersion) + ")");
     if (!hub_.ready()) return notReady();
     const StreamLayout layout = hub_.layout();
-    const auto repr = static_cast<uint8_t>(layout.repr);
-    if (h.representation() != pb::REPRESENTATION_UNSPECIFIED && static_cast<uint8_t>(h.representation()) != repr)
+    // An open enum: any int32 may arrive, and a narrowing cast would read 260 as 4 (l2).
+    const int wanted = h.representation();
+    if (!pb::Representation_IsValid(wanted))
+      return invalid("representation " + std::to_string(wanted) + " is not a known Representation");
+    const int served = static_cast<int>(layout.repr);
+    if (wanted != pb::REPRESENTATION_UNSPECIFIED && wanted != served)
       return invalid("representation " + pb::Representation_Name(h.representation()) + " is not served (this server "
-                     "streams " + pb::Representation_Name(static_cast<pb::Representation>(repr)) + ")");
+                     "streams " + pb::Representation_Name(static_cast<pb::Representation>(served)) + ")");
     const uint32_t bricks = brickCount(layout);
     if (static_cast<uint32_t>(h.held_size()) > bricks) return invalid("more held bricks than the volume has");
     std::vector<HeldBrick> held;
@@ -198,8 +260,7 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
     out_.Clear();
     const bus::Volume v = hub_.volume();
     volumeToWire(v.layout, v.bounds, v.epoch, *out_.mutable_volume());
-    writing_ = true;
-    StartWrite(&out_);  // the volume description first; frames follow from OnWriteDone
+    startWriteLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }
 
@@ -220,11 +281,15 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   ProbeHub& hub_;
   const ServerConfig& config_;
   std::atomic<uint32_t>& subscribers_;
+  FrameWriteTimes& writeTimes_;
+  const std::string peer_;
   std::shared_ptr<ReactorLink> link_;
+  grpc::ByteBuffer inBytes_, outBytes_;
   pb::ClientMessage in_;
   pb::ServerMessage out_;
   static constexpr uint32_t kFramesPerStats = 16;
   uint32_t framesSinceStats_ = 0;
+  uint64_t frameServerTimeUs_ = 0;  // of the frame being written (0: no frame in flight)
   uint64_t id_ = 0;
   bool counted_ = false;
   bool writing_ = false;
@@ -232,20 +297,23 @@ class SubscribeReactor : public grpc::ServerBidiReactor<pb::ClientMessage, pb::S
   std::optional<grpc::Status> pendingFinish_;
 };
 
-class Service final : public pb::ProbeStream::CallbackService {
+using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<
+    pb::ProbeStream::WithCallbackMethod_GetVolume<pb::ProbeStream::Service>>;
+
+class Service final : public RawSubscribeService {
  public:
   Service(ProbeHub& hub, const ServerConfig& config) : hub_(hub), config_(config) {}
 
-  grpc::ServerBidiReactor<pb::ClientMessage, pb::ServerMessage>* Subscribe(grpc::CallbackServerContext* ctx) override {
-    if (!authorized(ctx, config_.token))
+  RawReactor* Subscribe(grpc::CallbackServerContext* ctx) override {
+    if (!authorized(ctx, config_.token, config_.noAuth))
       return new RejectReactor(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
-    return new SubscribeReactor(hub_, config_, subscribers_);
+    return new SubscribeReactor(hub_, config_, subscribers_, writeTimes_, ctx->peer());
   }
 
   grpc::ServerUnaryReactor* GetVolume(grpc::CallbackServerContext* ctx, const pb::GetVolumeRequest*,
                                       pb::VolumeDescription* response) override {
     grpc::ServerUnaryReactor* reactor = ctx->DefaultReactor();
-    if (!authorized(ctx, config_.token)) {
+    if (!authorized(ctx, config_.token, config_.noAuth)) {
       reactor->Finish(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
       return reactor;
     }
@@ -259,10 +327,13 @@ class Service final : public pb::ProbeStream::CallbackService {
     return reactor;
   }
 
+  FrameWriteTimes& writeTimes() { return writeTimes_; }
+
  private:
   ProbeHub& hub_;
   const ServerConfig& config_;
   std::atomic<uint32_t> subscribers_{0};
+  FrameWriteTimes writeTimes_;
 };
 
 }  // namespace
@@ -282,6 +353,9 @@ struct ProbeServer::Impl {
 ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.config = config;
+  if (config.token.empty() && !config.noAuth)
+    throw std::runtime_error("refusing to serve without authentication: give a token, or ask for noAuth");
+  if (!config.token.empty() && config.noAuth) throw std::runtime_error("a token and noAuth contradict each other");
   std::shared_ptr<grpc::ServerCredentials> creds;
   const bool tls = !config.tlsCertPem.empty() || !config.tlsKeyPem.empty();
   if (tls) {
@@ -318,6 +392,8 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
 ProbeServer::~ProbeServer() { shutdown(); }
 
 int ProbeServer::port() const { return impl_->port; }
+
+LatencyHistogram ProbeServer::takeFrameWriteLatency() { return impl_->service->writeTimes().take(); }
 
 void ProbeServer::shutdown() {
   {

@@ -27,18 +27,32 @@ void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t
 }
 
 bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds, std::string& why) {
-  if (in.protocol_version() != kProtocolVersion) return why = "server speaks another protocol version", false;
-  if (in.codec_format_version() != kFormatVersion) return why = "server sends another codec format version", false;
-  if (in.grid_x() > kMaxGridDim || in.grid_y() > kMaxGridDim || in.grid_z() > kMaxGridDim || in.brick_size() > 255)
-    return why = "volume grid out of range", false;
+  if (in.protocol_version() != kProtocolVersion)
+    return why = "server speaks protocol version " + std::to_string(in.protocol_version()) + ", not " +
+                 std::to_string(kProtocolVersion), false;
+  if (in.codec_format_version() != kFormatVersion)
+    return why = "server sends codec format version " + std::to_string(in.codec_format_version()) + ", not " +
+                 std::to_string(kFormatVersion), false;
+  // Range-check every number before narrowing it: 70000 must not wrap to a small grid.
+  const uint32_t grid[3] = {in.grid_x(), in.grid_y(), in.grid_z()};
+  const auto gridText = [&] {
+    return "volume grid " + std::to_string(grid[0]) + "x" + std::to_string(grid[1]) + "x" + std::to_string(grid[2]);
+  };
+  for (uint32_t g : grid)
+    if (g < 1 || g > static_cast<uint32_t>(kMaxGridDim))
+      return why = gridText() + " is outside 1.." + std::to_string(kMaxGridDim) + " per axis", false;
+  if (in.brick_size() < static_cast<uint32_t>(kMinBrickDim) || in.brick_size() > static_cast<uint32_t>(kMaxBrickDim))
+    return why = "brick size " + std::to_string(in.brick_size()) + " is outside " + std::to_string(kMinBrickDim) +
+                 ".." + std::to_string(kMaxBrickDim), false;
+  const int repr = in.representation();  // an open enum: any int32 may arrive
+  if (!v1::Representation_IsValid(repr) || !isValidRepresentation(static_cast<uint8_t>(repr)))  // 0 is not one
+    return why = "representation " + std::to_string(repr) + " is not one the client decodes", false;
   StreamLayout l;
-  l.grid[0] = static_cast<uint16_t>(in.grid_x());
-  l.grid[1] = static_cast<uint16_t>(in.grid_y());
-  l.grid[2] = static_cast<uint16_t>(in.grid_z());
+  for (int a = 0; a < 3; ++a) l.grid[a] = static_cast<uint16_t>(grid[a]);
   l.brickDim = static_cast<uint8_t>(in.brick_size());
-  l.repr = static_cast<Representation>(in.representation());
-  if (!isValidRepresentation(static_cast<uint8_t>(in.representation())) || !isValidLayout(l))
-    return why = "volume layout not valid", false;
+  l.repr = static_cast<Representation>(repr);
+  if (!isValidLayout(l))
+    return why = gridText() + " holds more than " + std::to_string(kMaxProbes) + " probes", false;
   if (in.bounds_min_size() != 3 || in.bounds_max_size() != 3) return why = "volume bounds need 3 values each", false;
   for (int a = 0; a < 3; ++a) {
     bounds.min[a] = in.bounds_min(a);

@@ -4,12 +4,19 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <algorithm>
 #include <stdexcept>
 
 namespace probecast::session {
 
 ChildProcess::ChildProcess(std::function<int(const Say& say)> body) {
+  start([body = std::move(body)](const Say& say, const Hear&) { return body(say); });
+}
+
+ChildProcess::ChildProcess(std::function<int(const Say& say, const Hear& hear)> body) { start(std::move(body)); }
+
+void ChildProcess::start(std::function<int(const Say& say, const Hear& hear)> body) {
   int toChild[2], fromChild[2];
   if (pipe(toChild) != 0) throw std::runtime_error("pipe failed");
   if (pipe(fromChild) != 0) {
@@ -36,9 +43,18 @@ ChildProcess::ChildProcess(std::function<int(const Say& say)> body) {
       std::fprintf(to, "%s\n", line.c_str());
       std::fflush(to);
     };
+    FILE* from = fdopen(toChild[0], "r");
+    const Hear hear = [from](std::string& line) {
+      line.clear();
+      for (int c; (c = std::fgetc(from)) != EOF;) {
+        if (c == '\n') return true;
+        line.push_back(static_cast<char>(c));
+      }
+      return false;  // a last line without its newline is a parent cut off mid-line: not a command
+    };
     int status = 1;
     try {
-      status = body(say);
+      status = body(say, hear);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "probecast: error in a child process: %s\n", e.what());
     } catch (...) {
@@ -59,26 +75,44 @@ ChildProcess::~ChildProcess() {
   wait();
 }
 
-void ChildProcess::go() {
-  const char go = 1;
+bool ChildProcess::writeToChild(const char* data, size_t size) {
   // A child that is already gone must not take this process with it (SIGPIPE): ignore the signal
-  // for the one write and get EPIPE instead.
+  // for the write and get EPIPE instead.
   struct sigaction ignore {}, previous {};
   ignore.sa_handler = SIG_IGN;
   sigaction(SIGPIPE, &ignore, &previous);
-  const bool written = goFd_ >= 0 && write(goFd_, &go, 1) == 1;
+  bool written = goFd_ >= 0;
+  while (written && size > 0) {
+    const ssize_t n = write(goFd_, data, size);
+    if (n < 0 && errno == EINTR) continue;
+    written = n > 0;
+    if (written) {
+      data += n;
+      size -= static_cast<size_t>(n);
+    }
+  }
   sigaction(SIGPIPE, &previous, nullptr);
-  if (!written) throw std::runtime_error("child process is gone");
-  close(goFd_);
-  goFd_ = -1;
+  return written;
+}
+
+void ChildProcess::go() {
+  const char go = 1;
+  if (!writeToChild(&go, 1)) throw std::runtime_error("child process is gone");
+}
+
+bool ChildProcess::tell(const std::string& line) {
+  const std::string withNewline = line + "\n";
+  return writeToChild(withNewline.data(), withNewline.size());
 }
 
 bool ChildProcess::readLine(std::string& line) {
-  char buffer[256];
-  if (!from_ || !std::fgets(buffer, sizeof buffer, from_)) return false;
-  line = buffer;
-  while (!line.empty() && line.back() == '\n') line.pop_back();
-  return true;
+  line.clear();
+  if (!from_) return false;
+  for (int c; (c = std::fgetc(from_)) != EOF;) {
+    if (c == '\n') return true;
+    line.push_back(static_cast<char>(c));
+  }
+  return !line.empty();
 }
 
 void ChildProcess::signal(int sig) {

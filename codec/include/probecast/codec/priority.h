@@ -17,6 +17,10 @@ struct View {
   float eye[3];
 };
 
+// The most views one view set may hold (lf:16x16): what the raster client renders in one pass and
+// what a subscriber may send the server in one view update.
+constexpr uint32_t kMaxViewsPerSet = 256;
+
 struct PriorityParams {
   float outOfViewWeight = 0.05f;  // bricks outside every frustum still trickle in
   float ageWeight = 0.25f;        // per frame waited: no starvation
@@ -38,7 +42,9 @@ void brickInfluenceBox(const StreamLayout& layout, const GridBounds& bounds, uin
 // outside a frustum corner, never false for a box inside).
 bool boxIntersectsFrustum(const float viewProj[16], const float boxMin[3], const float boxMax[3]);
 
-// Score of each brick (0 = nothing to send). Higher is sent first.
+// Score of each brick (0 = nothing to send). Higher is sent first. A brick with something to send
+// scores a finite positive float for any views, however far (a non-finite eye counts as the
+// farthest), so every brick is sent eventually.
 void scoreBricks(const StreamLayout& layout, const GridBounds& bounds, std::span<const View> views,
                  std::span<const BrickCandidate> candidates, const PriorityParams& params, float* scores);
 

@@ -81,6 +81,12 @@ struct FrameHeader {
 
 // Parses and checks a frame header (magic, version, representation, layout, CRC, total size).
 CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* header);
+// Checks a whole frame's container without decoding it: the header, then every section's header
+// fields, size and CRC, and that the sections fill the frame exactly. Cheap (two CRC passes over
+// the bytes, no decompression), for relays and load tests that pass frames on unread. A frame
+// that StreamDecoder::apply accepts always passes; one that passes may still fail to decode (a
+// delta on a base the decoder lacks, a payload that is wrong under a correct CRC). `header` may be null.
+CodecStatus verifyFrame(const uint8_t* data, size_t size, FrameHeader* header = nullptr);
 
 struct SectionInfo {
   uint32_t brick = 0;

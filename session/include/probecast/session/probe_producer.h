@@ -75,6 +75,7 @@ class ProbeProducer {
   int serve(const service::ServerConfig& config);
   int port() const;
   void shutdownServer();
+  service::ProbeServer* server() { return server_.get(); }  // null until serve()
   // Publishes every brick version to the probe bus as well (edges serve from it). Throws like BusPublisher.
   void publishTo(const service::BusConfig& bus);
   // The bus publisher's counters (all zero when not publishing).

@@ -160,6 +160,10 @@ class ProbeHub {
   };
 
   void refill(Subscriber& s, Clock::time_point now) const;
+  // Whether every brick a subscriber lacks scores above 0 (then an unlimited budget takes them all).
+  bool everyStaleBrickScores() const;
+  // The frame of the first `n` bricks of chosen_ for `s` (who lacked `behind`), its state updated.
+  OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind);
   std::vector<std::function<void()>> collectWakes();
   void markStale(uint32_t brick);
   BrickVersionBytes versionBytes(uint32_t brick);

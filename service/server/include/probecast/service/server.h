@@ -6,19 +6,23 @@
 #include <memory>
 #include <string>
 
+#include "probecast/service/latency_histogram.h"
 #include "probecast/service/probe_hub.h"
 
 namespace probecast::service {
 
 struct ServerConfig {
   std::string listen = "127.0.0.1:0";  // host:port; port 0 picks a free one
-  std::string token;                    // bearer token required on every call; empty = none
+  std::string token;                    // bearer token required on every call
+  bool noAuth = false;                  // must be set to serve without a token (anyone may subscribe)
   std::string tlsCertPem;               // PEM contents; with tlsKeyPem enables TLS
   std::string tlsKeyPem;
   bool plaintext = false;               // must be set to serve without TLS
   uint32_t maxSubscribers = 1024;
-  uint32_t maxViews = 64;               // per view update
-  uint32_t maxMessageBytes = 64 * 1024; // largest client message accepted
+  uint32_t maxViews = kMaxViewsPerSet;  // per view update: any view set a renderer draws
+  // Largest client message accepted. A view is about 83 bytes on the wire (16 packed floats and
+  // three eye floats), so kMaxViewsPerSet views take about 21 KiB.
+  uint32_t maxMessageBytes = 64 * 1024;
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
   static constexpr int kTickMs = 50;
@@ -26,7 +30,8 @@ struct ServerConfig {
 
 class ProbeServer {
  public:
-  // Throws std::runtime_error when the configuration is unsafe or the port cannot be bound.
+  // Throws std::runtime_error when the configuration is unsafe (no TLS without plaintext, no token
+  // without noAuth, or a token with noAuth) or the port cannot be bound.
   ProbeServer(const ServerConfig& config, ProbeHub& hub);
   ~ProbeServer();
   ProbeServer(const ProbeServer&) = delete;
@@ -34,6 +39,11 @@ class ProbeServer {
 
   int port() const;
   void shutdown();
+
+  // Instrumentation for load tests: the time from the publish of a frame's newest lighting
+  // (OutgoingFrame::serverTimeUs, system clock) to gRPC's write-done for it, over all frames
+  // written since the last call, which starts a new count.
+  LatencyHistogram takeFrameWriteLatency();
 
  private:
   struct Impl;
