@@ -15,46 +15,19 @@
 #include "probecast/service/client.h"
 #include "probecast/service/edge_server.h"
 #include "probecast/session/nats_server.h"
+#include "service_test_support.h"
 #include "test_probes.h"
 
 namespace probecast::service {
 namespace {
 
-using namespace std::chrono_literals;
-
-constexpr char kToken[] = "edge-token";
-
-// 16 × 4 × 16 probes in bricks of 4 (16 bricks), the moving-light generator's layout.
-HubConfig volumeConfig() {
-  return hubConfigFor(ProbeGrid{{16, 4, 16}, {{-2.0f, 0.0f, -2.0f}, {1.5f, 1.5f, 5.5f}}}, Representation::Zh3);
-}
-
-template <typename Pred>
-bool waitFor(Pred pred, std::chrono::milliseconds limit) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return pred();
-}
-
-bool matches(const ProbeClient& client, const ProbeHub& hub) {
-  VolumeSnapshot snap;
-  if (!client.snapshot(snap)) return false;
-  const ProbeVolume want = hub.reconstruction();
-  return snap.volume.probes.size() == want.probes.size() &&
-         std::memcmp(snap.volume.probes.data(), want.probes.data(), want.probes.size() * sizeof(float)) == 0 &&
-         snap.volume.active == want.active;
-}
-
 // A producer's hub publishing to the bus, lit by a moving light.
-struct Producer {
+struct BusProducer {
   ProbeHub hub{volumeConfig()};
   BusPublisher publisher;
   std::mt19937 rng{5};
   int frame = 0;
-  explicit Producer(const BusConfig& bus) : publisher(bus, hub) {}
+  explicit BusProducer(const BusConfig& bus) : publisher(bus, hub) {}
   void publish(int frames, std::chrono::milliseconds interval = 20ms) {
     for (int f = 0; f < frames; ++f) {
       hub.publish(test::movingLightFrame(1024, frame++, 0.01f, rng).data(), nullptr);
@@ -98,7 +71,7 @@ class Edge : public ::testing::Test {
 };
 
 TEST_F(Edge, SubscribersOnTwoEdgesEndBitIdenticalToTheProducer) {
-  Producer producer(bus);
+  BusProducer producer(bus);
   EdgeServer a(edgeConfig()), b(edgeConfig());
   std::vector<std::unique_ptr<ProbeClient>> clients;
   for (int i = 0; i < 6; ++i) {
@@ -107,7 +80,7 @@ TEST_F(Edge, SubscribersOnTwoEdgesEndBitIdenticalToTheProducer) {
   }
   producer.publish(30);
   for (size_t i = 0; i < clients.size(); ++i)
-    EXPECT_TRUE(waitFor([&] { return matches(*clients[i], producer.hub); }, 10s)) << "client " << i;
+    EXPECT_TRUE(waitFor([&] { return matchesServer(*clients[i], producer.hub); }, 10s)) << "client " << i;
   for (auto& c : clients) EXPECT_EQ(c->stats().framesRejected, 0u);
   EXPECT_EQ(a.hub().epoch(), producer.hub.epoch());
   EXPECT_EQ(a.stats().refused, 0u);
@@ -115,7 +88,7 @@ TEST_F(Edge, SubscribersOnTwoEdgesEndBitIdenticalToTheProducer) {
 }
 
 TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyframeStorm) {
-  Producer producer(bus);
+  BusProducer producer(bus);
   auto a = std::make_unique<EdgeServer>(edgeConfig());
   EdgeServer b(edgeConfig());
   const std::string onA = "127.0.0.1:" + std::to_string(a->port()), onB = "127.0.0.1:" + std::to_string(b.port());
@@ -128,7 +101,7 @@ TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyfra
   }
   producer.publish(20);
   for (auto& c : clients) {
-    ASSERT_TRUE(waitFor([&] { return matches(*c, producer.hub); }, 10s));
+    ASSERT_TRUE(waitFor([&] { return matchesServer(*c, producer.hub); }, 10s));
     ASSERT_EQ(c->stats().address, onA);
   }
   // What a subscriber that holds nothing needs: every brick's keyframe.
@@ -144,14 +117,14 @@ TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyfra
     ProbeClient& c = *clients[i];
     ASSERT_TRUE(waitFor([&] { return c.stats().connected && c.stats().address == onB; }, 10s)) << i;
     // Resumed with its epoch and held versions: nothing to send, let alone a keyframe set.
-    EXPECT_TRUE(matches(c, producer.hub));
+    EXPECT_TRUE(matchesServer(c, producer.hub));
     EXPECT_LT(c.stats().bytesReceived - before[i].bytesReceived, keyframeSet / 2)
         << "client " << i << " of a " << keyframeSet << "-byte keyframe set";
   }
   producer.publish(3);  // the stream goes on from the other edge, in deltas
   for (size_t i = 0; i < clients.size(); ++i) {
     ProbeClient& c = *clients[i];
-    EXPECT_TRUE(waitFor([&] { return matches(c, producer.hub); }, 10s)) << i;
+    EXPECT_TRUE(waitFor([&] { return matchesServer(c, producer.hub); }, 10s)) << i;
     const ClientStats st = c.stats();
     EXPECT_EQ(st.connects, 2u);
     EXPECT_GE(st.failovers, 1u);
@@ -165,19 +138,19 @@ TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyfra
 }
 
 TEST_F(Edge, NatsServerRestartedEdgesAndProducerRecoverAndSubscribersConverge) {
-  Producer producer(bus);
+  BusProducer producer(bus);
   EdgeServer a(edgeConfig()), b(edgeConfig());
   ProbeClient onA(clientFor({a.port()})), onB(clientFor({b.port()}));
   onA.start();
   onB.start();
   producer.publish(10);
-  ASSERT_TRUE(waitFor([&] { return matches(onA, producer.hub) && matches(onB, producer.hub); }, 10s));
+  ASSERT_TRUE(waitFor([&] { return matchesServer(onA, producer.hub) && matchesServer(onB, producer.hub); }, 10s));
   nats->stop();
   producer.publish(10);  // lighting moves on while the bus is away
-  EXPECT_FALSE(matches(onA, producer.hub));
+  EXPECT_FALSE(matchesServer(onA, producer.hub));
   nats->start();
   producer.publish(5);
-  EXPECT_TRUE(waitFor([&] { return matches(onA, producer.hub) && matches(onB, producer.hub); }, 15s))
+  EXPECT_TRUE(waitFor([&] { return matchesServer(onA, producer.hub) && matchesServer(onB, producer.hub); }, 15s))
       << "edge a: " << a.stats().lastError << "; producer: " << producer.publisher.stats().lastError;
   EXPECT_GE(producer.publisher.stats().resyncs, 2u);
   EXPECT_GE(a.stats().subscribes, 2u);
@@ -185,23 +158,23 @@ TEST_F(Edge, NatsServerRestartedEdgesAndProducerRecoverAndSubscribersConverge) {
 }
 
 TEST_F(Edge, AnEdgeStartedLateServesFromTheRetainedMessages) {
-  Producer producer(bus);
+  BusProducer producer(bus);
   producer.publish(15, 5ms);
   ASSERT_TRUE(producer.caughtUp());
   EdgeServer late(edgeConfig());  // everything it gets was published before it existed
   ProbeClient client(clientFor({late.port()}));
   client.start();
-  EXPECT_TRUE(waitFor([&] { return matches(client, producer.hub); }, 10s)) << late.stats().lastError;
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s)) << late.stats().lastError;
   EXPECT_EQ(late.stats().epochs, 1u);
 }
 
 TEST_F(Edge, MalformedBusMessagesAreRefusedNotAppliedAndTheStreamGoesOn) {
-  Producer producer(bus);
+  BusProducer producer(bus);
   EdgeServer edge(edgeConfig());
   ProbeClient client(clientFor({edge.port()}));
   client.start();
   producer.publish(5);
-  ASSERT_TRUE(waitFor([&] { return matches(client, producer.hub); }, 10s));
+  ASSERT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
   const uint64_t refusedBefore = edge.stats().refused;
   // Garbage, a valid message cut short, and one with a flipped byte, on a brick's subject.
   natsConnection* nc = nullptr;
@@ -222,9 +195,9 @@ TEST_F(Edge, MalformedBusMessagesAreRefusedNotAppliedAndTheStreamGoesOn) {
   EXPECT_TRUE(waitFor([&] { return edge.stats().refused >= refusedBefore + 3; }, 5s))
       << edge.stats().received << " received, " << edge.stats().refused << " refused, " << edge.stats().lastError;
   EXPECT_NE(edge.stats().lastError.find("refused"), std::string::npos) << edge.stats().lastError;
-  EXPECT_TRUE(matches(client, producer.hub));
+  EXPECT_TRUE(matchesServer(client, producer.hub));
   producer.publish(3);
-  EXPECT_TRUE(waitFor([&] { return matches(client, producer.hub); }, 10s));
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
   EXPECT_EQ(client.stats().framesRejected, 0u);
   EXPECT_EQ(client.stats().connects, 1u);
 }
@@ -235,15 +208,15 @@ TEST_F(Edge, ARestartedProducerIsANewEpochEdgesEndTheirStreamsAndClientsConverge
   client.start();
   uint64_t firstEpoch = 0;
   {
-    Producer first(bus);
+    BusProducer first(bus);
     first.publish(5);
-    ASSERT_TRUE(waitFor([&] { return matches(client, first.hub); }, 10s));
+    ASSERT_TRUE(waitFor([&] { return matchesServer(client, first.hub); }, 10s));
     firstEpoch = first.hub.epoch();
   }
-  Producer second(bus);
+  BusProducer second(bus);
   second.rng.seed(77);  // other lighting
   second.publish(5);
-  EXPECT_TRUE(waitFor([&] { return matches(client, second.hub); }, 10s)) << edge.stats().lastError;
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, second.hub); }, 10s)) << edge.stats().lastError;
   EXPECT_NE(second.hub.epoch(), firstEpoch);
   EXPECT_EQ(edge.hub().epoch(), second.hub.epoch());
   EXPECT_GE(client.stats().connects, 2u);  // its stream was ended and it subscribed again

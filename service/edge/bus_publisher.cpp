@@ -84,15 +84,8 @@ struct BusPublisher::Impl {
     }
     size_t left = batch.size();
     for (const auto& [brick, v] : batch) {
-      bus::Brick b;
-      b.brick = v.brick;
-      b.version = v.version;
-      b.producerFrame = v.producerFrame;
-      b.change = v.change;
-      b.keyframe = v.keyframe;
-      b.delta = v.delta;
       volume.publishedUs = v.publishedUs;
-      bus::writeBrickMessage(volume, b, --left == 0 ? bus::kEndOfBatch : 0, message);
+      bus::writeBrickMessage(volume, busBrick(v), --left == 0 ? bus::kEndOfBatch : 0, message);
       if (!send(brickSubject(config.stream, brick))) return false;
       sent.keyframeBytes += v.keyframe.size();
       sent.deltaBytes += v.delta.size();
