@@ -13,6 +13,7 @@ void addDemoCommand(CLI::App& app);
 void addBakeCommand(CLI::App& app);
 void addReferenceCommand(CLI::App& app);
 void addServeCommands(CLI::App& app);
+void addEdgeCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 

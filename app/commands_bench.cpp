@@ -1,4 +1,4 @@
-// `probecast bench codec|update|raster|pipeline|environment|stability|stream`.
+// `probecast bench codec|update|raster|pipeline|environment|stability|stream|edge`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "codec_bench.h"
+#include "edge_bench.h"
 #include "environment_bench.h"
 #include "probecast/codec/probe_file.h"
 #include "commands.h"
@@ -296,6 +297,29 @@ void addBenchStream(CLI::App* bench) {
   });
 }
 
+// `probecast bench edge`: the probe bus and two edges against direct serving.
+void addBenchEdge(CLI::App* bench) {
+  CLI::App* edge = bench->add_subcommand("edge", "latency and failover through NATS and two edges, against direct");
+  struct EdgeOptions {
+    std::string json;
+    bench::EdgeBenchOptions bench;
+  };
+  auto eo = std::make_shared<EdgeOptions>();
+  edge->add_option("--clients", eo->bench.clients, "clients per phase (direct, then through the edges)")
+      ->check(CLI::Range(1, 1000));
+  edge->add_option("--hz", eo->bench.hz, "lighting updates per second")->check(CLI::Range(0.5, 240.0));
+  edge->add_option("--seconds", eo->bench.seconds, "measured time per latency phase")->check(CLI::Range(1.0, 3600.0));
+  edge->add_option("--kills", eo->bench.kills, "edges killed (SIGKILL) one after another")->check(CLI::Range(0, 100));
+  addRepresentationOption(edge, eo->bench.repr, "l1, zh3h, zh3, l2 or fp16");
+  addJsonOption(edge, eo->json);
+  edge->callback([eo] {
+    eo->bench.command = commandLine();
+    eo->bench.progress = progressLine;
+    const bench::EdgeBenchResult r = bench::runEdgeBench(eo->bench);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", eo->json, "", "");
+  });
+}
+
 }  // namespace
 
 void addBenchCommands(CLI::App& app) {
@@ -308,6 +332,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchEnvironment(bench);
   addBenchStability(bench);
   addBenchStream(bench);
+  addBenchEdge(bench);
 }
 
 }  // namespace probecast::app

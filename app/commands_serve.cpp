@@ -22,6 +22,7 @@ struct ServeOptions {
   TracingOptions tracing;
   ServerOptions server;
   std::string probes, repr = "zh3";
+  std::string publish, stream = "probes";
   int brick = 4, deadzone = 1;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
@@ -72,17 +73,30 @@ void addServeCommand(CLI::App& app) {
   serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
       ->check(CLI::Range(0, 127));
   o->server.add(serve);
+  CLI::Option* publish =
+      serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
+  serve->add_option("--stream", o->stream, "the volume's name on the bus (letters, digits, - and _)")->needs(publish);
   serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
   serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
   serve->callback([o] {
     const service::ServerConfig sc = o->server.config();
+    service::BusConfig bus;
+    bus.url = o->publish;
+    bus.stream = o->stream;
+    std::string why;
+    if (!o->publish.empty() && !service::checkBusConfig(bus, why)) throw std::runtime_error("--publish/--stream: " + why);
     ProbeVolume file;
     std::unique_ptr<renderer::VulkanContext> context;
     service::HubConfig hc;
     std::string what;
     const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what);
     const int port = producer->serve(sc);
+    if (!o->publish.empty()) {
+      producer->publishTo(bus);
+      fmt::print("serve: publishing to {} as stream {} (subjects {})\n", bus.url, service::busStreamName(bus.stream),
+                 service::busSubjects(bus.stream));
+    }
     fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}\n", what, port,
                sc.tlsCertPem.empty() ? "plaintext" : "TLS", representationName(hc.layout.repr), hc.layout.grid[0],
                hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file");
@@ -97,8 +111,13 @@ void addServeCommand(CLI::App& app) {
     double lastReport = 0.0;
     producer->run(pacing, &gInterrupted, [&](double seconds) {
       if (seconds - lastReport < 5.0) return;
-      fmt::print("serve: {:.0f} s, {} updates, {} subscribers\n", seconds, producer->stats().updates,
-                 producer->hub().subscriberCount());
+      const service::PublisherStats sent = producer->busStats();
+      fmt::print("serve: {:.0f} s, {} updates, {} subscribers{}\n", seconds, producer->stats().updates,
+                 producer->hub().subscriberCount(),
+                 o->publish.empty() ? std::string()
+                                    : fmt::format(", bus {} ({} messages, {} bytes{})",
+                                                  sent.connected ? "connected" : "away", sent.messages, sent.bytes,
+                                                  sent.lastError.empty() ? "" : ", last error: " + sent.lastError));
       std::fflush(stdout);
       lastReport = seconds;
     });
@@ -116,7 +135,7 @@ void addSubscribeCommand(CLI::App& app) {
     double seconds = 5.0;
   };
   auto so = std::make_shared<SubOptions>();
-  so->connection.add(sub, "server address host:port", true, true);
+  so->connection.add(sub, "server address host:port (several comma-separated: edges to fail over between)", true, true);
   sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
   sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
   sub->add_option("--out", so->out, "write the received volume here (probe volume file)");

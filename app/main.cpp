@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   probecast::app::addBakeCommand(app);
   probecast::app::addReferenceCommand(app);
   probecast::app::addServeCommands(app);
+  probecast::app::addEdgeCommand(app);
   probecast::app::addCompareCommand(app);
   probecast::app::addViewCommand(app);
   try {

@@ -228,9 +228,18 @@ struct ConnectOptions {
     cmd->add_option("--tls-ca", tlsCa, "PEM root certificate to trust (enables TLS)")->check(CLI::ExistingFile);
     cmd->add_option("--tls-name", tlsName, "server name to check in its certificate");
   }
+  // --connect may name several servers (edges), comma-separated: the client fails over between them.
   service::ClientConfig client(const std::string& name) const {
     service::ClientConfig cc;
-    cc.address = connect;
+    size_t start = 0;
+    while (start <= connect.size()) {
+      const size_t end = std::min(connect.find(',', start), connect.size());
+      const std::string one = connect.substr(start, end - start);
+      if (one.empty()) throw std::runtime_error("--connect '" + connect + "': an empty address in the list");
+      cc.addresses.push_back(one);
+      start = end + 1;
+    }
+    cc.address = cc.addresses.front();
     cc.token = tokenFrom(token, tokenFile);
     cc.name = name;
     if (!tlsCa.empty()) {

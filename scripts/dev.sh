@@ -3,8 +3,8 @@
 #   scripts/dev.sh demo          build, then run `probecast demo` (writes out/)
 #   scripts/dev.sh test          build, then run the whole test suite (ctest)
 #   scripts/dev.sh core-test     the Vulkan-free build (codec, imaging, service, their tests) in build-core, and its tests
-#   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec tests under it
-#   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec
+#   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec and bus-format tests under it
+#   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec and the bus decoder
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -56,26 +56,34 @@ case "$cmd" in
   memsafe)
     configure_and_build build-asan -DPROBECAST_SANITIZE=ON -DPROBECAST_APP=OFF
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L codec "$@"
+      ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L 'codec|bus' "$@"
     ;;
   fuzz)
+    # Two targets share the time: the codec's decoders and the probe bus decoder.
     secs=${1:-60}
     configure_and_build build-fuzz -DPROBECAST_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14
-    seeds=build-fuzz/seeds
-    corpus=build-fuzz/corpus
-    mkdir -p "$seeds" "$corpus"
-    ./build-fuzz/fuzz/codec_fuzz_seeds "$seeds"
-    echo "fuzz: running codec_fuzz for ${secs}s"
-    rc=0
-    ./build-fuzz/fuzz/codec_fuzz -max_total_time="$secs" -print_final_stats=1 -artifact_prefix=build-fuzz/ \
-      "$corpus" "$seeds" >build-fuzz/fuzz.log 2>&1 || rc=$?
-    grep -E '^(Done|stat::(number_of_executed_units|new_units_added)|==[0-9]+==|SUMMARY|.*artifact)' build-fuzz/fuzz.log || true
-    if [ "$rc" -ne 0 ]; then
-      tail -40 build-fuzz/fuzz.log
-      echo "fuzz: codec_fuzz found a failure (rc $rc, log build-fuzz/fuzz.log)"
-      exit 1
-    fi
-    echo "fuzz: clean after ${secs}s" 
+    for target in codec bus; do
+      if [ "$target" = codec ]; then
+        seeds=build-fuzz/seeds corpus=build-fuzz/corpus share=$(( (secs + 1) / 2 ))
+      else
+        seeds=build-fuzz/seeds-$target corpus=build-fuzz/corpus-$target share=$(( secs / 2 ))
+      fi
+      [ "$share" -ge 1 ] || share=1
+      mkdir -p "$seeds" "$corpus"
+      "./build-fuzz/fuzz/${target}_fuzz_seeds" "$seeds"
+      echo "fuzz: running ${target}_fuzz for ${share}s"
+      log=build-fuzz/fuzz-$target.log
+      rc=0
+      "./build-fuzz/fuzz/${target}_fuzz" -max_total_time="$share" -print_final_stats=1 -artifact_prefix=build-fuzz/ \
+        "$corpus" "$seeds" >"$log" 2>&1 || rc=$?
+      grep -E '^(Done|stat::(number_of_executed_units|new_units_added)|==[0-9]+==|SUMMARY|.*artifact)' "$log" || true
+      if [ "$rc" -ne 0 ]; then
+        tail -40 "$log"
+        echo "fuzz: ${target}_fuzz found a failure (rc $rc, log $log)"
+        exit 1
+      fi
+    done
+    echo "fuzz: clean after ${secs}s"
     ;;
   *)
     echo "usage: scripts/dev.sh demo|test|core-test|memsafe|fuzz [args]" >&2

@@ -9,6 +9,7 @@ PACKAGES=(
   nlohmann-json3-dev libstb-dev libopenexr-dev libglm-dev libtinygltf-dev
   libvulkan-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
+  nats-server libnats-dev
   clang-14 libclang-rt-14-dev openssl
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev
 )

@@ -7,7 +7,7 @@
 
 #include "brick_section.h"
 #include "byte_io.h"
-#include "crc32c.h"
+#include "probecast/codec/crc32c.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {
@@ -264,6 +264,17 @@ CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t
   v.data = data + kSectionHeaderSize;
   *view = v;
   *consumed = kSectionHeaderSize + v.storedSize;
+  return CodecStatus::Ok;
+}
+
+CodecStatus readSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionInfo* info) {
+  SectionView view;
+  size_t consumed = 0;
+  if (CodecStatus st = parseSection(layout, data, size, &view, &consumed); st != CodecStatus::Ok) return st;
+  info->brick = view.brick;
+  info->version = view.version;
+  info->kind = view.kind;
+  info->bytes = consumed;
   return CodecStatus::Ok;
 }
 

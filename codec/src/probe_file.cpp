@@ -7,7 +7,7 @@
 #include <iterator>
 
 #include "byte_io.h"
-#include "crc32c.h"
+#include "probecast/codec/crc32c.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {

@@ -45,7 +45,7 @@ struct ProbeClient::Impl {
     return s && s->Write(m);
   }
 
-  std::shared_ptr<grpc::Channel> channel() const {
+  std::shared_ptr<grpc::Channel> channel(const std::string& address) const {
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(256 << 20);
     std::shared_ptr<grpc::ChannelCredentials> creds;
@@ -57,11 +57,11 @@ struct ProbeClient::Impl {
     } else {
       creds = grpc::InsecureChannelCredentials();
     }
-    return grpc::CreateCustomChannel(config.address, creds, args);
+    return grpc::CreateCustomChannel(address, creds, args);
   }
 
   // False for a description the client cannot use: the connection is dropped and retried later.
-  bool onVolume(const pb::VolumeDescription& v) {
+  bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
     StreamLayout l;
     GridBounds b;
     std::string why;
@@ -81,6 +81,7 @@ struct ProbeClient::Impl {
     epoch = v.stream_epoch();
     stats.connected = true;
     stats.connects += 1;
+    stats.address = address;
     return true;
   }
 
@@ -100,6 +101,8 @@ struct ProbeClient::Impl {
     }
     stats.framesApplied += 1;
     stats.bytesReceived += f.payload().size();
+    stats.keyframesReceived += f.keyframes();
+    stats.deltasReceived += f.deltas();
     const uint64_t now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
                                                    std::chrono::system_clock::now().time_since_epoch())
                                                    .count());
@@ -130,11 +133,15 @@ struct ProbeClient::Impl {
   }
 
   void run() {
+    const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
+                                                                      : config.addresses;
+    size_t at = 0;
+    size_t failedInTurn = 0;  // servers tried since the last one that answered
     int backoff = config.reconnectMinMs;
     while (!stopping) {
       grpc::ClientContext ctx;
       if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
-      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel());
+      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel(servers[at]));
       std::unique_ptr<Stream> rw = stub->Subscribe(&ctx);
       {
         std::lock_guard<std::mutex> lock(mutex);
@@ -152,14 +159,17 @@ struct ProbeClient::Impl {
         write(vm);
       }
       pb::ServerMessage msg;
+      bool gotVolume = false;
       bool dropped = false;  // by us, for a reason already in lastError
       while (rw->Read(&msg)) {
         if (msg.has_volume()) {
-          if (!onVolume(msg.volume())) {
+          if (!onVolume(msg.volume(), servers[at])) {
             dropped = true;
             ctx.TryCancel();
             break;
           }
+          gotVolume = true;
+          failedInTurn = 0;
           backoff = config.reconnectMinMs;
         } else if (msg.has_stats()) {
           std::lock_guard<std::mutex> lock(mutex);
@@ -186,11 +196,11 @@ struct ProbeClient::Impl {
         context = nullptr;
       }
       const grpc::Status status = rw->Finish();
+      const auto code = status.error_code();
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
-        if (!status.ok() && !stopping && !dropped) stats.lastError = status.error_message();
-        const auto code = status.error_code();
+        if (!status.ok() && !stopping && !dropped) stats.lastError = servers[at] + ": " + status.error_message();
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {
           stats.fatal = true;
@@ -198,6 +208,19 @@ struct ProbeClient::Impl {
         }
       }
       if (stopping) return;
+      // ABORTED: the server's stream epoch changed (its producer restarted); subscribe there
+      // again at once. Anything else (unavailable, a dead connection): the next server, at once,
+      // until every one has failed in turn; then back off.
+      if (code == grpc::StatusCode::ABORTED && gotVolume) continue;
+      const bool moved = servers.size() > 1 && code != grpc::StatusCode::ABORTED;
+      if (moved) {
+        at = (at + 1) % servers.size();
+        std::lock_guard<std::mutex> lock(mutex);
+        stats.failovers += 1;
+      }
+      if (!gotVolume) ++failedInTurn;
+      if (moved && failedInTurn < servers.size()) continue;
+      failedInTurn = 0;
       std::unique_lock<std::mutex> lock(mutex);
       wakeup.wait_for(lock, std::chrono::milliseconds(backoff), [&] { return stopping.load(); });
       backoff = std::min(backoff * 2, config.reconnectMaxMs);

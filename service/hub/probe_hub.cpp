@@ -4,6 +4,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "brick_source.h"
+
 namespace probecast::service {
 namespace {
 
@@ -17,10 +19,71 @@ uint64_t randomEpoch() {
   return (static_cast<uint64_t>(rd()) << 32 | rd()) | 1u;  // never 0 ("no epoch")
 }
 
+bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBounds& bounds) {
+  const StreamLayout& l = a.layout;
+  bool same = l.repr == layout.repr && l.brickDim == layout.brickDim;
+  for (int i = 0; i < 3; ++i)
+    same = same && l.grid[i] == layout.grid[i] && a.bounds.min[i] == bounds.min[i] && a.bounds.max[i] == bounds.max[i];
+  return same;
+}
+
 }  // namespace
 
-ProbeHub::ProbeHub(const HubConfig& config)
-    : config_(config), epoch_(randomEpoch()), encoder_(config.layout, config.encoder) {}
+bus::Brick busBrick(const BrickVersionBytes& v) {
+  bus::Brick b;
+  b.brick = v.brick;
+  b.version = v.version;
+  b.producerFrame = v.producerFrame;
+  b.change = v.change;
+  b.keyframe = v.keyframe;
+  b.delta = v.delta;
+  return b;
+}
+
+ProbeHub::ProbeHub(const HubConfig& config) : config_(config), epoch_(randomEpoch()) {
+  auto source = std::make_unique<EncoderBricks>(config.layout, config.encoder);
+  encoder_ = source.get();
+  source_ = std::move(source);
+}
+
+ProbeHub::ProbeHub(const HubConfig& config, FromBus) : config_(config), fromBus_(true) {}
+
+ProbeHub::~ProbeHub() = default;
+
+bool ProbeHub::ready() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return source_ != nullptr;
+}
+
+StreamLayout ProbeHub::layout() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return config_.layout;
+}
+
+GridBounds ProbeHub::bounds() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return config_.bounds;
+}
+
+uint64_t ProbeHub::epoch() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return epoch_;
+}
+
+bus::Volume ProbeHub::volume() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  bus::Volume v;
+  v.epoch = epoch_;
+  v.publishedUs = publishedUs_;
+  v.layout = config_.layout;
+  v.bounds = config_.bounds;
+  return v;
+}
+
+EncoderBricks& ProbeHub::encoderSource(const char* what) const {
+  if (!encoder_) throw std::logic_error(std::string(what) + " is for a producer's hub; an edge's takes the bus");
+  return *encoder_;
+}
 
 HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, int brickDim, int deadzone) {
   HubConfig c;  // an edge out of the uint8_t range becomes 0, which isValidLayout refuses
@@ -41,18 +104,114 @@ void ProbeHub::publish(const ProbeVolume& volume) {
 
 void ProbeHub::publish(const float* probes, const uint8_t* active) {
   std::vector<std::function<void()>> wakes;
+  std::vector<BrickVersionBytes> made;
+  BusOutput output;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    encoder_.update(probes, active);
+    encoderSource("publish").encoder().update(probes, active);
     ++frame_;
     publishedUs_ = nowUs();
     const uint32_t bricks = brickCount(config_.layout);
-    for (auto& [id, s] : subscribers_)
+    for (uint32_t b = 0; b < bricks; ++b) markStale(b);
+    if (busOutput_) {
+      lastOutput_.resize(bricks, 0);
       for (uint32_t b = 0; b < bricks; ++b)
-        if (s.held[b] != encoder_.brickVersion(b) && s.staleSince[b] == UINT32_MAX) s.staleSince[b] = frame_;
+        if (source_->version(b) != lastOutput_[b]) {
+          made.push_back(versionBytes(b));
+          lastOutput_[b] = source_->version(b);
+        }
+      output = busOutput_;
+    }
     wakes = collectWakes();
   }
+  if (output && !made.empty()) output(std::move(made));
   for (auto& w : wakes) w();
+}
+
+void ProbeHub::markStale(uint32_t brick) {
+  const uint32_t current = source_->version(brick);
+  for (auto& [id, s] : subscribers_)
+    if (!s.ended && s.held[brick] < current && s.staleSince[brick] == UINT32_MAX) s.staleSince[brick] = frame_;
+}
+
+BrickVersionBytes ProbeHub::versionBytes(uint32_t brick) {
+  StreamEncoder& e = encoder_->encoder();
+  BrickVersionBytes v;
+  v.brick = brick;
+  v.version = e.brickVersion(brick);
+  v.producerFrame = frame_;
+  v.publishedUs = publishedUs_;
+  v.change = e.brickChange(brick);
+  const std::span<const uint8_t> key = e.keyframeSection(brick), delta = e.deltaSection(brick);
+  v.keyframe.assign(key.begin(), key.end());
+  v.delta.assign(delta.begin(), delta.end());
+  return v;
+}
+
+void ProbeHub::setBusOutput(BusOutput output) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  encoderSource("setBusOutput");
+  busOutput_ = std::move(output);
+  lastOutput_.assign(brickCount(config_.layout), 0);
+  for (uint32_t b = 0; b < lastOutput_.size(); ++b) lastOutput_[b] = source_->version(b);
+}
+
+std::vector<BrickVersionBytes> ProbeHub::currentBricks() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  encoderSource("currentBricks");
+  std::vector<BrickVersionBytes> all;
+  for (uint32_t b = 0; b < brickCount(config_.layout); ++b)
+    if (source_->version(b) != 0) all.push_back(versionBytes(b));
+  return all;
+}
+
+void ProbeHub::startEpoch(const bus::Volume& volume, std::vector<std::function<void()>>& wakes) {
+  config_.layout = volume.layout;
+  config_.bounds = volume.bounds;
+  epoch_ = volume.epoch;
+  auto source = std::make_unique<BusBricks>(volume.layout);
+  bus_ = source.get();
+  source_ = std::move(source);
+  frame_ = 0;
+  publishedUs_ = 0;
+  for (auto& [id, s] : subscribers_) {  // what they hold is of another epoch: their streams end
+    s.ended = true;
+    s.waiting = false;
+    if (s.wake) wakes.push_back(s.wake);
+  }
+}
+
+ProbeHub::Received ProbeHub::receive(const bus::Message& m, bool wake, std::string& why) {
+  if (!fromBus_) throw std::logic_error("receive is for an edge's hub; a producer's encodes its own");
+  std::vector<std::function<void()>> wakes;
+  Received result = Received::Stale;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!source_ || m.volume.epoch != epoch_) {
+      startEpoch(m.volume, wakes);
+      result = Received::NewEpoch;
+    } else if (!sameVolume(m.volume, config_.layout, config_.bounds)) {
+      why = "a message of stream epoch " + std::to_string(epoch_) + " describes another volume than the epoch's";
+      return Received::Refused;
+    }
+    if (m.kind == bus::Kind::Brick) {
+      const BusBricks::Accepted a = bus_->accept(m.brick, why);
+      if (a == BusBricks::Accepted::Refused) {
+        result = Received::Refused;
+      } else if (a == BusBricks::Accepted::Applied) {
+        frame_ = std::max(frame_, m.brick.producerFrame);
+        publishedUs_ = std::max(publishedUs_, m.volume.publishedUs);
+        markStale(m.brick.brick);
+        if (result != Received::NewEpoch) result = Received::Applied;
+      }
+    }
+    if (wake) {
+      std::vector<std::function<void()>> more = collectWakes();
+      wakes.insert(wakes.end(), more.begin(), more.end());
+    }
+  }
+  for (auto& w : wakes) w();
+  return result;
 }
 
 void ProbeHub::tick() {
@@ -82,6 +241,7 @@ uint32_t ProbeHub::serverFrame() const {
 uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
                                  std::function<void()> wake) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!source_) throw std::logic_error("addSubscriber before the hub has a volume (check ready())");
   const uint32_t bricks = brickCount(config_.layout);
   Subscriber s;
   s.budget = budgetBytesPerSecond;
@@ -91,9 +251,12 @@ uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, 
   s.staleSince.assign(bricks, UINT32_MAX);
   if (epoch == epoch_)
     for (const HeldBrick& h : held)
-      if (h.brick < bricks && h.version <= encoder_.brickVersion(h.brick)) s.held[h.brick] = h.version;
+      // On an edge a subscriber may come from a faster edge and hold versions this one has yet
+      // to receive: it is sent nothing of those bricks until they move past what it holds. A
+      // producer has made every version there is, so a later one is nonsense there.
+      if (h.brick < bricks && (fromBus_ || h.version <= source_->version(h.brick))) s.held[h.brick] = h.version;
   for (uint32_t b = 0; b < bricks; ++b)
-    if (s.held[b] != encoder_.brickVersion(b)) s.staleSince[b] = frame_;
+    if (s.held[b] < source_->version(b)) s.staleSince[b] = frame_;
   s.wake = std::move(wake);
   const uint64_t id = nextId_++;
   subscribers_.emplace(id, std::move(s));
@@ -136,19 +299,19 @@ void ProbeHub::refill(Subscriber& s, Clock::time_point now) const {
 std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = subscribers_.find(id);
-  if (it == subscribers_.end()) return std::nullopt;
+  if (it == subscribers_.end() || it->second.ended) return std::nullopt;
   Subscriber& s = it->second;
   const uint32_t bricks = brickCount(config_.layout);
   candidates_.assign(bricks, BrickCandidate{});
   uint32_t behind = 0;
   for (uint32_t b = 0; b < bricks; ++b) {
-    const uint32_t current = encoder_.brickVersion(b);
-    if (s.held[b] == current) continue;
+    const uint32_t current = source_->version(b);
+    if (s.held[b] >= current) continue;  // current, or ahead of a lagging edge
     ++behind;
     BrickCandidate& c = candidates_[b];
-    c.change = std::max(encoder_.changeSince(b, s.held[b]), 1e-3f);
+    c.change = std::max(source_->changeSince(b, s.held[b]), 1e-3f);
     c.ageFrames = frame_ - std::min(frame_, s.staleSince[b]);
-    c.bytes = static_cast<uint32_t>(encoder_.sectionFor(b, s.held[b]).size());
+    c.bytes = static_cast<uint32_t>(source_->sectionFor(b, s.held[b]).size());
   }
   s.stats.bricksBehind = behind;
   if (behind == 0) {
@@ -162,7 +325,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
     // matter, so the scoring (frustum tests per view and brick, a sort) is skipped.
     size_t n = 0;
     for (uint32_t b = 0; b < bricks; ++b)
-      if (s.held[b] != encoder_.brickVersion(b)) chosen_[n++] = b;
+      if (s.held[b] < source_->version(b)) chosen_[n++] = b;
     return buildFrame(s, n, behind);
   }
   scores_.resize(bricks);
@@ -201,10 +364,10 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind) {
   sections.reserve(n);
   for (size_t k = 0; k < n; ++k) {
     const uint32_t b = chosen_[k];
-    const bool delta = s.held[b] + 1 == encoder_.brickVersion(b);
-    sections.push_back(encoder_.sectionFor(b, s.held[b]));
+    bool delta = false;
+    sections.push_back(source_->sectionFor(b, s.held[b], &delta));
     (delta ? frame.deltas : frame.keyframes) += 1;
-    s.held[b] = encoder_.brickVersion(b);
+    s.held[b] = source_->version(b);
     s.staleSince[b] = UINT32_MAX;
   }
   frame.sequence = ++s.sequence;
@@ -241,6 +404,12 @@ bool ProbeHub::acknowledge(uint64_t id, uint32_t sequence, std::string& why) {
   return true;
 }
 
+bool ProbeHub::streamEnded(uint64_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = subscribers_.find(id);
+  return it != subscribers_.end() && it->second.ended;
+}
+
 SubscriberStats ProbeHub::stats(uint64_t id) const {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = subscribers_.find(id);
@@ -250,7 +419,7 @@ SubscriberStats ProbeHub::stats(uint64_t id) const {
 ProbeVolume ProbeHub::reconstruction() const {
   std::lock_guard<std::mutex> lock(mutex_);
   ProbeVolume v;
-  encoder_.copyVolume(config_.bounds, v);
+  if (source_) source_->copyVolume(config_.bounds, v);
   return v;
 }
 

@@ -39,6 +39,11 @@ bool authorized(grpc::CallbackServerContext* ctx, const std::string& token, bool
   return diff == 0;
 }
 
+// An edge that has not yet heard from its producer: another edge may have (the client moves on).
+grpc::Status notReady() {
+  return grpc::Status(grpc::StatusCode::UNAVAILABLE, "no volume yet: this edge has not heard from its producer");
+}
+
 class RejectReactor : public RawReactor {
  public:
   explicit RejectReactor(const grpc::Status& status) { Finish(status); }
@@ -134,6 +139,11 @@ class SubscribeReactor : public RawReactor {
   // Called by the hub's wake-up with the link locked.
   void tryWriteLocked() {
     if (writing_ || finished_ || pendingFinish_ || !id_) return;
+    if (hub_.streamEnded(id_)) {  // an edge whose producer restarted: what we sent belongs to another epoch
+      finishLocked(grpc::Status(grpc::StatusCode::ABORTED, "the stream epoch changed (the producer restarted); "
+                                                           "subscribe again"));
+      return;
+    }
     if (framesSinceStats_ >= kFramesPerStats) {  // a Stats message every kFramesPerStats frames
       framesSinceStats_ = 0;
       const SubscriberStats st = hub_.stats(id_);
@@ -216,15 +226,17 @@ class SubscribeReactor : public RawReactor {
     if (h.protocol_version() != kProtocolVersion)
       return invalid("protocol version " + std::to_string(h.protocol_version()) + " not supported (server speaks " +
                      std::to_string(kProtocolVersion) + ")");
+    if (!hub_.ready()) return notReady();
+    const StreamLayout layout = hub_.layout();
     // An open enum: any int32 may arrive, and a narrowing cast would read 260 as 4 (l2).
     const int wanted = h.representation();
     if (!pb::Representation_IsValid(wanted))
       return invalid("representation " + std::to_string(wanted) + " is not a known Representation");
-    const int served = static_cast<int>(hub_.layout().repr);
+    const int served = static_cast<int>(layout.repr);
     if (wanted != pb::REPRESENTATION_UNSPECIFIED && wanted != served)
       return invalid("representation " + pb::Representation_Name(h.representation()) + " is not served (this server "
                      "streams " + pb::Representation_Name(static_cast<pb::Representation>(served)) + ")");
-    const uint32_t bricks = brickCount(hub_.layout());
+    const uint32_t bricks = brickCount(layout);
     if (static_cast<uint32_t>(h.held_size()) > bricks) return invalid("more held bricks than the volume has");
     std::vector<HeldBrick> held;
     for (const auto& b : h.held()) {
@@ -246,7 +258,8 @@ class SubscribeReactor : public RawReactor {
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
     out_.Clear();
-    volumeToWire(hub_.layout(), hub_.bounds(), hub_.epoch(), *out_.mutable_volume());
+    const bus::Volume v = hub_.volume();
+    volumeToWire(v.layout, v.bounds, v.epoch, *out_.mutable_volume());
     startWriteLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }
@@ -304,7 +317,12 @@ class Service final : public RawSubscribeService {
       reactor->Finish(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
       return reactor;
     }
-    volumeToWire(hub_.layout(), hub_.bounds(), hub_.epoch(), *response);
+    if (!hub_.ready()) {
+      reactor->Finish(notReady());
+      return reactor;
+    }
+    const bus::Volume v = hub_.volume();
+    volumeToWire(v.layout, v.bounds, v.epoch, *response);
     reactor->Finish(grpc::Status::OK);
     return reactor;
   }

@@ -115,6 +115,10 @@ bool ChildProcess::readLine(std::string& line) {
   return !line.empty();
 }
 
+void ChildProcess::signal(int sig) {
+  if (pid_ > 0) kill(pid_, sig);
+}
+
 int ChildProcess::wait() {
   if (pid_ <= 0) return -1;
   int status = 0;

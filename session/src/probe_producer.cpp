@@ -12,6 +12,7 @@ ProbeProducer::ProbeProducer(const service::HubConfig& hub) : hub_(hub) {}
 ProbeProducer::~ProbeProducer() {
   stop();
   shutdownServer();
+  publisher_.reset();
 }
 
 int ProbeProducer::serve(const service::ServerConfig& config) {
@@ -20,6 +21,14 @@ int ProbeProducer::serve(const service::ServerConfig& config) {
 }
 
 int ProbeProducer::port() const { return server_ ? server_->port() : 0; }
+
+void ProbeProducer::publishTo(const service::BusConfig& bus) {
+  publisher_ = std::make_unique<service::BusPublisher>(bus, hub_);
+}
+
+service::PublisherStats ProbeProducer::busStats() const {
+  return publisher_ ? publisher_->stats() : service::PublisherStats{};
+}
 
 void ProbeProducer::shutdownServer() {
   if (server_) server_->shutdown();

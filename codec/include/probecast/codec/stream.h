@@ -88,6 +88,18 @@ CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* heade
 // delta on a base the decoder lacks, a payload that is wrong under a correct CRC). `header` may be null.
 CodecStatus verifyFrame(const uint8_t* data, size_t size, FrameHeader* header = nullptr);
 
+struct SectionInfo {
+  uint32_t brick = 0;
+  uint32_t version = 0;
+  SectionKind kind = SectionKind::Keyframe;
+  size_t bytes = 0;  // the whole section: header and stored data
+};
+
+// Parses and checks the section at the start of data[0..size) (header fields against the layout,
+// stored size within `size`, CRC-32C), for carriers that hold sections outside a frame. The
+// payload itself is checked only when a decoder applies it.
+CodecStatus readSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionInfo* info);
+
 // A volume of the stream's grid over `bounds` from a coder's samples and mask (into `out`'s
 // storage): decodedFrom is the layout's representation.
 void copyStreamVolume(const StreamLayout& layout, const GridBounds& bounds, const float* probes, const uint8_t* active,

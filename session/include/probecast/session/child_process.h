@@ -33,6 +33,8 @@ class ChildProcess {
   bool readLine(std::string& line);
   // Waits for the child to end; its exit status (-1 when it did not exit normally).
   int wait();
+  // Sends the child a signal (SIGKILL: it dies as a crashed machine would); nothing once it has been waited for.
+  void signal(int sig);
 
  private:
   void start(std::function<int(const Say& say, const Hear& hear)> body);

@@ -17,6 +17,7 @@
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
+#include "probecast/service/bus_nats.h"
 #include "probecast/service/probe_hub.h"
 #include "probecast/service/server.h"
 
@@ -75,6 +76,10 @@ class ProbeProducer {
   int port() const;
   void shutdownServer();
   service::ProbeServer* server() { return server_.get(); }  // null until serve()
+  // Publishes every brick version to the probe bus as well (edges serve from it). Throws like BusPublisher.
+  void publishTo(const service::BusConfig& bus);
+  // The bus publisher's counters (all zero when not publishing).
+  service::PublisherStats busStats() const;
 
   // The lighting source (one of three). A traced scene: `first` is `sceneSpec` at the animation's start.
   void traceScene(renderer::VulkanContext& context, const std::string& sceneSpec, const scene::Scene& first,
@@ -114,6 +119,7 @@ class ProbeProducer {
 
   service::ProbeHub hub_;
   std::unique_ptr<service::ProbeServer> server_;
+  std::unique_ptr<service::BusPublisher> publisher_;  // before hub_ in destruction: it detaches from it
   // Source.
   std::unique_ptr<renderer::ProbeUpdater> updater_;
   std::string sceneSpec_;

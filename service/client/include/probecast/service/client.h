@@ -1,6 +1,7 @@
 // The client library (no Vulkan): subscribes, sends views, decodes into a local probe volume, keeps
 // the last volume when the network drops, reconnects with back-off and resumes by telling the
-// server what it holds.
+// server what it holds. Given several servers (edges of one producer), it moves to the next when
+// one is unavailable or its connection dies, and resumes there with its epoch and held versions.
 #pragma once
 
 #include <cstdint>
@@ -15,13 +16,15 @@ namespace probecast::service {
 
 struct ClientConfig {
   std::string address;                  // host:port
+  // Servers to fail over between, in order (edges of one producer); empty: `address` alone.
+  std::vector<std::string> addresses;
   std::string token;                    // bearer token
   bool tls = false;
   std::string rootCertPem;              // trusted root for TLS (empty: system roots)
   std::string tlsServerName;            // override of the name checked against the certificate
   uint64_t budgetBytesPerSecond = 0;    // 0 = unlimited
   std::string name = "probecast-client";
-  int reconnectMinMs = 50;
+  int reconnectMinMs = 50;   // back-off after every server has failed in turn
   int reconnectMaxMs = 2000;
   // zh3h streams: decode L1 only (ProbeVolume::zh3PerPixel) so a renderer can interpolate first
   // and hallucinate per pixel; false: hallucinate per probe when decoding.
@@ -38,9 +41,13 @@ struct VolumeSnapshot {
 struct ClientStats {
   bool connected = false;
   uint32_t connects = 0;          // successful subscriptions (1 + resumes)
+  uint32_t failovers = 0;         // moves to the next server after one failed
+  std::string address;            // the server subscribed to last
   uint32_t framesApplied = 0;
   uint32_t framesRejected = 0;    // frames the decoder refused (state kept)
   uint64_t bytesReceived = 0;     // payload bytes
+  uint64_t keyframesReceived = 0; // brick sections in applied frames that were keyframes
+  uint64_t deltasReceived = 0;    // and that were deltas
   std::string lastError;          // last status or decode error
   bool fatal = false;             // the server refused us (auth, bad request): no more retries
   uint32_t statsReceived = 0;     // Stats messages from the server

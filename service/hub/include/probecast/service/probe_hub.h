@@ -1,7 +1,12 @@
-// The transport-free core of the service: one encoder for the volume, and per subscriber what it
-// holds, what it sees and what it may be sent. Frames are built from brick sections encoded once
-// (the same bytes for every subscriber); a subscriber that falls behind gets the newest version
-// (a keyframe when it skipped some), never a queue of stale ones.
+// The transport-free core of the service: the brick versions of one volume, and per subscriber
+// what it holds, what it sees and what it may be sent. Frames are built from brick sections
+// encoded once (the same bytes for every subscriber); a subscriber that falls behind gets the
+// newest version (a keyframe when it skipped some), never a queue of stale ones.
+//
+// The versions come from a source: a producer's hub encodes them itself (publish), an edge's
+// hub takes them from bus messages (receive) with the producer's epoch and version numbers, so
+// a subscriber resumes on any edge with what it holds. Everything per subscriber is one code
+// path for both.
 #pragma once
 
 #include <deque>
@@ -17,6 +22,7 @@
 
 #include "probecast/codec/priority.h"
 #include "probecast/codec/stream.h"
+#include "probecast/service/bus_format.h"
 
 namespace probecast::service {
 
@@ -34,6 +40,26 @@ struct HubConfig {
 // up to `deadzone` quantisation steps; check the layout with isValidLayout (a grid can be too
 // large for the stream format).
 HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, int brickDim = 4, int deadzone = 0);
+
+// A brick's new version as the producer hands it to the bus (bytes owned).
+struct BrickVersionBytes {
+  uint32_t brick = 0;
+  uint32_t version = 0;
+  uint32_t producerFrame = 0;
+  uint64_t publishedUs = 0;  // when the lighting of this version was published (wall clock)
+  float change = 0.0f;
+  std::vector<uint8_t> keyframe, delta;
+};
+
+// The bus message fields of a version (its sections view `v`).
+bus::Brick busBrick(const BrickVersionBytes& v);
+
+// Tag of an edge's hub, fed from the bus.
+struct FromBus {};
+
+class BrickSource;
+class EncoderBricks;
+class BusBricks;
 
 struct HeldBrick {
   uint32_t brick = 0;
@@ -58,18 +84,39 @@ struct SubscriberStats {
 
 class ProbeHub {
  public:
+  // A producer's hub: it encodes the lighting it is given (publish).
   explicit ProbeHub(const HubConfig& config);
+  // An edge's hub: volume, epoch and versions come from bus messages (receive); config's priority
+  // and burst apply, its layout and encoder do not. Not ready() until the first message.
+  ProbeHub(const HubConfig& config, FromBus);
+  ~ProbeHub();
 
-  const StreamLayout& layout() const { return config_.layout; }
-  const GridBounds& bounds() const { return config_.bounds; }
-  uint64_t epoch() const { return epoch_; }
+  bool ready() const;
+  StreamLayout layout() const;
+  GridBounds bounds() const;
+  uint64_t epoch() const;
+  // Layout, bounds and epoch read together (an edge's change with the producer's epoch).
+  bus::Volume volume() const;
 
   // A new lighting frame (27 floats per probe, sh.h layout; active mask or null). Each changed
-  // brick gets a new version, encoded once. Wakes subscribers that wait for data.
+  // brick gets a new version, encoded once. Wakes subscribers that wait for data. Producer hubs
+  // only (std::logic_error on an edge's).
   void publish(const float* probes, const uint8_t* active);
   // The same for a volume, which must pass checkProbeVolume and have the hub's grid size
   // (std::invalid_argument otherwise, nothing published).
   void publish(const ProbeVolume& volume);
+  // Every brick version publish() makes, keyframe and delta, is handed to `output` (called on the
+  // publishing thread, outside the hub's lock). Producer hubs only.
+  using BusOutput = std::function<void(std::vector<BrickVersionBytes>)>;
+  void setBusOutput(BusOutput output);
+  // The current version of every brick that has one (for republishing everything). Producer hubs only.
+  std::vector<BrickVersionBytes> currentBricks();
+
+  // An edge's input: a parsed bus message. A new epoch (the producer restarted) resets the hub and
+  // ends every subscriber's stream (streamEnded) so clients subscribe again. `wake` false defers
+  // waking subscribers to the next message with it set, or to tick().
+  enum class Received { Applied, Stale, NewEpoch, Refused };
+  Received receive(const bus::Message& message, bool wake, std::string& why);
   // Wakes subscribers whose budget has refilled (call at the producer's rate when nothing changes).
   void tick();
   uint32_t serverFrame() const;
@@ -85,13 +132,15 @@ class ProbeHub {
   // The next frame for this subscriber: the bricks it lacks, best first, within its budget.
   // nullopt when it holds everything or its budget is spent (it is woken later).
   std::optional<OutgoingFrame> nextFrame(uint64_t id);
+  // The subscriber's stream should end: the volume it subscribed to was replaced (a new epoch).
+  bool streamEnded(uint64_t id) const;
   SubscriberStats stats(uint64_t id) const;
   // The subscriber applied frames up to `sequence`. False (with the reason) for an ack of a frame
   // never sent or one that goes backwards: the client is broken and its stream should end.
   bool acknowledge(uint64_t id, uint32_t sequence, std::string& why);
 
-  // The volume every subscriber converges to (the encoder's reconstruction, zh3h hallucinated per
-  // probe), for tests and tools.
+  // The volume every subscriber converges to (the encoder's reconstruction, or on an edge the
+  // decoded bus versions; zh3h hallucinated per probe), for tests and tools.
   ProbeVolume reconstruction() const;
 
  private:
@@ -104,6 +153,7 @@ class ProbeHub {
     std::vector<View> views;
     std::function<void()> wake;
     bool waiting = false;
+    bool ended = false;
     uint32_t sequence = 0;
     std::deque<std::pair<uint32_t, Clock::time_point>> unacked;  // sequence, when handed out
     SubscriberStats stats;
@@ -115,11 +165,20 @@ class ProbeHub {
   // The frame of the first `n` bricks of chosen_ for `s` (who lacked `behind`), its state updated.
   OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind);
   std::vector<std::function<void()>> collectWakes();
+  void markStale(uint32_t brick);
+  BrickVersionBytes versionBytes(uint32_t brick);
+  EncoderBricks& encoderSource(const char* what) const;
+  void startEpoch(const bus::Volume& volume, std::vector<std::function<void()>>& wakes);
 
   HubConfig config_;
-  uint64_t epoch_;
+  uint64_t epoch_ = 0;
+  bool fromBus_ = false;
   mutable std::mutex mutex_;
-  StreamEncoder encoder_;
+  std::unique_ptr<BrickSource> source_;
+  EncoderBricks* encoder_ = nullptr;  // source_ of a producer's hub
+  BusBricks* bus_ = nullptr;          // source_ of an edge's hub
+  BusOutput busOutput_;
+  std::vector<uint32_t> lastOutput_;  // version last handed to busOutput_, per brick
   uint32_t frame_ = 0;
   uint64_t publishedUs_ = 0;
   uint64_t nextId_ = 1;

@@ -1,0 +1,183 @@
+#include "probecast/service/bus_format.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include "probecast/codec/crc32c.h"
+#include "probecast/codec/record.h"
+
+namespace probecast::bus {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the bus format is written with little-endian stores");
+
+constexpr uint8_t kMagic[4] = {'P', 'C', 'B', 'M'};
+
+void put(std::vector<uint8_t>& out, const void* v, size_t n) {
+  const auto* p = static_cast<const uint8_t*>(v);
+  out.insert(out.end(), p, p + n);
+}
+template <typename T>
+void put(std::vector<uint8_t>& out, T v) {
+  put(out, &v, sizeof v);
+}
+template <typename T>
+T get(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+void writeHeader(Kind kind, uint16_t flags, std::vector<uint8_t>& out) {
+  out.clear();
+  put(out, kMagic, 4);
+  put(out, kBusVersion);
+  put(out, static_cast<uint8_t>(kind));
+  put(out, flags);
+  put(out, uint32_t{0});  // body size and checksum, once the body is written
+  put(out, uint32_t{0});
+}
+
+void finish(std::vector<uint8_t>& out) {
+  const auto body = static_cast<uint32_t>(out.size() - kHeaderSize);
+  std::memcpy(out.data() + 8, &body, 4);
+  uint32_t crc = crc32c(out.data(), 12);
+  crc = crc32c(out.data() + kHeaderSize, body, crc);
+  std::memcpy(out.data() + 12, &crc, 4);
+}
+
+void writeVolume(const Volume& v, std::vector<uint8_t>& out) {
+  put(out, v.epoch);
+  put(out, v.publishedUs);
+  put(out, kFormatVersion);
+  put(out, static_cast<uint8_t>(v.layout.repr));
+  put(out, v.layout.brickDim);
+  put(out, uint8_t{0});
+  for (uint16_t n : v.layout.grid) put(out, n);
+  put(out, uint16_t{0});
+  for (float f : v.bounds.min) put(out, f);
+  for (float f : v.bounds.max) put(out, f);
+}
+
+bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
+  v.epoch = get<uint64_t>(p);
+  v.publishedUs = get<uint64_t>(p + 8);
+  if (v.epoch == 0) return why = "stream epoch 0 (no epoch)", false;
+  if (p[16] != kFormatVersion)
+    return why = "codec format version " + std::to_string(p[16]) + ", this build reads " +
+                 std::to_string(kFormatVersion), false;
+  if (!isValidRepresentation(p[17])) return why = "unknown representation " + std::to_string(p[17]), false;
+  if (p[19] != 0 || get<uint16_t>(p + 26) != 0) return why = "reserved volume bytes are not 0", false;
+  v.layout.repr = static_cast<Representation>(p[17]);
+  v.layout.brickDim = p[18];
+  for (int a = 0; a < 3; ++a) v.layout.grid[a] = get<uint16_t>(p + 20 + 2 * a);
+  if (!isValidLayout(v.layout))
+    return why = "volume layout " + std::to_string(v.layout.grid[0]) + "x" + std::to_string(v.layout.grid[1]) + "x" +
+                 std::to_string(v.layout.grid[2]) + " in bricks of " + std::to_string(v.layout.brickDim) +
+                 " is not valid", false;
+  for (int a = 0; a < 3; ++a) {
+    v.bounds.min[a] = get<float>(p + 28 + 4 * a);
+    v.bounds.max[a] = get<float>(p + 40 + 4 * a);
+    if (!std::isfinite(v.bounds.min[a]) || !std::isfinite(v.bounds.max[a]))
+      return why = "volume bounds are not finite", false;
+  }
+  return true;
+}
+
+// One section of the brick's version, of the given kind, exactly filling `bytes`.
+bool checkSection(const StreamLayout& layout, std::span<const uint8_t> bytes, const Brick& b, SectionKind kind,
+                  std::string& why) {
+  const char* name = kind == SectionKind::Keyframe ? "keyframe" : "delta";
+  SectionInfo info;
+  if (CodecStatus st = readSection(layout, bytes.data(), bytes.size(), &info); st != CodecStatus::Ok)
+    return why = std::string(name) + " section: " + codecStatusName(st), false;
+  if (info.bytes != bytes.size())
+    return why = std::string(name) + " section of " + std::to_string(info.bytes) + " bytes in a field of " +
+                 std::to_string(bytes.size()), false;
+  if (info.kind != kind) return why = std::string(name) + " field holds another kind of section", false;
+  if (info.brick != b.brick || info.version != b.version)
+    return why = std::string(name) + " section is brick " + std::to_string(info.brick) + " version " +
+                 std::to_string(info.version) + ", the message brick " + std::to_string(b.brick) + " version " +
+                 std::to_string(b.version), false;
+  return true;
+}
+
+}  // namespace
+
+void writeVolumeMessage(const Volume& volume, uint16_t flags, std::vector<uint8_t>& out) {
+  writeHeader(Kind::Volume, flags, out);
+  writeVolume(volume, out);
+  finish(out);
+}
+
+void writeBrickMessage(const Volume& volume, const Brick& brick, uint16_t flags, std::vector<uint8_t>& out) {
+  writeHeader(Kind::Brick, flags, out);
+  writeVolume(volume, out);
+  put(out, brick.brick);
+  put(out, brick.version);
+  put(out, brick.producerFrame);
+  put(out, brick.change);
+  put(out, static_cast<uint32_t>(brick.keyframe.size()));
+  put(out, static_cast<uint32_t>(brick.delta.size()));
+  put(out, brick.keyframe.data(), brick.keyframe.size());
+  put(out, brick.delta.data(), brick.delta.size());
+  finish(out);
+}
+
+bool readMessage(const uint8_t* data, size_t size, Message& out, std::string& why) {
+  if (size < kHeaderSize)
+    return why = "truncated: " + std::to_string(size) + " bytes, a bus message has at least " +
+                 std::to_string(kHeaderSize), false;
+  if (std::memcmp(data, kMagic, 4) != 0) return why = "not a probe bus message (bad magic)", false;
+  if (data[4] != kBusVersion)
+    return why = "bus format version " + std::to_string(data[4]) + ", this build reads " +
+                 std::to_string(kBusVersion), false;
+  if (data[5] != static_cast<uint8_t>(Kind::Volume) && data[5] != static_cast<uint8_t>(Kind::Brick))
+    return why = "unknown message kind " + std::to_string(data[5]), false;
+  out.kind = static_cast<Kind>(data[5]);
+  out.flags = get<uint16_t>(data + 6);
+  if (out.flags & ~kEndOfBatch) return why = "unknown flags " + std::to_string(out.flags), false;
+  const uint64_t body = get<uint32_t>(data + 8);
+  if (body != size - kHeaderSize)
+    return why = "header announces " + std::to_string(body) + " body bytes, the message has " +
+                 std::to_string(size - kHeaderSize), false;
+  uint32_t crc = crc32c(data, 12);
+  crc = crc32c(data + kHeaderSize, size - kHeaderSize, crc);
+  if (crc != get<uint32_t>(data + 12)) return why = "checksum mismatch", false;
+
+  const uint8_t* p = data + kHeaderSize;
+  const size_t fixed = out.kind == Kind::Volume ? kVolumeSize : kVolumeSize + kBrickFixedSize;
+  if (body < fixed || (out.kind == Kind::Volume && body != kVolumeSize))
+    return why = "body of " + std::to_string(body) + " bytes, a " +
+                 (out.kind == Kind::Volume ? "volume message has " : "brick message has at least ") +
+                 std::to_string(fixed), false;
+  if (!readVolume(p, out.volume, why)) return false;
+  if (out.kind == Kind::Volume) return true;
+
+  p += kVolumeSize;
+  Brick& b = out.brick;
+  b.brick = get<uint32_t>(p);
+  b.version = get<uint32_t>(p + 4);
+  b.producerFrame = get<uint32_t>(p + 8);
+  b.change = get<float>(p + 12);
+  const uint64_t keyBytes = get<uint32_t>(p + 16), deltaBytes = get<uint32_t>(p + 20);
+  const StreamLayout& layout = out.volume.layout;
+  if (b.brick >= brickCount(layout))
+    return why = "brick " + std::to_string(b.brick) + " outside the volume's " + std::to_string(brickCount(layout)),
+           false;
+  if (b.version == 0) return why = "brick version 0 (nothing) is never published", false;
+  if (!std::isfinite(b.change) || b.change < 0.0f || b.change > kMaxChange)
+    return why = "brick change is not a finite value in [0, 1e6]", false;
+  if (keyBytes + deltaBytes != body - fixed)
+    return why = "sections of " + std::to_string(keyBytes) + " + " + std::to_string(deltaBytes) + " bytes in " +
+                 std::to_string(body - fixed) + " bytes", false;
+  p += kBrickFixedSize;
+  b.keyframe = {p, static_cast<size_t>(keyBytes)};
+  b.delta = {p + keyBytes, static_cast<size_t>(deltaBytes)};
+  if (!checkSection(layout, b.keyframe, b, SectionKind::Keyframe, why)) return false;
+  if (!b.delta.empty() && !checkSection(layout, b.delta, b, SectionKind::Delta, why)) return false;
+  return true;
+}
+
+}  // namespace probecast::bus

@@ -1,0 +1,79 @@
+// The probe bus format: how a producer hands brick versions to a message system (NATS JetStream)
+// for stateless edge servers. It is ours, not the message system's: versioned, little-endian,
+// checksummed, and parsed by a decoder that checks every size before it reads (codec and std only,
+// so the fuzz build links it).
+//
+// Every brick message is self-contained: it carries the volume it belongs to (epoch, layout,
+// bounds) and both sections of the new version, its keyframe and its delta from the version
+// before. A store that keeps only the newest message per brick therefore holds everything a
+// late joiner needs, and a holder one version behind still gets the small delta.
+//
+// Message = header (16 bytes) + body, little-endian:
+//   header: magic "PCBM" | u8 busVersion (1) | u8 kind (1 volume, 2 brick) | u16 flags
+//           | u32 bodyBytes | u32 CRC-32C of the preceding 12 bytes and the body
+//   volume: u64 epoch (nonzero) | u64 publishedUs | u8 codecFormatVersion (stream.h kFormatVersion)
+//           | u8 representation | u8 brickDim | u8 reserved (0) | u16 nx, ny, nz | u16 reserved (0)
+//           | f32 boundsMin[3] | f32 boundsMax[3]                                     (52 bytes)
+//           The whole body of a volume message; the first part of a brick message's body.
+//   brick:  u32 brick | u32 version (>= 1) | u32 producerFrame | f32 change (finite, >= 0)
+//           | u32 keyframeBytes | u32 deltaBytes | keyframe section | delta section  (24 bytes + sections)
+//           Sections exactly as in a codec frame (stream.h); the delta may be absent (0 bytes).
+// flags: bit 0 = the last message of a batch the producer published together (receivers may wait
+// for it before waking subscribers); other bits must be 0.
+// publishedUs: producer wall clock, microseconds since 1970, when the lighting was published.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "probecast/codec/probe_volume.h"
+#include "probecast/codec/stream.h"
+
+namespace probecast::bus {
+
+constexpr uint8_t kBusVersion = 1;
+constexpr size_t kHeaderSize = 16;
+constexpr size_t kVolumeSize = 52;
+constexpr size_t kBrickFixedSize = 24;
+constexpr uint16_t kEndOfBatch = 1;
+// A brick's relative change above this is nonsense from a broken producer, not lighting.
+constexpr float kMaxChange = 1e6f;
+
+enum class Kind : uint8_t { Volume = 1, Brick = 2 };
+
+struct Volume {
+  uint64_t epoch = 0;  // the producer's stream epoch: brick versions are meaningful within it
+  uint64_t publishedUs = 0;
+  StreamLayout layout;
+  GridBounds bounds;
+};
+
+struct Brick {
+  uint32_t brick = 0;
+  uint32_t version = 0;
+  uint32_t producerFrame = 0;  // the producer's lighting update that made this version
+  float change = 0.0f;         // StreamEncoder::brickChange of this version
+  std::span<const uint8_t> keyframe;  // the version's keyframe section
+  std::span<const uint8_t> delta;     // its delta section from version - 1; may be empty
+};
+
+struct Message {
+  Kind kind = Kind::Volume;
+  uint16_t flags = 0;
+  Volume volume;
+  Brick brick;  // kind Brick: its sections view the parsed bytes
+};
+
+// Message for a brick's new version and for the volume description (appended to `out` after clearing it).
+void writeVolumeMessage(const Volume& volume, uint16_t flags, std::vector<uint8_t>& out);
+void writeBrickMessage(const Volume& volume, const Brick& brick, uint16_t flags, std::vector<uint8_t>& out);
+
+// Parses and checks a message: header, checksum, every size, the volume's layout, the brick's
+// index against it and the sections' own headers (brick, version, kind, CRC). False with `why`
+// saying what is wrong; `out` is then unspecified. On success out.brick's sections view `data`.
+bool readMessage(const uint8_t* data, size_t size, Message& out, std::string& why);
+
+}  // namespace probecast::bus

@@ -1,0 +1,212 @@
+// The producer's side of the bus: every brick version a hub makes, published to JetStream.
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "nats_link.h"
+#include "probecast/service/bus_format.h"
+#include "probecast/service/bus_nats.h"
+
+namespace probecast::service {
+
+struct BusPublisher::Impl {
+  BusConfig config;
+  ProbeHub& hub;
+  std::mutex mutex;  // everything below
+  std::condition_variable wake;
+  std::map<uint32_t, BrickVersionBytes> pending;  // the newest unsent version per brick
+  bool stopping = false, needStream = true, resync = false, purge = true, busy = false;
+  std::string failure;  // an acknowledgement that came back refused, from the library's thread
+  PublisherStats stats;
+  std::unique_ptr<NatsLink> link;
+  std::thread worker;
+
+  Impl(const BusConfig& c, ProbeHub& h) : config(c), hub(h) {}
+
+  static void refused(jsCtx*, jsPubAckErr* pae, void* self) {
+    auto* s = static_cast<Impl*>(self);
+    std::lock_guard<std::mutex> lock(s->mutex);
+    s->failure = "the bus refused a message: " + natsErrorText(pae->Err, pae->ErrCode) +
+                 (pae->ErrText ? std::string(" ") + pae->ErrText : std::string());
+  }
+
+  // Creates the stream or brings its limits up to date; the first time, drops what it held.
+  bool ensureStream(bool purgeIt, std::string& why) {
+    const std::string name = busStreamName(config.stream), subjects = busSubjects(config.stream);
+    const char* subjectList[] = {subjects.c_str()};
+    jsStreamConfig sc;
+    jsStreamConfig_Init(&sc);
+    sc.Name = name.c_str();
+    sc.Subjects = subjectList;
+    sc.SubjectsLen = 1;
+    sc.Retention = js_LimitsPolicy;
+    sc.Storage = js_FileStorage;
+    sc.MaxMsgsPerSubject = 1;  // the newest version of each brick is all anyone needs
+    sc.MaxAge = 0;             // lighting does not expire; a new producer replaces it
+    sc.Discard = js_DiscardOld;
+    jsOptions jo = link->requestOptions();
+    jsErrCode code = static_cast<jsErrCode>(0);
+    jsStreamInfo* info = nullptr;
+    natsStatus s = js_AddStream(&info, link->jetStream(), &sc, &jo, &code);
+    if (s != NATS_OK && code == JSStreamNameExistErr) {
+      code = static_cast<jsErrCode>(0);
+      s = js_UpdateStream(&info, link->jetStream(), &sc, &jo, &code);
+    }
+    if (info) jsStreamInfo_Destroy(info);
+    if (s != NATS_OK) return why = "cannot create stream " + name + ": " + natsErrorText(s, code), false;
+    if (purgeIt && (s = js_PurgeStream(link->jetStream(), name.c_str(), &jo, &code)) != NATS_OK)
+      return why = "cannot purge stream " + name + ": " + natsErrorText(s, code), false;
+    return true;
+  }
+
+  // Publishes the batch (and the volume first when `withVolume`), then waits for every acknowledgement.
+  bool publish(const std::map<uint32_t, BrickVersionBytes>& batch, bool withVolume, PublisherStats& sent,
+               std::string& why) {
+    bus::Volume volume = hub.volume();
+    std::vector<uint8_t> message;
+    jsPubOptions po;
+    jsPubOptions_Init(&po);
+    po.MaxWait = config.requestTimeoutMs;
+    const auto send = [&](const std::string& subject) {
+      const natsStatus s = js_PublishAsync(link->jetStream(), subject.c_str(), message.data(),
+                                           static_cast<int>(message.size()), &po);
+      if (s != NATS_OK) return why = "publish on " + subject + ": " + natsErrorText(s), false;
+      sent.bytes += message.size();
+      ++sent.messages;
+      return true;
+    };
+    if (withVolume) {
+      bus::writeVolumeMessage(volume, batch.empty() ? bus::kEndOfBatch : 0, message);
+      if (!send(volumeSubject(config.stream))) return false;
+    }
+    size_t left = batch.size();
+    for (const auto& [brick, v] : batch) {
+      volume.publishedUs = v.publishedUs;
+      bus::writeBrickMessage(volume, busBrick(v), --left == 0 ? bus::kEndOfBatch : 0, message);
+      if (!send(brickSubject(config.stream, brick))) return false;
+      sent.keyframeBytes += v.keyframe.size();
+      sent.deltaBytes += v.delta.size();
+    }
+    const natsStatus s = js_PublishAsyncComplete(link->jetStream(), &po);
+    if (s != NATS_OK) {
+      natsMsgList lost;
+      if (js_PublishAsyncGetPendingList(&lost, link->jetStream()) == NATS_OK) natsMsgList_Destroy(&lost);
+      return why = "the bus did not acknowledge every message: " + natsErrorText(s), false;
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!failure.empty()) {
+      why = failure;
+      failure.clear();
+      return false;
+    }
+    return true;
+  }
+
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stopping) {
+      wake.wait_for(lock, std::chrono::milliseconds(200), [this] {
+        return stopping || (link->connected() && (needStream || resync || !pending.empty()));
+      });
+      if (stopping) break;
+      if (!link->connected() || !(needStream || resync || !pending.empty())) continue;
+      busy = true;
+      if (needStream) {
+        const bool purgeIt = purge;
+        lock.unlock();
+        std::string why;
+        const bool ok = ensureStream(purgeIt, why);
+        lock.lock();
+        if (!ok) {
+          stats.lastError = why;
+          busy = false;
+          wake.wait_for(lock, std::chrono::milliseconds(200), [this] { return stopping; });
+          continue;
+        }
+        purge = false;
+        needStream = false;
+        resync = true;
+      }
+      const bool all = resync;
+      resync = false;
+      std::map<uint32_t, BrickVersionBytes> batch;
+      batch.swap(pending);
+      lock.unlock();
+      if (all)
+        for (BrickVersionBytes& v : hub.currentBricks()) {
+          auto it = batch.find(v.brick);
+          if (it == batch.end() || it->second.version < v.version) batch[v.brick] = std::move(v);
+        }
+      PublisherStats sent;
+      std::string why;
+      const bool ok = publish(batch, all, sent, why);
+      lock.lock();
+      busy = false;
+      if (all) ++stats.resyncs;
+      if (ok) {
+        stats.messages += sent.messages;
+        stats.bytes += sent.bytes;
+        stats.keyframeBytes += sent.keyframeBytes;
+        stats.deltaBytes += sent.deltaBytes;
+      } else {  // the stream may be gone or the server away: make sure of the stream, then send all again
+        stats.lastError = why;
+        needStream = true;
+        wake.wait_for(lock, std::chrono::milliseconds(100), [this] { return stopping; });
+      }
+    }
+  }
+};
+
+BusPublisher::BusPublisher(const BusConfig& config, ProbeHub& hub) : impl_(std::make_shared<Impl>(config, hub)) {
+  std::string why;
+  if (!checkBusConfig(config, why)) throw std::invalid_argument(why);
+  Impl& s = *impl_;
+  s.link = std::make_unique<NatsLink>(
+      config,
+      [&s] {  // every (re)connect: the server may have lost the stream or messages
+        std::lock_guard<std::mutex> lock(s.mutex);
+        s.needStream = true;
+        s.wake.notify_all();
+      },
+      [&s] { s.wake.notify_all(); }, &Impl::refused, &s);
+  s.worker = std::thread([&s] { s.run(); });
+  hub.setBusOutput([weak = std::weak_ptr<Impl>(impl_)](std::vector<BrickVersionBytes> made) {
+    const std::shared_ptr<Impl> self = weak.lock();
+    if (!self) return;
+    std::lock_guard<std::mutex> lock(self->mutex);
+    if (self->stopping) return;
+    for (BrickVersionBytes& v : made)
+      if (!self->pending.insert_or_assign(v.brick, std::move(v)).second) ++self->stats.superseded;
+    self->wake.notify_all();
+  });
+}
+
+BusPublisher::~BusPublisher() {
+  Impl& s = *impl_;
+  s.hub.setBusOutput(nullptr);
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.stopping = true;
+  }
+  s.wake.notify_all();
+  if (s.worker.joinable()) s.worker.join();
+  s.link.reset();
+}
+
+PublisherStats BusPublisher::stats() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  PublisherStats st = impl_->stats;
+  st.connected = impl_->link->connected();
+  return st;
+}
+
+bool BusPublisher::caughtUp() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  const Impl& s = *impl_;
+  return s.link->connected() && !s.busy && !s.needStream && !s.resync && s.pending.empty();
+}
+
+}  // namespace probecast::service

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# serve a baked volume and publish it to a nats-server started here; two edges serve it; a
+# subscriber given a dead address first and then the edges ends with the same volume as one
+# subscribed to the producer directly. Bounded: everything stops itself after 30 s; the script
+# kills what it started when done.
+set -euo pipefail
+probecast=$1
+work=$2
+rm -rf "$work"
+mkdir -p "$work"
+nats=$(command -v nats-server || true)
+for d in /usr/sbin /usr/bin; do [ -n "$nats" ] || { [ -x "$d/nats-server" ] && nats=$d/nats-server; }; done
+if [ -z "$nats" ]; then echo "nats-server not found (a dependency: scripts/setup.sh installs it)"; exit 1; fi
+base=$((20000 + RANDOM % 20000))
+np=$base sp=$((base + 1)) ea=$((base + 2)) eb=$((base + 3)) dead=$((base + 4))
+pids=()
+trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done' EXIT
+"$nats" -a 127.0.0.1 -p "$np" -js -sd "$work/nats" >"$work/nats.log" 2>&1 &
+pids+=($!)
+"$probecast" bake --scene builtin:cornell --grid 6,6,6 --spp 32 --updates 1 --out "$work/served.pcpv" >/dev/null
+"$probecast" serve --probes "$work/served.pcpv" --listen "127.0.0.1:$sp" --plaintext --token t0k --seconds 30 \
+  --publish "nats://127.0.0.1:$np" --stream cli >"$work/serve.log" 2>&1 &
+pids+=($!)
+for port in $ea $eb; do
+  "$probecast" edge --nats "nats://127.0.0.1:$np" --stream cli --listen "127.0.0.1:$port" --plaintext --token t0k \
+    --seconds 30 >"$work/edge-$port.log" 2>&1 &
+  pids+=($!)
+done
+for log in serve "edge-$ea" "edge-$eb"; do
+  for _ in $(seq 100); do grep -q "on port" "$work/$log.log" && break; sleep 0.1; done
+done
+"$probecast" subscribe --connect "127.0.0.1:$sp" --token t0k --seconds 2 --out "$work/direct.pcpv" >/dev/null
+"$probecast" subscribe --connect "127.0.0.1:$dead,127.0.0.1:$ea,127.0.0.1:$eb" --token t0k --seconds 2 \
+  --out "$work/edge.pcpv" | tee "$work/subscribe.log"
+cmp "$work/direct.pcpv" "$work/edge.pcpv"
+# The wrong token is refused by an edge as by the producer.
+if "$probecast" subscribe --connect "127.0.0.1:$eb" --token wrong --seconds 1 2>"$work/refused.log"; then
+  echo "an edge accepted a wrong token"; exit 1
+fi
+grep -q "wrong bearer token" "$work/refused.log"
+echo "edge round trip ok"

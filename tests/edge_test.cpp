@@ -1,0 +1,227 @@
+// The probe bus end to end with a real nats-server started by the test: a producer publishing to
+// JetStream, edge servers fed from it, clients over loopback gRPC failing over between edges.
+// Every wait is bounded; every test stops what it started.
+#include <gtest/gtest.h>
+
+#include <nats/nats.h>
+
+#include <chrono>
+#include <cstring>
+#include <random>
+#include <thread>
+
+#include "probecast/service/bus_format.h"
+#include "probecast/service/bus_nats.h"
+#include "probecast/service/client.h"
+#include "probecast/service/edge_server.h"
+#include "probecast/session/nats_server.h"
+#include "service_test_support.h"
+#include "test_probes.h"
+
+namespace probecast::service {
+namespace {
+
+// A producer's hub publishing to the bus, lit by a moving light.
+struct BusProducer {
+  ProbeHub hub{volumeConfig()};
+  BusPublisher publisher;
+  std::mt19937 rng{5};
+  int frame = 0;
+  explicit BusProducer(const BusConfig& bus) : publisher(bus, hub) {}
+  void publish(int frames, std::chrono::milliseconds interval = 20ms) {
+    for (int f = 0; f < frames; ++f) {
+      hub.publish(test::movingLightFrame(1024, frame++, 0.01f, rng).data(), nullptr);
+      std::this_thread::sleep_for(interval);
+    }
+  }
+  bool caughtUp() { return waitFor([&] { return publisher.caughtUp(); }, 10s); }
+};
+
+class Edge : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_FALSE(session::NatsServer::findProgram().empty())
+        << "nats-server is a dependency of these tests (scripts/setup.sh installs it): not on PATH, in /usr/sbin "
+           "or /usr/bin";
+    nats = std::make_unique<session::NatsServer>();
+    bus.url = nats->url();
+    static int tests = 0;
+    bus.stream = "edge-test-" + std::to_string(++tests);
+  }
+
+  EdgeConfig edgeConfig() const {
+    EdgeConfig c;
+    c.bus = bus;
+    c.server.listen = "127.0.0.1:0";
+    c.server.token = kToken;
+    c.server.plaintext = true;
+    return c;
+  }
+
+  ClientConfig clientFor(std::vector<int> ports) const {
+    ClientConfig c;
+    for (int p : ports) c.addresses.push_back("127.0.0.1:" + std::to_string(p));
+    c.token = kToken;
+    c.reconnectMaxMs = 200;
+    return c;
+  }
+
+  std::unique_ptr<session::NatsServer> nats;
+  BusConfig bus;
+};
+
+TEST_F(Edge, SubscribersOnTwoEdgesEndBitIdenticalToTheProducer) {
+  BusProducer producer(bus);
+  EdgeServer a(edgeConfig()), b(edgeConfig());
+  std::vector<std::unique_ptr<ProbeClient>> clients;
+  for (int i = 0; i < 6; ++i) {
+    clients.push_back(std::make_unique<ProbeClient>(clientFor({i % 2 ? b.port() : a.port()})));
+    clients.back()->start();
+  }
+  producer.publish(30);
+  for (size_t i = 0; i < clients.size(); ++i)
+    EXPECT_TRUE(waitFor([&] { return matchesServer(*clients[i], producer.hub); }, 10s)) << "client " << i;
+  for (auto& c : clients) EXPECT_EQ(c->stats().framesRejected, 0u);
+  EXPECT_EQ(a.hub().epoch(), producer.hub.epoch());
+  EXPECT_EQ(a.stats().refused, 0u);
+  EXPECT_GE(a.stats().applied, 16u);
+}
+
+TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyframeStorm) {
+  BusProducer producer(bus);
+  auto a = std::make_unique<EdgeServer>(edgeConfig());
+  EdgeServer b(edgeConfig());
+  const std::string onA = "127.0.0.1:" + std::to_string(a->port()), onB = "127.0.0.1:" + std::to_string(b.port());
+  producer.publish(1);  // edges without a volume answer UNAVAILABLE: the clients would start elsewhere
+  ASSERT_TRUE(waitFor([&] { return a->hub().ready() && b.hub().ready(); }, 10s));
+  std::vector<std::unique_ptr<ProbeClient>> clients;
+  for (int i = 0; i < 4; ++i) {
+    clients.push_back(std::make_unique<ProbeClient>(clientFor({a->port(), b.port()})));
+    clients.back()->start();
+  }
+  producer.publish(20);
+  for (auto& c : clients) {
+    ASSERT_TRUE(waitFor([&] { return matchesServer(*c, producer.hub); }, 10s));
+    ASSERT_EQ(c->stats().address, onA);
+  }
+  // What a subscriber that holds nothing needs: every brick's keyframe.
+  ProbeHub& hub = producer.hub;
+  const uint64_t fresh = hub.addSubscriber(0, 0, {}, nullptr);
+  const size_t keyframeSet = hub.nextFrame(fresh)->payload.size();
+  hub.removeSubscriber(fresh);
+  std::vector<ClientStats> before;
+  for (auto& c : clients) before.push_back(c->stats());
+
+  a->shutdown();
+  for (size_t i = 0; i < clients.size(); ++i) {
+    ProbeClient& c = *clients[i];
+    ASSERT_TRUE(waitFor([&] { return c.stats().connected && c.stats().address == onB; }, 10s)) << i;
+    // Resumed with its epoch and held versions: nothing to send, let alone a keyframe set.
+    EXPECT_TRUE(matchesServer(c, producer.hub));
+    EXPECT_LT(c.stats().bytesReceived - before[i].bytesReceived, keyframeSet / 2)
+        << "client " << i << " of a " << keyframeSet << "-byte keyframe set";
+  }
+  producer.publish(3);  // the stream goes on from the other edge, in deltas
+  for (size_t i = 0; i < clients.size(); ++i) {
+    ProbeClient& c = *clients[i];
+    EXPECT_TRUE(waitFor([&] { return matchesServer(c, producer.hub); }, 10s)) << i;
+    const ClientStats st = c.stats();
+    EXPECT_EQ(st.connects, 2u);
+    EXPECT_GE(st.failovers, 1u);
+    EXPECT_EQ(st.framesRejected, 0u);
+    // A brick version the publisher replaced by a newer one before it went out (a slow bus) has
+    // no delta on the bus, so a holder one behind gets that brick's keyframe: a few, not a storm.
+    EXPECT_LE(st.keyframesReceived - before[i].keyframesReceived, 2u)
+        << "client " << i << "; versions superseded before publishing: " << producer.publisher.stats().superseded;
+    EXPECT_GT(st.deltasReceived, before[i].deltasReceived) << "client " << i;
+  }
+}
+
+TEST_F(Edge, NatsServerRestartedEdgesAndProducerRecoverAndSubscribersConverge) {
+  BusProducer producer(bus);
+  EdgeServer a(edgeConfig()), b(edgeConfig());
+  ProbeClient onA(clientFor({a.port()})), onB(clientFor({b.port()}));
+  onA.start();
+  onB.start();
+  producer.publish(10);
+  ASSERT_TRUE(waitFor([&] { return matchesServer(onA, producer.hub) && matchesServer(onB, producer.hub); }, 10s));
+  nats->stop();
+  producer.publish(10);  // lighting moves on while the bus is away
+  EXPECT_FALSE(matchesServer(onA, producer.hub));
+  nats->start();
+  producer.publish(5);
+  EXPECT_TRUE(waitFor([&] { return matchesServer(onA, producer.hub) && matchesServer(onB, producer.hub); }, 15s))
+      << "edge a: " << a.stats().lastError << "; producer: " << producer.publisher.stats().lastError;
+  EXPECT_GE(producer.publisher.stats().resyncs, 2u);
+  EXPECT_GE(a.stats().subscribes, 2u);
+  EXPECT_EQ(onA.stats().framesRejected, 0u);
+}
+
+TEST_F(Edge, AnEdgeStartedLateServesFromTheRetainedMessages) {
+  BusProducer producer(bus);
+  producer.publish(15, 5ms);
+  ASSERT_TRUE(producer.caughtUp());
+  EdgeServer late(edgeConfig());  // everything it gets was published before it existed
+  ProbeClient client(clientFor({late.port()}));
+  client.start();
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s)) << late.stats().lastError;
+  EXPECT_EQ(late.stats().epochs, 1u);
+}
+
+TEST_F(Edge, MalformedBusMessagesAreRefusedNotAppliedAndTheStreamGoesOn) {
+  BusProducer producer(bus);
+  EdgeServer edge(edgeConfig());
+  ProbeClient client(clientFor({edge.port()}));
+  client.start();
+  producer.publish(5);
+  ASSERT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
+  const uint64_t refusedBefore = edge.stats().refused;
+  // Garbage, a valid message cut short, and one with a flipped byte, on a brick's subject.
+  natsConnection* nc = nullptr;
+  ASSERT_EQ(natsConnection_ConnectTo(&nc, bus.url.c_str()), NATS_OK);
+  std::vector<uint8_t> valid;
+  const ProbeHub& hub = producer.hub;
+  bus::writeVolumeMessage(hub.volume(), 0, valid);
+  std::vector<uint8_t> cut(valid.begin(), valid.end() - 5), flipped = valid;
+  flipped[30] ^= 1;
+  // Each on a subject of its own: the stream keeps only the newest message of a subject.
+  uint32_t brick = 3;
+  for (const std::vector<uint8_t>& m : {std::vector<uint8_t>{'j', 'u', 'n', 'k'}, cut, flipped}) {
+    const std::string subject = brickSubject(bus.stream, brick++);
+    ASSERT_EQ(natsConnection_Publish(nc, subject.c_str(), m.data(), static_cast<int>(m.size())), NATS_OK);
+  }
+  ASSERT_EQ(natsConnection_FlushTimeout(nc, 2000), NATS_OK);
+  natsConnection_Destroy(nc);
+  EXPECT_TRUE(waitFor([&] { return edge.stats().refused >= refusedBefore + 3; }, 5s))
+      << edge.stats().received << " received, " << edge.stats().refused << " refused, " << edge.stats().lastError;
+  EXPECT_NE(edge.stats().lastError.find("refused"), std::string::npos) << edge.stats().lastError;
+  EXPECT_TRUE(matchesServer(client, producer.hub));
+  producer.publish(3);
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
+  EXPECT_EQ(client.stats().framesRejected, 0u);
+  EXPECT_EQ(client.stats().connects, 1u);
+}
+
+TEST_F(Edge, ARestartedProducerIsANewEpochEdgesEndTheirStreamsAndClientsConvergeAgain) {
+  EdgeServer edge(edgeConfig());
+  ProbeClient client(clientFor({edge.port()}));
+  client.start();
+  uint64_t firstEpoch = 0;
+  {
+    BusProducer first(bus);
+    first.publish(5);
+    ASSERT_TRUE(waitFor([&] { return matchesServer(client, first.hub); }, 10s));
+    firstEpoch = first.hub.epoch();
+  }
+  BusProducer second(bus);
+  second.rng.seed(77);  // other lighting
+  second.publish(5);
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, second.hub); }, 10s)) << edge.stats().lastError;
+  EXPECT_NE(second.hub.epoch(), firstEpoch);
+  EXPECT_EQ(edge.hub().epoch(), second.hub.epoch());
+  EXPECT_GE(client.stats().connects, 2u);  // its stream was ended and it subscribed again
+  EXPECT_EQ(client.stats().framesRejected, 0u);
+}
+
+}  // namespace
+}  // namespace probecast::service
