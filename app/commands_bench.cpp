@@ -285,6 +285,9 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--sample-every", so->bench.sampleEvery,
                      "1 in this many subscribers decodes in full and is checked bit for bit")
       ->check(CLI::Range(1, 5000));
+  stream->add_option("--edges", so->bench.edges,
+                     "0: subscribers connect to the producer; N: through a nats-server and N edges")
+      ->check(CLI::Range(0, 16));
   addRepresentationOption(stream, so->bench.repr, "l1, zh3h, zh3, l2 or fp16");
   addJsonOption(stream, so->json);
   stream->add_option("--chart", so->chart, "write an SVG chart here");

@@ -1,10 +1,12 @@
 #include "stream_bench.h"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -14,8 +16,10 @@
 #include <fmt/format.h>
 
 #include "load_client.h"
+#include "probecast/service/edge_server.h"
 #include "probecast/service/server.h"
 #include "probecast/session/child_process.h"
+#include "probecast/session/nats_server.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/volumes.h"
@@ -101,8 +105,9 @@ ProcessSample parseSample(const std::string& text, const std::string& who) {
 
 // The server process: a producer of lighting frames at `hz`, served over gRPC, driven by the
 // parent's commands (sample, latency, stop, quit) so that baseline and load are measured apart.
-int serveLightingFrames(double hz, const std::string& repr, const session::ChildProcess::Say& say,
-                        const session::ChildProcess::Hear& hear) {
+// With `bus`, it also publishes every brick version there (the relayed topology's origin).
+int serveLightingFrames(double hz, const std::string& repr, const service::BusConfig* bus,
+                        const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
   session::ProbeProducer producer(service::hubConfigFor(
       session::unitGrid({kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]}),
       parseRepresentation(repr).value_or(Representation::Zh3), 4, 1));
@@ -111,6 +116,7 @@ int serveLightingFrames(double hz, const std::string& repr, const session::Child
   sc.token = kBenchToken;
   sc.maxSubscribers = 100000;
   say(fmt::format("port {}", producer.serve(sc)));
+  if (bus) producer.publishTo(*bus);
   producer.generate([](uint32_t frame, std::vector<float>& probes) { lightingFrame(static_cast<int>(frame), probes); });
   session::Pacing pacing;
   pacing.mode = session::Pacing::Mode::FixedRate;
@@ -212,30 +218,112 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// The server side of a run: its processes and the addresses subscribers connect to.
+// An edge process: an edge server fed from `bus`, driven like the server process (sample,
+// latency, quit). It says its port once the bus has delivered the volume, so subscribers that
+// connect then are served rather than told to go elsewhere.
+int serveEdge(const service::BusConfig& bus, const session::ChildProcess::Say& say,
+              const session::ChildProcess::Hear& hear) {
+  service::EdgeConfig ec;
+  ec.bus = bus;
+  ec.server.plaintext = true;
+  ec.server.token = kBenchToken;
+  ec.server.maxSubscribers = 100000;
+  service::EdgeServer edge(ec);
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (edge.stats().applied == 0 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(20ms);
+  if (edge.stats().applied == 0) {
+    say("error the edge received nothing from the bus: " + edge.stats().lastError);
+    return 1;
+  }
+  say(fmt::format("port {}", edge.port()));
+  for (std::string command; hear(command);) {
+    if (command == "sample") {
+      say(sampleLine());
+    } else if (command == "latency") {
+      say("latency " + edge.takeFrameWriteLatency().toText());
+    } else if (command == "quit") {
+      edge.shutdown();
+      return 0;
+    } else {
+      say("unknown command " + command);
+    }
+  }
+  return 1;
+}
+
+// CPU seconds and resident kB of another process (nats-server), from /proc.
+ProcessSample sampleProcess(pid_t pid) {
+  ProcessSample s;
+  if (pid <= 0) return s;
+  if (FILE* f = std::fopen(fmt::format("/proc/{}/stat", pid).c_str(), "r")) {
+    char buf[1024];
+    const size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+    std::fclose(f);
+    buf[n] = 0;
+    const char* p = std::strrchr(buf, ')');  // fields after the command name, which may hold spaces
+    unsigned long long utime = 0, stime = 0;
+    if (p && std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &utime, &stime) == 2)
+      s.cpuSeconds = static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+  }
+  if (FILE* f = std::fopen(fmt::format("/proc/{}/status", pid).c_str(), "r")) {
+    char line[256];
+    uint64_t kb = 0;
+    while (std::fgets(line, sizeof line, f))
+      if (std::sscanf(line, "VmRSS: %" SCNu64, &kb) == 1) break;
+    std::fclose(f);
+    s.rssKb = static_cast<double>(kb);
+  }
+  return s;
+}
+
+// The server side of a run: its processes (the producer first) and the addresses subscribers
+// connect to; a relayed run also has a nats-server, whose CPU and memory count as the server's.
 struct Topology {
+  std::unique_ptr<session::NatsServer> nats;
   std::vector<std::unique_ptr<session::ChildProcess>> servers;
   std::vector<std::string> addresses;
 };
 
-// One server, subscribers connected straight to it.
-Topology directTopology(const StreamBenchOptions& o) {
-  Topology t;
-  t.servers.push_back(std::make_unique<session::ChildProcess>(
-      [&o](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
-        return serveLightingFrames(o.hz, o.repr, say, hear);
-      }));
-  t.servers.back()->go();
+// Starts a server-side child and reads the port it says.
+int startServerChild(session::ChildProcess& child, const std::string& who) {
+  child.go();
   std::string line;
   int port = 0;
-  if (!t.servers.back()->readLine(line) || std::sscanf(line.c_str(), "port %d", &port) != 1)
-    throw std::runtime_error("server process did not start");
-  t.addresses.push_back("127.0.0.1:" + std::to_string(port));
+  if (!child.readLine(line) || std::sscanf(line.c_str(), "port %d", &port) != 1)
+    throw std::runtime_error(who + " did not start: " + line);
+  return port;
+}
+
+// One server, subscribers connected straight to it; or (o.edges > 0) the producer publishing to
+// a nats-server with JetStream and that many edges serving the subscribers, split evenly.
+Topology makeTopology(const StreamBenchOptions& o) {
+  Topology t;
+  service::BusConfig bus;
+  if (o.edges > 0) {
+    t.nats = std::make_unique<session::NatsServer>();
+    bus.url = t.nats->url();
+    bus.stream = "bench";
+  }
+  const service::BusConfig* busOrNull = o.edges > 0 ? &bus : nullptr;
+  t.servers.push_back(std::make_unique<session::ChildProcess>(
+      [&o, busOrNull](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
+        return serveLightingFrames(o.hz, o.repr, busOrNull, say, hear);
+      }));
+  const int port = startServerChild(*t.servers.back(), "server process");
+  if (o.edges == 0) t.addresses.push_back("127.0.0.1:" + std::to_string(port));
+  for (int e = 0; e < o.edges; ++e) {
+    t.servers.push_back(std::make_unique<session::ChildProcess>(
+        [bus](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
+          return serveEdge(bus, say, hear);
+        }));
+    t.addresses.push_back("127.0.0.1:" + std::to_string(startServerChild(*t.servers.back(), "edge process")));
+  }
   return t;
 }
 
-ProcessSample sampleAll(std::vector<std::unique_ptr<session::ChildProcess>>& processes, const std::string& who) {
-  ProcessSample total;
+ProcessSample sampleAll(std::vector<std::unique_ptr<session::ChildProcess>>& processes, const std::string& who,
+                        pid_t other = -1) {
+  ProcessSample total = sampleProcess(other);
   for (auto& p : processes) {
     const ProcessSample s = parseSample(ask(*p, "sample", "sample", who), who);
     total.cpuSeconds += s.cpuSeconds;
@@ -293,13 +381,14 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
                                   "cpu/sub", "rss MB", "KB/sub", "B/s/sub", "load cpu", "errors");
   std::string failure;
   for (const int n : o.subscribers) {
-    Topology topo = directTopology(o);
-    say(fmt::format("{} subscribers on {}, {:.0f} s at {} Hz", n, topo.addresses[0], o.seconds, o.hz));
+    Topology topo = makeTopology(o);
+    say(fmt::format("{} subscribers on {}{}, {:.0f} s at {} Hz", n, topo.addresses[0],
+                    o.edges > 0 ? fmt::format(" and {} more edges (through NATS)", o.edges - 1) : "", o.seconds, o.hz));
     // Baseline: the producer publishing to nobody.
-    const ProcessSample b0 = sampleAll(topo.servers, "server");
+    const ProcessSample b0 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
     auto tb = std::chrono::steady_clock::now();
     std::this_thread::sleep_for(1500ms);
-    const ProcessSample b1 = sampleAll(topo.servers, "server");
+    const ProcessSample b1 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
     const double baselineCores = (b1.cpuSeconds - b0.cpuSeconds) / secondsSince(tb);
     // Load: separate processes, a share of the subscribers each.
     const int processes = (n + o.subscribersPerLoadProcess - 1) / o.subscribersPerLoadProcess;
@@ -331,13 +420,13 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
     std::this_thread::sleep_for(1s);  // the first keyframes go out
     takeAll(loads);
     takeWriteLatency(topo);
-    const ProcessSample s0 = sampleAll(topo.servers, "server");
+    const ProcessSample s0 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
     const auto t0 = std::chrono::steady_clock::now();
     const LoadReport l0 = takeAll(loads);
     std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds));
     const LoadReport l1 = takeAll(loads);
     const double dt = secondsSince(t0);
-    const ProcessSample s1 = sampleAll(topo.servers, "server");
+    const ProcessSample s1 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
     const service::LatencyHistogram writes = takeWriteLatency(topo);
     // The lighting stops; every decoding subscriber must come to hold the producer's volume.
     std::string hash;
@@ -376,6 +465,8 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
     const uint64_t errors = f.sequenceErrors + f.crcErrors + f.decodeErrors + f.streamErrors;
     const nlohmann::json run = {
         {"subscribers", n},
+        {"topology", o.edges > 0 ? "nats" : "direct"},
+        {"edges", o.edges},
         {"connected", connected},
         {"hz", o.hz},
         {"seconds", dt},
@@ -428,7 +519,10 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
             {"hz", o.hz},
             {"seconds", o.seconds},
             {"budget_bytes_per_s", o.budgetBytesPerSecond},
-            {"topology", "direct: one server process"},
+            {"topology", o.edges > 0 ? fmt::format("nats: the producer publishes to a nats-server (JetStream); {} edge "
+                                                   "processes serve the subscribers, split evenly; server figures sum "
+                                                   "producer, edges and nats-server", o.edges)
+                                     : std::string("direct: one server process")},
             {"runs", runs},
             {"notes",
              "loopback; the server (producer, hub, gRPC) and the load clients run in separate processes, CPU from "

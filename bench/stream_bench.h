@@ -19,6 +19,9 @@ struct StreamBenchOptions {
   uint64_t budgetBytesPerSecond = 0;  // per subscriber; 0 = unlimited
   std::string repr = "zh3";
   int subscribersPerLoadProcess = 250;
+  // 0: subscribers connect to the producer's server. N > 0: the producer publishes to a
+  // nats-server (JetStream, started for the run) and N edges serve the subscribers, split evenly.
+  int edges = 0;
   int sampleEvery = 50;  // 1 in this many subscribers decodes fully (subscriber 0 always does)
   std::string command;
   std::function<void(const std::string&)> progress;

@@ -166,6 +166,10 @@ EdgeStats EdgeServer::stats() const {
 
 const ProbeHub& EdgeServer::hub() const { return impl_->hub; }
 
+LatencyHistogram EdgeServer::takeFrameWriteLatency() {
+  return impl_->server ? impl_->server->takeFrameWriteLatency() : LatencyHistogram{};
+}
+
 void EdgeServer::shutdown() {
   Impl& s = *impl_;
   if (s.server) s.server->shutdown();

@@ -27,6 +27,7 @@ class NatsServer {
   std::string url() const;  // nats://127.0.0.1:PORT
   const std::string& storeDir() const { return store_; }
   bool running() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }  // -1 while stopped
   // SIGTERM, then SIGKILL after 5 s; waits for it to end.
   void stop();
   // Starts it again on the same port and store (after stop()).

@@ -44,6 +44,8 @@ class EdgeServer {
   int port() const;
   EdgeStats stats() const;
   const ProbeHub& hub() const;
+  // The gRPC server's frame write latencies since the last call (ProbeServer::takeFrameWriteLatency).
+  LatencyHistogram takeFrameWriteLatency();
   // Ends every stream and stops listening, then leaves the bus.
   void shutdown();
 
