@@ -271,6 +271,7 @@ void addBenchStream(CLI::App* bench) {
       "stream", "the service under N subscribers on loopback: server and light load clients in processes of their own");
   struct StreamOptions {
     std::string json, chart;
+    GridOptions grid{{bench::kLightingGrid[0], bench::kLightingGrid[1], bench::kLightingGrid[2]}, {}};
     bench::StreamBenchOptions bench;
   };
   auto so = std::make_shared<StreamOptions>();
@@ -285,6 +286,7 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--sample-every", so->bench.sampleEvery,
                      "1 in this many subscribers decodes in full and is checked bit for bit")
       ->check(CLI::Range(1, 5000));
+  so->grid.add(stream, false, 2, 256);  // the benchmark volume, probes 1 m apart
   stream->add_option("--edges", so->bench.edges,
                      "0: subscribers connect to the producer; N: through a nats-server and N edges")
       ->check(CLI::Range(0, 16));
@@ -294,6 +296,7 @@ void addBenchStream(CLI::App* bench) {
   stream->callback([so] {
     so->bench.command = commandLine();
     so->bench.progress = progressLine;
+    for (int a = 0; a < 3; ++a) so->bench.grid[a] = static_cast<uint16_t>(so->grid.dims[a]);
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
     if (!r.failure.empty()) throw std::runtime_error("the stream was wrong: " + r.failure);

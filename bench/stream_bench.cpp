@@ -40,11 +40,14 @@ double cpuSeconds() {
 
 }  // namespace
 
-void lightingFrame(int frame, std::vector<float>& probes) {
-  const int nx = kLightingGrid[0], ny = kLightingGrid[1], nz = kLightingGrid[2];
+void lightingFrame(int frame, std::vector<float>& probes, std::array<uint16_t, 3> dims) {
+  const int nx = dims[0], ny = dims[1], nz = dims[2];
   probes.assign(static_cast<size_t>(nx) * ny * nz * 27, 0.0f);
   const float a = 0.05f * static_cast<float>(frame);
-  const float light[3] = {16.0f + 10.0f * std::cos(a), 10.0f, 16.0f + 10.0f * std::sin(a)};
+  // Over the 32-wide grid: a circle of radius 10 around (16, 10, 16).
+  const float cx = 0.5f * static_cast<float>(nx), cz = 0.5f * static_cast<float>(nz);
+  const float r = 10.0f * static_cast<float>(nx) / 32.0f;
+  const float light[3] = {cx + r * std::cos(a), 10.0f, cz + r * std::sin(a)};
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y)
       for (int x = 0; x < nx; ++x) {
@@ -106,18 +109,19 @@ ProcessSample parseSample(const std::string& text, const std::string& who) {
 // The server process: a producer of lighting frames at `hz`, served over gRPC, driven by the
 // parent's commands (sample, latency, stop, quit) so that baseline and load are measured apart.
 // With `bus`, it also publishes every brick version there (the relayed topology's origin).
-int serveLightingFrames(double hz, const std::string& repr, const service::BusConfig* bus,
+int serveLightingFrames(double hz, const std::string& repr, std::array<uint16_t, 3> dims, const service::BusConfig* bus,
                         const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
   session::ProbeProducer producer(service::hubConfigFor(
-      session::unitGrid({kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]}),
-      parseRepresentation(repr).value_or(Representation::Zh3), 4, 1));
+      session::unitGrid({dims[0], dims[1], dims[2]}), parseRepresentation(repr).value_or(Representation::Zh3), 4, 1));
   service::ServerConfig sc;
   sc.plaintext = true;
   sc.token = kBenchToken;
   sc.maxSubscribers = 100000;
   say(fmt::format("port {}", producer.serve(sc)));
   if (bus) producer.publishTo(*bus);
-  producer.generate([](uint32_t frame, std::vector<float>& probes) { lightingFrame(static_cast<int>(frame), probes); });
+  producer.generate([dims](uint32_t frame, std::vector<float>& probes) {
+    lightingFrame(static_cast<int>(frame), probes, dims);
+  });
   session::Pacing pacing;
   pacing.mode = session::Pacing::Mode::FixedRate;
   pacing.hz = hz;
@@ -194,12 +198,14 @@ LoadReport parseFigures(const std::string& text, const std::string& who) {
   return r;
 }
 
-// A top-down orthographic view of an 8 m patch from 20 m up: clip x = (x − cx)/4,
-// clip y = (z − cz)/4, clip z = (20 − y)/30 (column-major, m[col * 4 + row]).
-View randomView(uint32_t index) {
+// A top-down orthographic view of an 8 m patch from 20 m up, centred somewhere over the grid
+// (`dims`, 1 m apart): clip x = (x − cx)/4, clip y = (z − cz)/4, clip z = (20 − y)/30
+// (column-major, m[col * 4 + row]).
+View randomView(uint32_t index, std::array<uint16_t, 3> dims) {
   std::mt19937 rng(7 + index);
-  std::uniform_real_distribution<float> u(0.0f, 31.0f);
-  const float cx = u(rng), cz = u(rng), h = 4.0f;
+  std::uniform_real_distribution<float> ux(0.0f, static_cast<float>(dims[0] - 1));
+  std::uniform_real_distribution<float> uz(0.0f, static_cast<float>(dims[2] - 1));
+  const float cx = ux(rng), cz = uz(rng), h = 4.0f;
   View v{};
   v.viewProj[0] = 1.0f / h;
   v.viewProj[12] = -cx / h;
@@ -307,7 +313,7 @@ Topology makeTopology(const StreamBenchOptions& o) {
   const service::BusConfig* busOrNull = o.edges > 0 ? &bus : nullptr;
   t.servers.push_back(std::make_unique<session::ChildProcess>(
       [&o, busOrNull](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
-        return serveLightingFrames(o.hz, o.repr, busOrNull, say, hear);
+        return serveLightingFrames(o.hz, o.repr, o.grid, busOrNull, say, hear);
       }));
   const int port = startServerChild(*t.servers.back(), "server process");
   if (o.edges == 0) t.addresses.push_back("127.0.0.1:" + std::to_string(port));
@@ -372,6 +378,9 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
     if (n < 1) throw std::invalid_argument("subscriber counts must be positive");
   if (o.subscribersPerLoadProcess < 1 || o.sampleEvery < 1)
     throw std::invalid_argument("subscribers per load process and the sampling interval must be positive");
+  if (!isValidLayout(streamLayoutFor(session::unitGrid({o.grid[0], o.grid[1], o.grid[2]}), Representation::Zh3, 4)))
+    throw std::invalid_argument(fmt::format("a {}x{}x{} grid cannot be streamed (too many probes for the stream format)",
+                                            o.grid[0], o.grid[1], o.grid[2]));
   nlohmann::json runs = nlohmann::json::array();
   imaging::ChartSeries p50Series{"produce → receive p50", {}, true};
   imaging::ChartSeries p99Series{"produce → receive p99", {}, true};
@@ -401,7 +410,7 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
       lc.subscribers = static_cast<uint32_t>(static_cast<int64_t>(n) * (k + 1) / processes) - lc.firstIndex;
       lc.sampleEvery = static_cast<uint32_t>(o.sampleEvery);
       lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
-      lc.view = randomView;
+      lc.view = [dims = o.grid](uint32_t i) { return randomView(i, dims); };
       loads.push_back(std::make_unique<session::ChildProcess>(
           [lc](const session::ChildProcess::Say& s, const session::ChildProcess::Hear& h) { return runLoad(lc, s, h); }));
       loads.back()->go();
@@ -515,7 +524,8 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   }
   StreamBenchResult r;
   r.json = {{"command", o.command},
-            {"volume", "32x8x32 probes, bricks of 4, " + o.repr + ", dead-zone 1, light circling"},
+            {"volume", fmt::format("{}x{}x{} probes, bricks of 4, {}, dead-zone 1, light circling", o.grid[0], o.grid[1],
+                                   o.grid[2], o.repr)},
             {"hz", o.hz},
             {"seconds", o.seconds},
             {"budget_bytes_per_s", o.budgetBytesPerSecond},

@@ -4,6 +4,8 @@
 // them and never starts gRPC itself (gRPC cannot be forked once it runs).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -11,6 +13,9 @@
 #include <nlohmann/json.hpp>
 
 namespace probecast::bench {
+
+// The benchmark volume's probes per axis (lightingFrame).
+constexpr uint16_t kLightingGrid[3] = {32, 8, 32};
 
 struct StreamBenchOptions {
   std::vector<int> subscribers = {1, 100, 1000};
@@ -22,7 +27,8 @@ struct StreamBenchOptions {
   // 0: subscribers connect to the producer's server. N > 0: the producer publishes to a
   // nats-server (JetStream, started for the run) and N edges serve the subscribers, split evenly.
   int edges = 0;
-  int sampleEvery = 50;  // 1 in this many subscribers decodes fully (subscriber 0 always does)
+  int sampleEvery = 50;
+  std::array<uint16_t, 3> grid = {kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]};  // probes per axis, 1 m apart  // 1 in this many subscribers decodes fully (subscriber 0 always does)
   std::string command;
   std::function<void(const std::string&)> progress;
 };
@@ -40,7 +46,8 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& options);
 
 // Lighting frame `frame` of the benchmark's volume: 32 × 8 × 32 probes (x fastest) lit by a light
 // circling above them (analytic SH), 27 floats per probe.
-constexpr uint16_t kLightingGrid[3] = {32, 8, 32};
-void lightingFrame(int frame, std::vector<float>& probes);
+// Other grids (`dims`, probes 1 m apart) get the same light over their own centre, its circle's
+// radius scaled with the grid's width.
+void lightingFrame(int frame, std::vector<float>& probes, std::array<uint16_t, 3> dims = {32, 8, 32});
 
 }  // namespace probecast::bench
