@@ -41,7 +41,8 @@ vec4 materialBase(PtMaterial m, vec4 uvs) {
 
 vec3 materialEmission(PtMaterial m, vec4 uvs) {
   if (m.textures.y < 0) return m.emissionRoughness.rgb;
-  return m.emissionRoughness.rgb * sampleTexture(m.textures.y, transformedUv(m.emissiveTransform0, m.emissiveTransform1, uvs)).rgb;
+  vec2 uv = transformedUv(m.emissiveTransform0, m.emissiveTransform1, uvs);
+  return m.emissionRoughness.rgb * sampleTexture(m.textures.y, uv).rgb;
 }
 
 // Mask: the point is not there (rays pass, raster discards).

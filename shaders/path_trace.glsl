@@ -35,7 +35,9 @@ float rnd(inout uint s) {
 
 vec3 vertexPosition(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
 vec3 vertexNormal(uint i) { return vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); }
-vec4 vertexTexcoords(uint i) { return vec4(texcoords[4 * i], texcoords[4 * i + 1], texcoords[4 * i + 2], texcoords[4 * i + 3]); }
+vec4 vertexTexcoords(uint i) {
+  return vec4(texcoords[4 * i], texcoords[4 * i + 1], texcoords[4 * i + 2], texcoords[4 * i + 3]);
+}
 
 // Offset of a ray origin from a surface point p, against self-intersection.
 float rayOffset(vec3 p) { return 1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))); }

@@ -27,7 +27,8 @@ inline void putBigEndian(std::string& out, uint32_t v, int bytes) {
 
 // A PNG of `channels` (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA) samples of `bits` (8 or 16) per
 // pixel, rows top first; the zlib stream holds stored (uncompressed) deflate blocks.
-inline std::string pngFile(uint32_t width, uint32_t height, int channels, int bits, const std::vector<uint16_t>& samples) {
+inline std::string pngFile(uint32_t width, uint32_t height, int channels, int bits,
+                           const std::vector<uint16_t>& samples) {
   std::string raw;
   for (uint32_t y = 0; y < height; ++y) {
     raw.push_back(0);  // filter: none

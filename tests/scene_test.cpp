@@ -182,7 +182,8 @@ TEST(Scene, AlphaModesTransmissionAndTextureTransformsAreLoaded) {
   }
   const std::string materials =
       R"({"name":"mask","alphaMode":"MASK","alphaCutoff":0.3,"pbrMetallicRoughness":{"baseColorFactor":[1,1,1,0.9],)"
-      R"("baseColorTexture":{"index":0,"extensions":{"KHR_texture_transform":{"offset":[0.25,0.5],"rotation":1.5707963,)"
+      R"("baseColorTexture":{"index":0,"extensions":{"KHR_texture_transform":)"
+      R"({"offset":[0.25,0.5],"rotation":1.5707963,)"
       R"("scale":[2,3],"texCoord":1}}}}},)"
       R"({"name":"glass","alphaMode":"BLEND","pbrMetallicRoughness":{"baseColorFactor":[1,0,0,0.4]}},)"
       R"({"name":"thin","extensions":{"KHR_materials_transmission":{"transmissionFactor":0.8}}})";
@@ -234,7 +235,8 @@ TEST(Scene, SixteenBitPngIsReadAsItsTopEightBitsRounded) {
   quads[0].corners[3] = {0, 1, 0};
   const std::string path = test::writeQuadGltf(
       dir, "png16", quads,
-      R"({"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"emissiveTexture":{"index":1},"emissiveFactor":[1,1,1]})",
+      R"({"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},)"
+      R"("emissiveTexture":{"index":1},"emissiveFactor":[1,1,1]})",
       R"({"source":0},{"source":1})", R"({"uri":"rgba16.png"},{"uri":"ga16.png"})");
   Scene s;
   std::string error;

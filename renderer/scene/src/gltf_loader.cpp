@@ -215,7 +215,9 @@ void convertMaterials(const tinygltf::Model& model, Scene& scene) {
     out.emissiveTransform = textureTransform(m.emissiveTexture.extensions, m.emissiveTexture.texCoord);
     out.alpha = pbr.baseColorFactor.size() == 4 ? std::clamp(static_cast<float>(pbr.baseColorFactor[3]), 0.0f, 1.0f)
                                                 : 1.0f;
-    out.alphaMode = m.alphaMode == "MASK" ? AlphaMode::Mask : (m.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque);
+    out.alphaMode = m.alphaMode == "MASK"    ? AlphaMode::Mask
+                    : m.alphaMode == "BLEND" ? AlphaMode::Blend
+                                             : AlphaMode::Opaque;
     out.alphaCutoff = std::isfinite(m.alphaCutoff) ? static_cast<float>(m.alphaCutoff) : 0.5f;
     it = m.extensions.find("KHR_materials_transmission");
     if (it != m.extensions.end() && it->second.IsObject())

@@ -78,7 +78,8 @@ void finalizeScene(Scene& s) {
         (s.positions[s.indices[3 * t]] + s.positions[s.indices[3 * t + 1]] + s.positions[s.indices[3 * t + 2]]) / 3.0f;
     const glm::vec3 u = glm::clamp((c - s.boundsMin) / extent, 0.0f, 1.0f) * 1023.0f;
     // The class in bits 30-31 keeps each class one run; Morton order within it.
-    code[t] = (triangleClass(s, t) << 30) | spreadBits(static_cast<uint32_t>(u.x)) | (spreadBits(static_cast<uint32_t>(u.y)) << 1) |
+    code[t] = (triangleClass(s, t) << 30) | spreadBits(static_cast<uint32_t>(u.x)) |
+              (spreadBits(static_cast<uint32_t>(u.y)) << 1) |
               (spreadBits(static_cast<uint32_t>(u.z)) << 2);
   }
   std::vector<uint32_t> order(count);
