@@ -4,10 +4,18 @@
 // roulette, bounce limit, clamp. Misses return the environment (black when there is none).
 // Nothing here divides by a quantity that can reach zero or takes pow/normalize of something that
 // can leave its domain: a non-finite sample is a defect (the raygens still drop and count one).
-// The including raygen declares the bindings, the payloads `hit` (location 0) and `visible`
-// (location 1), and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES, PATH_INDIRECT_CLAMP,
+// Cut-outs (alphaMode Mask) are holes to every ray (the any-hit shaders); transmissive surfaces
+// (Blend, KHR_materials_transmission; the rule in scene.h) attenuate visibility rays by T = τ·base
+// and let a path through with probability τ. The including raygen declares the bindings
+// (scene_bindings.glsl) and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES, PATH_INDIRECT_CLAMP,
 // PATH_EMITTER_COUNT and PATH_EMITTER_POWER.
-const float PI = 3.14159265358979;
+#include "material.glsl"
+
+layout(location = 0) rayPayloadEXT HitPayload hit;
+layout(location = 1) rayPayloadEXT vec4 shadowRay;  // rgb transmittance so far, a = 1 when it got through
+
+// Straight-through crossings of transmissive surfaces a path may make between two bounces.
+const uint PATH_MAX_CROSSINGS = 16u;
 
 // Rays traced by this invocation (for rays-per-second figures).
 uint gClosestRays = 0u;
@@ -27,29 +35,12 @@ float rnd(inout uint s) {
 
 vec3 vertexPosition(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
 vec3 vertexNormal(uint i) { return vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); }
-vec2 vertexTexcoord(uint i) { return vec2(texcoords[2 * i], texcoords[2 * i + 1]); }
-
-vec3 srgbToLinear(vec3 c) {
-  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+vec4 vertexTexcoords(uint i) {
+  return vec4(texcoords[4 * i], texcoords[4 * i + 1], texcoords[4 * i + 2], texcoords[4 * i + 3]);
 }
 
-vec3 texel(PtTexture t, int x, int y) {
-  x = ((x % int(t.width)) + int(t.width)) % int(t.width);  // repeat
-  y = ((y % int(t.height)) + int(t.height)) % int(t.height);
-  uint v = texels[t.offset + uint(y) * t.width + uint(x)];
-  return srgbToLinear(vec3(float(v & 255u), float((v >> 8) & 255u), float((v >> 16) & 255u)) / 255.0);
-}
-
-// Bilinear, repeat, sRGB decoded before filtering.
-vec3 sampleTexture(int index, vec2 uv) {
-  if (index < 0) return vec3(1.0);
-  PtTexture t = textures[index];
-  vec2 p = uv * vec2(t.width, t.height) - 0.5;
-  ivec2 i = ivec2(floor(p));
-  vec2 f = p - vec2(i);
-  return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x),
-             mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
-}
+// Offset of a ray origin from a surface point p, against self-intersection.
+float rayOffset(vec3 p) { return 1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))); }
 
 void onb(vec3 n, out vec3 t, out vec3 b) {
   float s = n.z >= 0.0 ? 1.0 : -1.0;
@@ -57,27 +48,6 @@ void onb(vec3 n, out vec3 t, out vec3 b) {
   float c = n.x * n.y * a;
   t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
   b = vec3(c, s + n.y * n.y * a, -n.y);
-}
-
-// Lambert + GGX (Cook-Torrance, Smith-Schlick G, Schlick F), metallic-roughness as glTF.
-vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) {
-  float nl = dot(n, wi), nv = dot(n, wo);
-  if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
-  vec3 h = normalize(wo + wi);  // nonzero: wo and wi lie on the same side of n
-  // Dot products of unit vectors can round past 1; pow() of the negative 1 − v·h that follows is
-  // undefined (NaN on llvmpipe), so clamp both into [0, 1] and expand the powers as products.
-  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(wo, h), 0.0, 1.0);
-  float a2 = alpha * alpha;
-  float dd = nh * nh * (a2 - 1.0) + 1.0;
-  float d = a2 / (PI * dd * dd);
-  float k = alpha * 0.5;
-  float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
-  vec3 f0 = mix(vec3(0.04), base, metallic);
-  float x = 1.0 - vh, x2 = x * x;
-  vec3 f = f0 + (1.0 - f0) * (x2 * x2 * x);
-  vec3 spec = d * g * f / max(4.0 * nl * nv, 1e-6);
-  vec3 diffuse = base * (1.0 - metallic) / PI;
-  return diffuse + spec;
 }
 
 float pdfBsdf(vec3 n, vec3 wo, vec3 wi, float alpha, float specProb) {
@@ -111,13 +81,17 @@ vec3 sampleBsdf(vec3 n, vec3 wo, float alpha, float specProb, inout uint rng) {
   return normalize(t * (r * cos(phi)) + b * (r * sin(phi)) + n * sqrt(max(0.0, 1.0 - u2)));
 }
 
-bool unoccluded(vec3 origin, vec3 dir, float tmax) {
-  visible = 0u;
+// What reaches `origin` from `origin + dir · tmax`: 0 behind anything solid, else the product of
+// the transmittances of the transmissive surfaces crossed (1 through free space and cut-outs).
+vec3 transmittance(vec3 origin, vec3 dir, float tmax) {
+  shadowRay = vec4(1.0, 1.0, 1.0, 0.0);
   ++gShadowRays;
-  traceRayEXT(tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT,
-              0xFF, 0, 0, 1, origin, 0.0, dir, tmax, 1);
-  return visible != 0u;
+  traceRayEXT(tlas, gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsSkipClosestHitShaderEXT, 0xFF,
+              PT_HIT_GROUP_SHADOW, 1, PT_MISS_SHADOW, origin, 0.0, dir, tmax, 1);
+  return shadowRay.a > 0.0 ? shadowRay.rgb : vec3(0.0);
 }
+
+bool anyLight(vec3 c) { return max(c.r, max(c.g, c.b)) > 0.0; }
 
 // Radiance of punctual lights arriving at p along wi, times the cosine, via a shadow ray.
 vec3 directLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha) {
@@ -143,8 +117,9 @@ vec3 directLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, fl
     }
     float cosine = dot(n, wi);
     if (cosine <= 0.0 || dot(ng, wi) <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
-    vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
-    if (unoccluded(origin, wi, dist * (1.0 - 1e-4))) sum += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e;
+    vec3 origin = p + ng * rayOffset(p);
+    vec3 t = transmittance(origin, wi, dist * (1.0 - 1e-4));
+    if (anyLight(t)) sum += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e * t;
   }
   return sum;
 }
@@ -221,10 +196,11 @@ vec3 environmentLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metalli
   vec3 le = sampleEnvironment(rng, wi, pdfLight);
   float cosSurface = dot(n, wi);
   if (!(pdfLight > 0.0) || cosSurface <= 0.0 || dot(ng, wi) <= 0.0) return vec3(0.0);
-  vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
-  if (!unoccluded(origin, wi, 1e30)) return vec3(0.0);
+  vec3 origin = p + ng * rayOffset(p);
+  vec3 t = transmittance(origin, wi, 1e30);
+  if (!anyLight(t)) return vec3(0.0);
   float weight = powerHeuristic(pdfLight, pdfBsdf(n, wo, wi, alpha, specProb));
-  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * (weight / pdfLight);
+  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * t * (weight / pdfLight);
 }
 
 // Solid-angle pdf with which emitter sampling picks a direction that reaches a point of triangle
@@ -263,15 +239,16 @@ vec3 emitterLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, f
   vec3 le = leFactor;
   if (em.textures.y >= 0) {
     uint i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
-    vec2 uv = vertexTexcoord(i0) * (1.0 - su) + vertexTexcoord(i1) * (su * (1.0 - v)) + vertexTexcoord(i2) * (su * v);
-    le *= sampleTexture(em.textures.y, uv);
+    vec4 uvs = vertexTexcoords(i0) * (1.0 - su) + vertexTexcoords(i1) * (su * (1.0 - v)) + vertexTexcoords(i2) * (su * v);
+    le = materialEmission(em, uvs);
   }
   float pdfLight = emitterPdf(leFactor, dist, cosLight);
   if (pdfLight <= 0.0) return vec3(0.0);
-  vec3 origin = p + ng * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
-  if (!unoccluded(origin, wi, dist * (1.0 - 1e-3))) return vec3(0.0);
+  vec3 origin = p + ng * rayOffset(p);
+  vec3 t = transmittance(origin, wi, dist * (1.0 - 1e-3));
+  if (!anyLight(t)) return vec3(0.0);
   float weight = powerHeuristic(pdfLight, pdfBsdf(n, wo, wi, alpha, specProb));
-  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * (weight / pdfLight);
+  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * t * (weight / pdfLight);
 }
 
 vec3 clampIndirect(vec3 c, uint bounce) {
@@ -283,8 +260,10 @@ vec3 clampIndirect(vec3 c, uint bounce) {
 vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
   float lastBsdfPdf = 0.0;  // pdf of the BSDF sample that started this segment (0: not sampled)
+  float segment = 0.0;      // distance from the segment's start to `origin` (crossings move it)
+  uint crossings = 0u;
   for (uint bounce = 0u; bounce < PATH_MAX_BOUNCES; ++bounce) {
-    traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, origin, 0.0, dir, 1e30, 0);
+    traceRayEXT(tlas, gl_RayFlagsNoneEXT, 0xFF, PT_HIT_GROUP_CLOSEST, 1, PT_MISS_CLOSEST, origin, 0.0, dir, 1e30, 0);
     ++gClosestRays;
     if (hit.t < 0.0) {
       // The environment, weighted against environment sampling when a BSDF sample got here
@@ -305,27 +284,37 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     vec3 p = origin + dir * hit.t;
     uint i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
     vec3 bary = vec3(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics);
-    vec2 uv = vertexTexcoord(i0) * bary.x + vertexTexcoord(i1) * bary.y + vertexTexcoord(i2) * bary.z;
+    vec4 uvs = vertexTexcoords(i0) * bary.x + vertexTexcoords(i1) * bary.y + vertexTexcoords(i2) * bary.z;
     vec3 leFactor = m.emissionRoughness.rgb;
-    vec3 le = leFactor * sampleTexture(m.textures.y, uv);
-    if (hit.backFace == 0u && max(le.r, max(le.g, le.b)) > 0.0) {
+    vec3 le = materialEmission(m, uvs);
+    if (hit.backFace == 0u && anyLight(le)) {
       // Emission found by BSDF sampling, weighted against emitter sampling (not on the first
       // segment: probe and camera rays are not BSDF samples).
       float weight = 1.0;
       if (lastBsdfPdf > 0.0) {
-        float pdfLight = emitterPdf(leFactor, hit.t, abs(dot(ng, dir)));
+        float pdfLight = emitterPdf(leFactor, segment + hit.t, abs(dot(ng, dir)));
         weight = powerHeuristic(lastBsdfPdf, pdfLight);
       }
       radiance += clampIndirect(throughput * le * weight, bounce);
     }
     vec3 ngf = dot(ng, dir) < 0.0 ? ng : -ng;  // geometric normal facing the ray (two-sided)
-    vec3 ns = vertexNormal(i0) * bary.x + vertexNormal(i1) * bary.y + vertexNormal(i2) * bary.z;
-    float nsLen = length(ns);
-    vec3 n = nsLen > 1e-6 ? ns / nsLen : ngf;
-    if (dot(n, ngf) < 0.0) n = -n;                        // shading normal on the ray's side
-    if (dot(n, -dir) <= 1e-4) n = ngf;                     // grazing: fall back to the geometric normal
+    vec4 baseAlpha = materialBase(m, uvs);
+    vec3 base = baseAlpha.rgb;
+    float tau = materialTransmission(m, baseAlpha.a);
+    if (tau > 0.0 && crossings < PATH_MAX_CROSSINGS && rnd(rng) < tau) {
+      // Straight through (probability τ, weight T / τ = base); not a bounce: same direction, same
+      // BSDF sample, so the MIS weights of whatever the segment reaches still hold.
+      throughput *= base;
+      ++crossings;
+      --bounce;
+      segment += hit.t;
+      origin = p - ngf * rayOffset(p);
+      continue;
+    }
+    // Reflection (probability 1 − τ, weight (1 − τ) / (1 − τ) = 1).
+    segment = 0.0;
+    vec3 n = shadingNormal(vertexNormal(i0) * bary.x + vertexNormal(i1) * bary.y + vertexNormal(i2) * bary.z, ngf, -dir);
     vec3 wo = -dir;
-    vec3 base = m.baseColorMetallic.rgb * sampleTexture(m.textures.x, uv);
     float metallic = m.baseColorMetallic.a;
     float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
     float specProb = mix(0.2, 0.9, metallic);
@@ -344,12 +333,11 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
       throughput /= q;
     }
     if (dot(wi, ngf) <= 0.0) break;  // a shading-normal sample that goes below the surface
-    origin = p + ngf * (1e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z)))));
+    origin = p + ngf * rayOffset(p);
     dir = wi;
   }
   return radiance;
 }
-
 
 // A path sample the raygens may add: every component finite (they drop and count any other).
 bool finiteRadiance(vec3 c) { return !any(isnan(c)) && !any(isinf(c)); }

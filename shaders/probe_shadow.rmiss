@@ -1,6 +1,6 @@
 #version 460
 #extension GL_EXT_ray_tracing : require
 
-layout(location = 1) rayPayloadInEXT uint visible;
+layout(location = 1) rayPayloadInEXT vec4 shadowRay;
 
-void main() { visible = 1u; }
+void main() { shadowRay.a = 1.0; }

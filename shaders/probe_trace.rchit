@@ -8,7 +8,7 @@ hitAttributeEXT vec2 attribs;
 
 void main() {
   hit.t = gl_HitTEXT;
-  hit.primitive = gl_PrimitiveID;
+  hit.primitive = uint(gl_InstanceCustomIndexEXT) + uint(gl_PrimitiveID);  // the scene's triangle index
   hit.barycentrics = attribs;
   hit.backFace = gl_HitKindEXT == gl_HitKindBackFacingTriangleEXT ? 1u : 0u;
 }

@@ -20,7 +20,7 @@
 #define PT_BINDING_PARTIALS 8   // float[active probes * LANES * PARTIAL_FLOATS]
 #define PT_BINDING_EMITTERS 9   // PtEmitter[]: emissive triangles for next-event estimation
 #define PT_BINDING_NORMALS 10   // float[3 * vertices], shading normals
-#define PT_BINDING_TEXCOORDS 11 // float[2 * vertices]
+#define PT_BINDING_TEXCOORDS 11 // float[4 * vertices]: TEXCOORD_0 uv, TEXCOORD_1 uv
 #define PT_BINDING_TEXELS 12    // uint[]: every texture's sRGB RGBA8 texels, packed
 #define PT_BINDING_TEXTURES 13  // PtTexture[]
 #define PT_BINDING_ENVIRONMENT 14 // PtEnvironment (one): how to read PT_BINDING_ENV_DATA
@@ -29,6 +29,16 @@
 
 #define PT_ENV_NONE 0u          // misses are black
 #define PT_ENV_MAP 1u           // misses return the equirect map (environment.h's convention)
+
+#define PT_ALPHA_OPAQUE 0       // PtMaterial.textures.z, as scene::AlphaMode
+#define PT_ALPHA_MASK 1
+#define PT_ALPHA_BLEND 2
+
+// Hit groups (shader binding table records) of the two ray types.
+#define PT_HIT_GROUP_CLOSEST 0u // paths: closest hit, any-hit drops cut-away points
+#define PT_HIT_GROUP_SHADOW 1u  // visibility: any-hit multiplies the transmittance
+#define PT_MISS_CLOSEST 0u
+#define PT_MISS_SHADOW 1u
 
 #define PT_LIGHT_POINT 0u
 #define PT_LIGHT_SPOT 1u
@@ -53,7 +63,13 @@ struct mat4 {
 struct PtMaterial {
   vec4 baseColorMetallic;   // rgb base colour, a metallic
   vec4 emissionRoughness;   // rgb emitted radiance, a roughness
-  ivec4 textures;           // x base colour texture, y emissive texture (-1 = none)
+  ivec4 textures;           // x base colour texture, y emissive texture (-1 = none), z PT_ALPHA_*
+  vec4 alpha;               // x alpha (baseColorFactor.a), y alpha cutoff (Mask), z transmission factor
+  // KHR_texture_transform: uv' = (row0.xyz · (u, v, 1), row1.xyz · (u, v, 1)) of TEXCOORD_<row0.w>.
+  vec4 baseTransform0;
+  vec4 baseTransform1;
+  vec4 emissiveTransform0;
+  vec4 emissiveTransform1;
 };
 
 struct PtTexture {
@@ -136,7 +152,7 @@ struct PtCameraPushConstants {
 #ifdef __cplusplus
 static_assert(sizeof(PtCameraPushConstants) == 112);
 static_assert(sizeof(PtEmitter) == 16);
-static_assert(sizeof(PtMaterial) == 48);
+static_assert(sizeof(PtMaterial) == 128);
 static_assert(sizeof(PtTexture) == 16);
 static_assert(sizeof(PtLight) == 64);
 static_assert(sizeof(PtPushConstants) == 112);

@@ -1,14 +1,18 @@
 #version 460
 // Raster client shading: surface emission + direct light from punctual lights (shadow maps, 3×3
 // PCF) + diffuse indirect albedo/π · E(n) and split-sum glossy indirect from the probe volume
-// (trilinear in 3D textures), linear radiance out.
+// (trilinear in 3D textures), linear radiance out. Cut-away points (alphaMode Mask) are discarded;
+// transmissive surfaces (scene.h's rule) are drawn after the opaque ones in two blended passes:
+// RS_PASS_TRANSMIT multiplies what lies behind by T = τ·base, RS_PASS_REFLECT adds emission +
+// (1 − τ)·(direct + indirect). One layer is exact; several are order-independent but approximate
+// (a far layer's reflection is not tinted by a nearer one).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_multiview : require
 #include "raster_shared.h"
 
 layout(location = 0) in vec3 worldPosition;
 layout(location = 1) in vec3 worldNormal;
-layout(location = 2) in vec2 texcoord;
+layout(location = 2) in vec4 texcoord;  // TEXCOORD_0, TEXCOORD_1
 layout(location = 0) out vec4 outColor;
 layout(push_constant) uniform Push { RsPushConstants pc; };
 
@@ -24,42 +28,7 @@ layout(std430, binding = RS_BINDING_SHADOW_LIGHTS) readonly buffer ShadowLights 
 layout(std430, binding = RS_BINDING_SHADOW_LAYERS) readonly buffer ShadowLayers { RsShadowLayer shadowLayers[]; };
 layout(binding = RS_BINDING_SHADOW_MAP) uniform sampler2DArrayShadow shadowMap;
 
-const float PI = 3.14159265358979;
-
-vec3 srgbToLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045))); }
-
-vec3 texel(PtTexture t, int x, int y) {
-  x = ((x % int(t.width)) + int(t.width)) % int(t.width);
-  y = ((y % int(t.height)) + int(t.height)) % int(t.height);
-  uint v = texels[t.offset + uint(y) * t.width + uint(x)];
-  return srgbToLinear(vec3(float(v & 255u), float((v >> 8) & 255u), float((v >> 16) & 255u)) / 255.0);
-}
-
-vec3 sampleTexture(int index, vec2 uv) {
-  if (index < 0) return vec3(1.0);
-  PtTexture t = textures[index];
-  vec2 p = uv * vec2(t.width, t.height) - 0.5;
-  ivec2 i = ivec2(floor(p));
-  vec2 f = p - vec2(i);
-  return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x), mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
-}
-
-vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) {
-  float nl = dot(n, wi), nv = dot(n, wo);
-  if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
-  vec3 h = normalize(wo + wi);
-  // As path_trace.glsl: v·h can round past 1, and pow() of a negative base is undefined.
-  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(wo, h), 0.0, 1.0);
-  float a2 = alpha * alpha;
-  float dd = nh * nh * (a2 - 1.0) + 1.0;
-  float d = a2 / (PI * dd * dd);
-  float k = alpha * 0.5;
-  float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
-  vec3 f0 = mix(vec3(0.04), base, metallic);
-  float x = 1.0 - vh, x2 = x * x;
-  vec3 f = f0 + (1.0 - f0) * (x2 * x2 * x);
-  return base * (1.0 - metallic) / PI + d * g * f / max(4.0 * nl * nv, 1e-6);
-}
+#include "material.glsl"
 
 // The probe volume's 27 SH coefficients at p (trilinear over active probes).
 bool probeCoefficients(vec3 p, out float c[28]) {
@@ -163,14 +132,26 @@ vec3 probeGlossy(float c[28], vec3 r, float roughness, float nv, vec3 f0) {
 }
 
 void main() {
-  PtMaterial m = materials[triangleMaterial[gl_PrimitiveID]];
-  vec3 base = m.baseColorMetallic.rgb * sampleTexture(m.textures.x, texcoord);
+  vec3 wo = normalize(views[pc.viewBase + gl_ViewIndex].eye.xyz - worldPosition);
+  // The geometric normal from the position's screen derivatives (before any discard), on the
+  // viewer's side; the shading normal then follows the rule of material.glsl, as in the tracers.
+  vec3 ng = cross(dFdx(worldPosition), dFdy(worldPosition));
+  float ngLen = length(ng);
+  vec3 ngf = ngLen > 1e-20 ? ng / ngLen : wo;
+  if (dot(ngf, wo) < 0.0) ngf = -ngf;
+  PtMaterial m = materials[triangleMaterial[pc.primitiveBase + uint(gl_PrimitiveID)]];
+  vec4 baseAlpha = materialBase(m, texcoord);
+  if (materialCutAway(m, baseAlpha.a)) discard;
+  vec3 base = baseAlpha.rgb;
+  float tau = pc.pass == RS_PASS_OPAQUE ? 0.0 : materialTransmission(m, baseAlpha.a);
+  if (pc.pass == RS_PASS_TRANSMIT) {
+    outColor = vec4(tau * base, 1.0);
+    return;
+  }
   float metallic = m.baseColorMetallic.a;
   float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
-  vec3 emission = m.emissionRoughness.rgb * sampleTexture(m.textures.y, texcoord);
-  vec3 wo = normalize(views[pc.viewBase + gl_ViewIndex].eye.xyz - worldPosition);
-  vec3 n = normalize(worldNormal);
-  if (dot(n, wo) < 0.0) n = -n;  // two-sided, as in the path tracer
+  vec3 emission = materialEmission(m, texcoord);
+  vec3 n = shadingNormal(worldNormal, ngf, wo);
   vec3 direct = vec3(0.0);
   for (uint i = 0u; i < pc.lightCount; ++i) {
     PtLight l = lights[i];
@@ -190,7 +171,7 @@ void main() {
       if (type == PT_LIGHT_SPOT) e *= smoothstep(l.cone.x, l.cone.y, dot(-wi, l.directionRange.xyz));
     }
     float cosine = dot(n, wi);
-    if (cosine > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e * shadowVisibility(i, worldPosition, n);
+    if (cosine > 0.0 && dot(ngf, wi) > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e * shadowVisibility(i, worldPosition, n);
   }
   float c[28];
   vec3 indirect = vec3(0.0);
@@ -201,5 +182,5 @@ void main() {
     indirect = base * (1.0 - metallic) / PI * probeIrradiance(c, n) +
                probeGlossy(c, reflect(-wo, n), roughness, clamp(dot(n, wo), 0.0, 1.0), f0);
   }
-  outColor = vec4(emission + direct + indirect, 1.0);
+  outColor = vec4(emission + (1.0 - tau) * (direct + indirect), 1.0);
 }

@@ -7,10 +7,10 @@
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
-layout(location = 2) in vec2 inTexcoord;
+layout(location = 2) in vec4 inTexcoord;  // TEXCOORD_0, TEXCOORD_1
 layout(location = 0) out vec3 worldPosition;
 layout(location = 1) out vec3 worldNormal;
-layout(location = 2) out vec2 texcoord;
+layout(location = 2) out vec4 texcoord;
 layout(push_constant) uniform Push { RsPushConstants pc; };
 layout(std430, binding = RS_BINDING_VIEWS) readonly buffer Views { RsView views[]; };
 

@@ -18,6 +18,10 @@
 #define RS_BINDING_SHADOW_MAP 10       // sampler2DArrayShadow: depth of every shadow layer
 #define RS_BINDING_COUNT 11
 
+#define RS_PASS_OPAQUE 0u              // opaque and cut-out triangles, depth written
+#define RS_PASS_TRANSMIT 1u            // transmissive triangles: colour × T (blend: dst · src)
+#define RS_PASS_REFLECT 2u             // transmissive triangles: + emission + (1 − τ) · lighting
+
 #define RS_SHADOW_NONE 0u              // unshadowed (no layer left for it)
 #define RS_SHADOW_CUBE 1u              // point light: six 90° faces +x −x +y −y +z −z
 #define RS_SHADOW_PERSPECTIVE 2u       // spot light: one perspective layer
@@ -52,11 +56,25 @@ struct RsPushConstants {
   uint lightCount;
   uint viewBase;       // index of this pass's first view in RsView[] (+ gl_ViewIndex)
   uint shadowMapSize;  // texels per side of each shadow layer
+  uint primitiveBase;  // scene triangle index of the draw's first triangle (+ gl_PrimitiveID)
+  uint pass;           // RS_PASS_*
   uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
+// Shadow-map passes: one layer's view-projection, and the draw's first triangle.
+struct RsShadowPush {
+  mat4 viewProj;
+  uint primitiveBase;
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RsPushConstants) == 96);
+static_assert(sizeof(RsPushConstants) == 112);
+static_assert(sizeof(RsShadowPush) == 80);
 static_assert(sizeof(RsView) == 80);
 static_assert(sizeof(RsShadowLight) == 16);
 }  // namespace probecast::shaders

@@ -1,4 +1,4 @@
-// Scene bindings shared by every ray-tracing raygen (numbers from probe_trace_shared.h).
+// Scene bindings shared by every ray-tracing shader (numbers from probe_trace_shared.h).
 layout(binding = PT_BINDING_TLAS) uniform accelerationStructureEXT tlas;
 layout(std430, binding = PT_BINDING_POSITIONS) readonly buffer Positions { float positions[]; };
 layout(std430, binding = PT_BINDING_INDICES) readonly buffer Indices { uint indices[]; };
@@ -12,6 +12,3 @@ layout(std430, binding = PT_BINDING_TEXELS) readonly buffer Texels { uint texels
 layout(std430, binding = PT_BINDING_TEXTURES) readonly buffer Textures { PtTexture textures[]; };
 layout(std430, binding = PT_BINDING_ENVIRONMENT) readonly buffer EnvironmentHeader { PtEnvironment environment; };
 layout(std430, binding = PT_BINDING_ENV_DATA) readonly buffer EnvironmentData { float envData[]; };
-
-layout(location = 0) rayPayloadEXT HitPayload hit;
-layout(location = 1) rayPayloadEXT uint visible;

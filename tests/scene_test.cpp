@@ -1,8 +1,10 @@
 // Scene loading: the Cornell glTF (tests/data), built-in scenes, and broken files.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
+#include "gltf_test_files.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::scene {
@@ -164,6 +166,102 @@ TEST(Scene, TexturedGltfLoadsTexturesUvsAndNormals) {
     if (glm::dot(fn, s.normals[s.indices[3 * t]]) < 0.99f) ++smooth;
   }
   EXPECT_GT(smooth, 100);
+}
+
+// Three quads: Mask with cutoff 0.3 and a transformed texture read through TEXCOORD_1, Blend with
+// alpha 0.4, and an opaque material with KHR_materials_transmission 0.8 — all extensions required.
+TEST(Scene, AlphaModesTransmissionAndTextureTransformsAreLoaded) {
+  const std::string dir = PROBECAST_TEST_TMP;
+  test::writeFile(dir + "/mat_tex.png", test::pngFile(2, 2, 4, 8, std::vector<uint16_t>(16, 200)));
+  std::vector<test::GltfQuad> quads(3);
+  for (int q = 0; q < 3; ++q) {
+    const float z = -static_cast<float>(q);
+    quads[q].corners[0] = {0, 0, z}, quads[q].corners[1] = {1, 0, z}, quads[q].corners[2] = {1, 1, z};
+    quads[q].corners[3] = {0, 1, z};
+    quads[q].material = q;
+  }
+  const std::string materials =
+      R"({"name":"mask","alphaMode":"MASK","alphaCutoff":0.3,"pbrMetallicRoughness":{"baseColorFactor":[1,1,1,0.9],)"
+      R"("baseColorTexture":{"index":0,"extensions":{"KHR_texture_transform":)"
+      R"({"offset":[0.25,0.5],"rotation":1.5707963,)"
+      R"("scale":[2,3],"texCoord":1}}}}},)"
+      R"({"name":"glass","alphaMode":"BLEND","pbrMetallicRoughness":{"baseColorFactor":[1,0,0,0.4]}},)"
+      R"({"name":"thin","extensions":{"KHR_materials_transmission":{"transmissionFactor":0.8}}})";
+  const std::string top =
+      R"("extensionsUsed":["KHR_texture_transform","KHR_materials_transmission"],)"
+      R"("extensionsRequired":["KHR_texture_transform","KHR_materials_transmission"],)";
+  const std::string path = test::writeQuadGltf(dir, "materials", quads, materials, R"({"source":0})",
+                                               R"({"uri":"mat_tex.png"})", top);
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(loadGltf(path, s, error)) << error;
+  ASSERT_GE(s.materials.size(), 3u);
+  const Material &mask = s.materials[0], &glass = s.materials[1], &thin = s.materials[2];
+  EXPECT_EQ(mask.alphaMode, AlphaMode::Mask);
+  EXPECT_FLOAT_EQ(mask.alphaCutoff, 0.3f);
+  EXPECT_FLOAT_EQ(mask.alpha, 0.9f);
+  EXPECT_GE(mask.baseColorTexture, 0);
+  // translation(0.25, 0.5) × rotation(π/2) × scale(2, 3): rows (cos·2, sin·3, 0.25), (−sin·2, cos·3, 0.5).
+  EXPECT_EQ(mask.baseColorTransform.texCoord, 1u);
+  EXPECT_NEAR(mask.baseColorTransform.row0.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(mask.baseColorTransform.row0.y, 3.0f, 1e-6f);
+  EXPECT_NEAR(mask.baseColorTransform.row0.z, 0.25f, 1e-6f);
+  EXPECT_NEAR(mask.baseColorTransform.row1.x, -2.0f, 1e-6f);
+  EXPECT_NEAR(mask.baseColorTransform.row1.y, 0.0f, 1e-6f);
+  EXPECT_NEAR(mask.baseColorTransform.row1.z, 0.5f, 1e-6f);
+  EXPECT_EQ(glass.alphaMode, AlphaMode::Blend);
+  EXPECT_FLOAT_EQ(glass.alpha, 0.4f);
+  EXPECT_TRUE(glass.transmissive());
+  EXPECT_EQ(thin.alphaMode, AlphaMode::Opaque);
+  EXPECT_FLOAT_EQ(thin.transmission, 0.8f);
+  EXPECT_TRUE(thin.transmissive());
+  ASSERT_EQ(s.texcoords1.size(), s.positions.size());
+  // finalizeScene's order: the cut-out quad before the two transmissive ones, each one run.
+  ASSERT_EQ(s.triangleCount(), 6u);
+  EXPECT_EQ(leadingTrianglesBelowClass(s, 1), 0u);
+  EXPECT_EQ(leadingTrianglesBelowClass(s, 2), 2u);
+  for (uint32_t t = 2; t < 6; ++t) EXPECT_EQ(triangleClass(s, t), 2u);
+}
+
+TEST(Scene, SixteenBitPngIsReadAsItsTopEightBitsRounded) {
+  // RGBA16 texels: 0x8080 → 128, 0xffff → 255, 0x4000 → round(16384 · 255 / 65535) = 64, 0 → 0;
+  // a 16-bit grey + alpha image expands grey to RGB.
+  const std::string dir = PROBECAST_TEST_TMP;
+  test::writeFile(dir + "/rgba16.png", test::pngFile(2, 1, 4, 16, {0x8080, 0xffff, 0x4000, 0xffff,  //
+                                                                  0, 0x4000, 0xffff, 0x8080}));
+  test::writeFile(dir + "/ga16.png", test::pngFile(1, 1, 2, 16, {0x4000, 0xffff}));
+  std::vector<test::GltfQuad> quads(1);
+  quads[0].corners[0] = {0, 0, 0}, quads[0].corners[1] = {1, 0, 0}, quads[0].corners[2] = {1, 1, 0};
+  quads[0].corners[3] = {0, 1, 0};
+  const std::string path = test::writeQuadGltf(
+      dir, "png16", quads,
+      R"({"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},)"
+      R"("emissiveTexture":{"index":1},"emissiveFactor":[1,1,1]})",
+      R"({"source":0},{"source":1})", R"({"uri":"rgba16.png"},{"uri":"ga16.png"})");
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(loadGltf(path, s, error)) << error;
+  ASSERT_GE(s.materials[0].baseColorTexture, 0) << "16-bit PNG not loaded";
+  ASSERT_GE(s.materials[0].emissiveTexture, 0);
+  const Texture& rgba = s.textures[s.materials[0].baseColorTexture];
+  ASSERT_EQ(rgba.width, 2u);
+  const std::vector<uint8_t> expected = {128, 255, 64, 255, 0, 64, 255, 128};
+  EXPECT_EQ(rgba.rgba, expected);
+  const Texture& ga = s.textures[s.materials[0].emissiveTexture];
+  EXPECT_EQ(ga.rgba, (std::vector<uint8_t>{64, 64, 64, 255}));
+}
+
+TEST(Scene, UnknownRequiredExtensionIsStillRefused) {
+  std::vector<test::GltfQuad> quads(1);
+  quads[0].corners[0] = {0, 0, 0}, quads[0].corners[1] = {1, 0, 0}, quads[0].corners[2] = {1, 1, 0};
+  quads[0].corners[3] = {0, 1, 0};
+  const std::string path = test::writeQuadGltf(PROBECAST_TEST_TMP, "required", quads, "{}", "", "",
+                                               R"("extensionsUsed":["KHR_materials_volume"],)"
+                                               R"("extensionsRequired":["KHR_materials_volume"],)");
+  Scene s;
+  std::string error;
+  EXPECT_FALSE(loadGltf(path, s, error));
+  EXPECT_NE(error.find("KHR_materials_volume"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -15,10 +15,24 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   g.triangleMaterial = createBufferWithData(d, s.triangleMaterial.data(), s.triangleMaterial.size() * 4, kStorage);
   std::vector<shaders::PtMaterial> mats;
   const auto textureIndex = [&](int32_t t) { return t >= 0 && t < static_cast<int32_t>(s.textures.size()) ? t : -1; };
-  for (const scene::Material& m : s.materials)
-    mats.push_back({{m.baseColor.r, m.baseColor.g, m.baseColor.b, m.metallic},
-                    {m.emission.r, m.emission.g, m.emission.b, m.roughness},
-                    {textureIndex(m.baseColorTexture), textureIndex(m.emissiveTexture), -1, -1}});
+  const auto rows = [](const scene::TextureTransform& t, shaders::vec4& row0, shaders::vec4& row1) {
+    row0 = {t.row0.x, t.row0.y, t.row0.z, static_cast<float>(t.texCoord)};
+    row1 = {t.row1.x, t.row1.y, t.row1.z, 0.0f};
+  };
+  for (const scene::Material& m : s.materials) {
+    shaders::PtMaterial pm{};
+    pm.baseColorMetallic = {m.baseColor.r, m.baseColor.g, m.baseColor.b, m.metallic};
+    pm.emissionRoughness = {m.emission.r, m.emission.g, m.emission.b, m.roughness};
+    pm.textures = {textureIndex(m.baseColorTexture), textureIndex(m.emissiveTexture),
+                  static_cast<int32_t>(m.alphaMode), 0};
+    pm.alpha = {m.alpha, m.alphaCutoff, m.transmission, 0.0f};
+    rows(m.baseColorTransform, pm.baseTransform0, pm.baseTransform1);
+    rows(m.emissiveTransform, pm.emissiveTransform0, pm.emissiveTransform1);
+    mats.push_back(pm);
+  }
+  static_assert(PT_ALPHA_OPAQUE == static_cast<int>(scene::AlphaMode::Opaque) &&
+                PT_ALPHA_MASK == static_cast<int>(scene::AlphaMode::Mask) &&
+                PT_ALPHA_BLEND == static_cast<int>(scene::AlphaMode::Blend));
   g.materials = createBufferWithData(d, mats.data(), mats.size() * sizeof(shaders::PtMaterial), kStorage);
   std::vector<shaders::PtLight> ls;
   for (const scene::Light& l : s.lights) {
@@ -89,9 +103,12 @@ void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   normals.resize(s.positions.size(), glm::vec3(0.0f));  // 0: the shader uses the geometric normal
   constexpr VkBufferUsageFlags kVertex = kStorage | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
   g.normals = createBufferWithData(d, normals.data(), normals.size() * sizeof(glm::vec3), kVertex);
-  std::vector<glm::vec2> uvs = s.texcoords;
-  uvs.resize(s.positions.size(), glm::vec2(0.0f));
-  g.texcoords = createBufferWithData(d, uvs.data(), uvs.size() * sizeof(glm::vec2), kVertex);
+  std::vector<glm::vec4> uvs(s.positions.size(), glm::vec4(0.0f));  // TEXCOORD_0, TEXCOORD_1
+  for (size_t i = 0; i < uvs.size(); ++i) {
+    if (i < s.texcoords.size()) uvs[i].x = s.texcoords[i].x, uvs[i].y = s.texcoords[i].y;
+    if (i < s.texcoords1.size()) uvs[i].z = s.texcoords1[i].x, uvs[i].w = s.texcoords1[i].y;
+  }
+  g.texcoords = createBufferWithData(d, uvs.data(), uvs.size() * sizeof(glm::vec4), kVertex);
   std::vector<uint32_t> texels;
   std::vector<shaders::PtTexture> infos;
   for (const scene::Texture& t : s.textures) {

@@ -14,7 +14,7 @@ struct GpuScene {
   Buffer lights;            // PtLight[]
   Buffer emitters;          // PtEmitter[]: emissive triangles with a power CDF
   Buffer normals;           // float3 per vertex
-  Buffer texcoords;         // float2 per vertex
+  Buffer texcoords;         // float4 per vertex: TEXCOORD_0, TEXCOORD_1
   Buffer texels;            // packed sRGB RGBA8 of every texture
   Buffer textures;          // PtTexture[]
   Buffer environment;       // PtEnvironment

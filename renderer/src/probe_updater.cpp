@@ -258,7 +258,8 @@ uint64_t ProbeUpdater::deviceBytes() const {
   for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.gpu.triangleMaterial,
                           &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.normals, &s.gpu.texcoords, &s.gpu.texels,
                           &s.gpu.textures, &s.gpu.environment, &s.gpu.environmentData, &s.gpu.accel.positions, &s.gpu.accel.indices,
-                          &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.tlas.storage, &s.pass.sbt})
+                          &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.blasNonOpaque.storage,
+                          &s.gpu.accel.tlas.storage, &s.pass.sbt})
     total += b->size;
   return total;
 }

@@ -126,29 +126,30 @@ struct RasterRenderer::Impl {
   VkDescriptorSet set = VK_NULL_HANDLE;
   shaders::RsPushConstants push{};
   uint32_t indexCount = 0;
+  uint32_t drawnOpaque = 0;  // leading triangles drawn with depth writes (not transmissive)
   glm::vec3 sceneMin{0.0f}, sceneMax{0.0f};
   std::vector<glm::mat4> inverseViewProj;  // of the views being rendered, for the background
 
-  // Pixels the pass left clear (alpha 0: no surface) take the environment's radiance along the
-  // pixel centre's ray, unprojected from the view's near and far planes (off-axis views too).
-  void drawBackground(Image& img, const glm::mat4& inverse) const {
-    if (!options.environment || options.environment->empty()) return;
-    for (uint32_t y = 0; y < img.height; ++y)
-      for (uint32_t x = 0; x < img.width; ++x) {
-        const size_t i = static_cast<size_t>(y) * img.width + x;
-        if (coverage[i] != 0) continue;
-        const float nx = (static_cast<float>(x) + 0.5f) / static_cast<float>(img.width) * 2.0f - 1.0f;
-        const float ny = (static_cast<float>(y) + 0.5f) / static_cast<float>(img.height) * 2.0f - 1.0f;
+  // The environment's radiance along each pixel centre's ray, unprojected from the view's near and
+  // far planes (off-axis views too), written as RGBA float with alpha 0 into `layer`: the colour
+  // target starts from it, so transmissive surfaces in front of the sky tint it.
+  void writeBackground(float* layer, const glm::mat4& inverse) const {
+    for (uint32_t y = 0; y < height; ++y)
+      for (uint32_t x = 0; x < width; ++x) {
+        float* px = layer + (static_cast<size_t>(y) * width + x) * 4;
+        px[0] = px[1] = px[2] = px[3] = 0.0f;
+        const float nx = (static_cast<float>(x) + 0.5f) / static_cast<float>(width) * 2.0f - 1.0f;
+        const float ny = (static_cast<float>(y) + 0.5f) / static_cast<float>(height) * 2.0f - 1.0f;
         const glm::vec4 nearPoint = inverse * glm::vec4(nx, ny, 0.0f, 1.0f);
         const glm::vec4 farPoint = inverse * glm::vec4(nx, ny, 1.0f, 1.0f);
         const glm::vec3 dir = glm::vec3(farPoint) / farPoint.w - glm::vec3(nearPoint) / nearPoint.w;
         const float len = glm::length(dir);
         if (!(len > 0.0f) || !std::isfinite(len)) continue;
         const glm::vec3 L = environmentRadiance(*options.environment, dir / len);
-        for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = L[c];
+        for (int c = 0; c < 3; ++c) px[c] = L[c];
       }
   }
-  std::vector<uint8_t> coverage;  // per pixel of the view being read back: 1 where a surface was drawn
+  bool hasBackground() const { return options.environment && !options.environment->empty(); }
 
   void writeDescriptors() {
     const Buffer* buffers[8] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
@@ -245,16 +246,32 @@ struct RasterRenderer::Impl {
     });
   }
 
-  void drawScene(VkCommandBuffer cmd) {
+  // Opaque and cut-out triangles (the leading run of finalizeScene's order) with depth writes,
+  // then the transmissive ones twice: × T, then + their own light (raster.frag).
+  void drawScene(VkCommandBuffer cmd, uint32_t viewMask) {
     const VkBuffer vbufs[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
     const VkDeviceSize offsets[3] = {0, 0, 0};
     vkCmdBindVertexBuffers(cmd, 0, 3, vbufs, offsets);
     vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
-    vkCmdDrawIndexed(cmd, indexCount, 1, 0, 0, 0);
+    const uint32_t triangles = indexCount / 3, opaque = std::min(drawnOpaque, triangles);
+    const struct {
+      uint32_t pass, first, count;
+    } draws[3] = {{RS_PASS_OPAQUE, 0, opaque},
+                  {RS_PASS_TRANSMIT, opaque, triangles - opaque},
+                  {RS_PASS_REFLECT, opaque, triangles - opaque}};
+    for (const auto& draw : draws) {
+      if (draw.count == 0) continue;
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineFor(viewMask, draw.pass));
+      push.pass = draw.pass;
+      push.primitiveBase = draw.first;
+      vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
+      vkCmdDrawIndexed(cmd, 3 * draw.count, 1, 3 * draw.first, 0, 0);
+    }
   }
 
-  VkPipeline pipelineFor(uint32_t viewMask) {
-    auto it = pipelines.find(viewMask);
+  VkPipeline pipelineFor(uint32_t viewMask, uint32_t pass) {
+    const uint32_t key = viewMask | (pass << 16);
+    auto it = pipelines.find(key);
     if (it == pipelines.end()) {
       GraphicsPipelineDesc desc;
       desc.vertexCode = kRasterVert;
@@ -263,23 +280,40 @@ struct RasterRenderer::Impl {
       desc.fragmentBytes = sizeof kRasterFrag;
       desc.viewMask = viewMask;
       desc.layout = layout;
-      it = pipelines.emplace(viewMask, createGraphicsPipeline(*d, desc)).first;
+      desc.blend = pass == RS_PASS_OPAQUE ? ColorBlend::None
+                                          : (pass == RS_PASS_TRANSMIT ? ColorBlend::Multiply : ColorBlend::Add);
+      it = pipelines.emplace(key, createGraphicsPipeline(*d, desc)).first;
     }
     return it->second;
   }
 
   // Renders views [first, first + count) into layers 0..count-1 and reads them back.
   void renderChunk(uint32_t first, uint32_t count, std::vector<Image>& out) {
+    const size_t pixels = static_cast<size_t>(width) * height;
+    const bool background = hasBackground();
+    if (background)
+      for (uint32_t v = 0; v < count; ++v)
+        writeBackground(static_cast<float*>(readback.mapped) + v * pixels * 4, inverseViewProj[first + v]);
     submitAndWait(*d, [&](VkCommandBuffer cmd) {
-      transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+      if (background) {  // the colour target starts as the environment (alpha 0: no surface)
+        transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, count};
+        region.imageExtent = {width, height, 1};
+        vkCmdCopyBufferToImage(cmd, readback.buffer, color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        transitionImage(cmd, color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+      } else {
+        transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+      }
       transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
       const bool multiview = options.passes == ViewPasses::Multiview && count > 1;
       const uint32_t passes = multiview ? 1 : count;
       for (uint32_t p = 0; p < passes; ++p) {
         const VkImageView colorView = multiview || chunk == 1 ? color.view : color.layerViews[p];
         const VkImageView depthView = multiview || chunk == 1 ? depth.view : depth.layerViews[p];
-        const VkRenderingAttachmentInfo colorInfo =
+        VkRenderingAttachmentInfo colorInfo =
             clearedAttachment(colorView, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
+        if (background) colorInfo.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
         const VkRenderingAttachmentInfo depthInfo =
             clearedAttachment(depthView, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_DONT_CARE);
         VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
@@ -291,11 +325,10 @@ struct RasterRenderer::Impl {
         ri.pDepthAttachment = &depthInfo;
         vkCmdBeginRendering(cmd, &ri);
         setViewportScissor(cmd, width, height);
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineFor(ri.viewMask));
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineFor(ri.viewMask, RS_PASS_OPAQUE));
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &set, 0, nullptr);
         push.viewBase = first + p;
-        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
-        drawScene(cmd);
+        drawScene(cmd, ri.viewMask);
         vkCmdEndRendering(cmd);
       }
       transitionImage(cmd, color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
@@ -309,7 +342,6 @@ struct RasterRenderer::Impl {
       vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr,
                            0, nullptr);
     });
-    const size_t pixels = static_cast<size_t>(width) * height;
     const float* src = static_cast<const float*>(readback.mapped);
     for (uint32_t v = 0; v < count; ++v) {
       Image& img = out[first + v];
@@ -317,12 +349,8 @@ struct RasterRenderer::Impl {
       img.height = height;
       img.rgb.resize(pixels * 3);
       const float* layer = src + v * pixels * 4;
-      coverage.resize(pixels);
-      for (size_t i = 0; i < pixels; ++i) {
+      for (size_t i = 0; i < pixels; ++i)
         for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer[i * 4 + c];
-        coverage[i] = layer[i * 4 + 3] > 0.0f ? 1 : 0;  // the fragment shader writes alpha 1
-      }
-      drawBackground(img, inverseViewProj[first + v]);
     }
   }
 };
@@ -345,12 +373,14 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.sceneMax = scene.boundsMax;
   uploadGpuScene(d, scene, s.gpu);
   s.indexCount = static_cast<uint32_t>(scene.indices.size());
+  s.drawnOpaque = scene::leadingTrianglesBelowClass(scene, 2);
   s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {width, height}, s.chunk,
-                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                 VK_IMAGE_USAGE_TRANSFER_DST_BIT);  // starts as the background
   s.depth = createImageArray(d, VK_FORMAT_D32_SFLOAT, {width, height}, s.chunk,
                              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   s.readback = createBuffer(d, static_cast<VkDeviceSize>(width) * height * 16 * s.chunk,
-                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+                            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   s.views = createBuffer(d, sizeof(shaders::RsView) * Impl::kMaxViews, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
@@ -380,8 +410,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &s.setLayout));
   s.layout = createPipelineLayout(d, s.setLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                                   sizeof(shaders::RsPushConstants));
-  s.pipelineFor(0);
-  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, s.shadows);
+  s.pipelineFor(0, RS_PASS_OPAQUE);
+  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, s.setLayout, s.shadows);
 
   const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 2}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
@@ -463,7 +493,7 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   if (views.size() > Impl::kMaxViews)
     throw std::invalid_argument("at most " + std::to_string(Impl::kMaxViews) + " views per view set");
   std::vector<Image> out(views.size());
-  drawShadowMaps(*s.d, s.gpu, s.indexCount, s.shadows);
+  drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;
   const auto t0 = Clock::now();
   auto* dst = static_cast<shaders::RsView*>(s.views.mapped);

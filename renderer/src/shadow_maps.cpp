@@ -3,26 +3,34 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "probecast/renderer/view_sets.h"
 #include "raster_shared.h"
+#include "shadow.frag.h"
 #include "shadow.vert.h"
 #include "vk_pipeline.h"
 
 namespace probecast::renderer {
 
-void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, ShadowMaps& out) {
+constexpr VkShaderStageFlags kShadowStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+
+void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, VkDescriptorSetLayout materials,
+                      ShadowMaps& out) {
   out.size = size;
   out.maxLayers = maxLayers;
-  out.layout = createPipelineLayout(d, VK_NULL_HANDLE, VK_SHADER_STAGE_VERTEX_BIT, sizeof(glm::mat4));
+  out.layout = createPipelineLayout(d, materials, kShadowStages, sizeof(shaders::RsShadowPush));
   GraphicsPipelineDesc desc;
   desc.vertexCode = kShadowVert;
   desc.vertexBytes = sizeof kShadowVert;
-  desc.vertexStreams = 1;
   desc.depthBias = true;
   desc.layout = out.layout;
   out.pipeline = createGraphicsPipeline(d, desc);
+  desc.fragmentCode = kShadowFrag;
+  desc.fragmentBytes = sizeof kShadowFrag;
+  desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard
+  out.cutoutPipeline = createGraphicsPipeline(d, desc);
 }
 
 void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps) {
@@ -87,14 +95,17 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
   maps.dirty = true;
 }
 
-void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, ShadowMaps& maps) {
+void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, VkDescriptorSet materials,
+                    ShadowMaps& maps) {
   if (!maps.dirty) return;
   const auto t0 = std::chrono::steady_clock::now();
   const uint32_t n = maps.size;
   submitAndWait(d, [&](VkCommandBuffer cmd) {
     transitionImage(cmd, maps.depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-    const VkDeviceSize offset = 0;
+    const VkBuffer streams[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
+    const VkDeviceSize offsets[3] = {0, 0, 0};
+    const uint32_t opaque = std::min(gpu.accel.opaqueTriangles, indexCount / 3);
     for (size_t k = 0; k < maps.matrices.size(); ++k) {
       const VkRenderingAttachmentInfo depthInfo = clearedAttachment(
           maps.depth.layerViews[k], VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
@@ -104,11 +115,20 @@ void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, S
       ri.pDepthAttachment = &depthInfo;
       vkCmdBeginRendering(cmd, &ri);
       setViewportScissor(cmd, n, n);
-      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, maps.pipeline);
-      vkCmdPushConstants(cmd, maps.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(glm::mat4), &maps.matrices[k]);
-      vkCmdBindVertexBuffers(cmd, 0, 1, &gpu.accel.positions.buffer, &offset);
+      vkCmdBindVertexBuffers(cmd, 0, 3, streams, offsets);
       vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, indexCount, 1, 0, 0, 0);
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, maps.layout, 0, 1, &materials, 0, nullptr);
+      shaders::RsShadowPush push{};
+      std::memcpy(&push.viewProj, &maps.matrices[k][0][0], sizeof push.viewProj);
+      // Opaque triangles first (the leading run, finalizeScene's order), then the rest.
+      for (int part = 0; part < 2; ++part) {
+        const uint32_t first = part == 0 ? 0 : opaque, count = part == 0 ? opaque : indexCount / 3 - opaque;
+        if (count == 0) continue;
+        push.primitiveBase = first;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, part == 0 ? maps.pipeline : maps.cutoutPipeline);
+        vkCmdPushConstants(cmd, maps.layout, kShadowStages, 0, sizeof push, &push);
+        vkCmdDrawIndexed(cmd, 3 * count, 1, 3 * first, 0, 0);
+      }
       vkCmdEndRendering(cmd);
     }
     transitionImage(cmd, maps.depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -122,7 +142,8 @@ void destroyShadowMaps(VulkanDevice& d, ShadowMaps& maps) {
   destroyImage(d, maps.depth);
   destroyBuffer(d, maps.lights);
   destroyBuffer(d, maps.layers);
-  if (maps.pipeline) vkDestroyPipeline(d.device, maps.pipeline, nullptr);
+  for (VkPipeline p : {maps.pipeline, maps.cutoutPipeline})
+    if (p) vkDestroyPipeline(d.device, p, nullptr);
   if (maps.layout) vkDestroyPipelineLayout(d.device, maps.layout, nullptr);
   maps = ShadowMaps{};
 }

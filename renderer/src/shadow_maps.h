@@ -1,7 +1,8 @@
 // Shadow maps of a scene's punctual lights, for the raster client: one layer of a D32 2D array
 // per face — six 90° faces for a point light (+x −x +y −y +z −z; spot lights wider than 150° are
 // treated the same), one perspective layer for a spot light, one orthographic layer over the
-// scene for a directional light — drawn depth-only with a slope-scaled bias. The fragment shader
+// scene for a directional light — drawn depth-only with a slope-scaled bias; non-opaque triangles
+// with shadow.frag (cut-outs pass light, transmissive surfaces dithered). The fragment shader
 // reads them through RsShadowLight / RsShadowLayer (raster_shared.h). Lights past the layer budget
 // (in scene order) stay unshadowed.
 #pragma once
@@ -24,16 +25,21 @@ struct ShadowMaps {
   Buffer layers;             // RsShadowLayer per layer in use
   std::vector<glm::mat4> matrices;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;         // opaque triangles, depth only
+  VkPipeline cutoutPipeline = VK_NULL_HANDLE;   // the rest, through shadow.frag
   bool dirty = true;         // planned but not drawn yet
   double lastDrawMs = 0.0;
 };
 
-void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, ShadowMaps& out);
+// `materials`: a set layout with the raster client's material bindings (RS_BINDING_*).
+void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, VkDescriptorSetLayout materials,
+                      ShadowMaps& out);
 // Plans the layers for the scene's lights (bounds from the scene); drawn at the next draw call.
 void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps);
-// Draws every planned layer of `gpu`'s triangles if the plan changed since the last draw.
-void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, ShadowMaps& maps);
+// Draws every planned layer of `gpu`'s triangles if the plan changed since the last draw;
+// `materials` is a set of the layout given at creation.
+void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, VkDescriptorSet materials,
+                    ShadowMaps& maps);
 void destroyShadowMaps(VulkanDevice& d, ShadowMaps& maps);
 
 }  // namespace probecast::renderer

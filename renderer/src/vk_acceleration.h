@@ -1,4 +1,6 @@
-// Acceleration structures: one BLAS of a scene's (spatially sorted) triangles, one TLAS instance.
+// Acceleration structures: a scene's (spatially sorted) triangles in two BLASes — the leading run
+// that is opaque to rays (opaque geometry: no any-hit) and the rest (cut-outs and transmissive
+// surfaces: any-hit decides) — one TLAS instance each, its custom index the BLAS's first triangle.
 #pragma once
 
 #include "probecast/scene/scene.h"
@@ -15,8 +17,10 @@ struct AccelerationStructure {
 struct SceneAccel {
   Buffer positions;  // float3 per vertex, also read by shaders
   Buffer indices;    // uint3 per triangle, also read by shaders
-  AccelerationStructure blas;
+  AccelerationStructure blas;          // triangles [0, opaqueTriangles)
+  AccelerationStructure blasNonOpaque;  // triangles [opaqueTriangles, count)
   AccelerationStructure tlas;
+  uint32_t opaqueTriangles = 0;
   Buffer instances;
 };
 

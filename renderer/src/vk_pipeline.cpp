@@ -6,6 +6,7 @@ namespace probecast::renderer {
 
 VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& desc) {
   const bool depthOnly = desc.fragmentCode == nullptr;
+  const bool colorless = depthOnly || desc.colorFormat == VK_FORMAT_UNDEFINED;
   const VkShaderModule vs = createShaderModule(d, desc.vertexCode, desc.vertexBytes);
   const VkShaderModule fs = depthOnly ? VK_NULL_HANDLE : createShaderModule(d, desc.fragmentCode, desc.fragmentBytes);
   VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
@@ -17,9 +18,9 @@ VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& d
   stages[1].module = fs;
   stages[1].pName = "main";
   const VkVertexInputBindingDescription vb[3] = {
-      {0, 12, VK_VERTEX_INPUT_RATE_VERTEX}, {1, 12, VK_VERTEX_INPUT_RATE_VERTEX}, {2, 8, VK_VERTEX_INPUT_RATE_VERTEX}};
+      {0, 12, VK_VERTEX_INPUT_RATE_VERTEX}, {1, 12, VK_VERTEX_INPUT_RATE_VERTEX}, {2, 16, VK_VERTEX_INPUT_RATE_VERTEX}};
   const VkVertexInputAttributeDescription va[3] = {
-      {0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0}, {2, 2, VK_FORMAT_R32G32_SFLOAT, 0}};
+      {0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0}, {2, 2, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
   VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   vi.vertexBindingDescriptionCount = desc.vertexStreams;
   vi.pVertexBindingDescriptions = vb;
@@ -41,12 +42,22 @@ VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& d
   ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
   VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
   ds.depthTestEnable = VK_TRUE;
-  ds.depthWriteEnable = VK_TRUE;
+  ds.depthWriteEnable = desc.blend == ColorBlend::None ? VK_TRUE : VK_FALSE;
   ds.depthCompareOp = VK_COMPARE_OP_LESS;
   VkPipelineColorBlendAttachmentState cba{};
   cba.colorWriteMask = 0xF;
+  if (desc.blend != ColorBlend::None) {
+    cba.blendEnable = VK_TRUE;
+    const bool multiply = desc.blend == ColorBlend::Multiply;
+    cba.srcColorBlendFactor = multiply ? VK_BLEND_FACTOR_ZERO : VK_BLEND_FACTOR_ONE;
+    cba.dstColorBlendFactor = multiply ? VK_BLEND_FACTOR_SRC_COLOR : VK_BLEND_FACTOR_ONE;
+    cba.colorBlendOp = VK_BLEND_OP_ADD;
+    cba.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+    cba.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    cba.alphaBlendOp = VK_BLEND_OP_ADD;
+  }
   VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-  cb.attachmentCount = depthOnly ? 0 : 1;
+  cb.attachmentCount = colorless ? 0 : 1;
   cb.pAttachments = &cba;
   const VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
   VkPipelineDynamicStateCreateInfo dys{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
@@ -54,7 +65,7 @@ VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& d
   dys.pDynamicStates = dyn;
   VkPipelineRenderingCreateInfo rci{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
   rci.viewMask = desc.viewMask;
-  rci.colorAttachmentCount = depthOnly ? 0 : 1;
+  rci.colorAttachmentCount = colorless ? 0 : 1;
   rci.pColorAttachmentFormats = &desc.colorFormat;
   rci.depthAttachmentFormat = desc.depthFormat;
   VkGraphicsPipelineCreateInfo gci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};

@@ -3,7 +3,9 @@
 #include <cstring>
 #include <vector>
 
+#include "probe_shadow.rahit.h"
 #include "probe_shadow.rmiss.h"
+#include "probe_trace.rahit.h"
 #include "probe_trace.rchit.h"
 #include "probe_trace.rmiss.h"
 
@@ -24,7 +26,8 @@ void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygen
     binding.descriptorType = b == PT_BINDING_TLAS ? VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR
                                                   : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     binding.descriptorCount = 1;
-    binding.stageFlags = VK_SHADER_STAGE_RAYGEN_BIT_KHR;  // only raygen reads the scene
+    // Raygen shades; any-hit reads materials and texture coordinates for cut-outs and transmission.
+    binding.stageFlags = VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_ANY_HIT_BIT_KHR;
     bindings.push_back(binding);
   }
   VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
@@ -34,48 +37,63 @@ void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygen
 
   pass.layout = createPipelineLayout(d, pass.setLayout, VK_SHADER_STAGE_RAYGEN_BIT_KHR, pushBytes);
 
-  const VkShaderModule modules[4] = {
+  // Stages: raygen, miss, shadow miss, closest hit, path any-hit, shadow any-hit. Groups: raygen |
+  // miss, shadow miss | hit group PT_HIT_GROUP_CLOSEST (closest hit + path any-hit),
+  // PT_HIT_GROUP_SHADOW (shadow any-hit). Any-hit runs only on non-opaque geometry.
+  constexpr uint32_t kStages = 6, kGroups = 5;
+  const VkShaderModule modules[kStages] = {
       createShaderModule(d, raygen, raygenBytes),
       createShaderModule(d, kProbeTraceRmiss, sizeof kProbeTraceRmiss),
       createShaderModule(d, kProbeShadowRmiss, sizeof kProbeShadowRmiss),
       createShaderModule(d, kProbeTraceRchit, sizeof kProbeTraceRchit),
+      createShaderModule(d, kProbeTraceRahit, sizeof kProbeTraceRahit),
+      createShaderModule(d, kProbeShadowRahit, sizeof kProbeShadowRahit),
   };
-  const VkShaderStageFlagBits stageBits[4] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
-                                              VK_SHADER_STAGE_MISS_BIT_KHR, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR};
-  VkPipelineShaderStageCreateInfo stages[4];
-  VkRayTracingShaderGroupCreateInfoKHR groups[4];
-  for (uint32_t i = 0; i < 4; ++i) {
+  const VkShaderStageFlagBits stageBits[kStages] = {
+      VK_SHADER_STAGE_RAYGEN_BIT_KHR,      VK_SHADER_STAGE_MISS_BIT_KHR,    VK_SHADER_STAGE_MISS_BIT_KHR,
+      VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR, VK_SHADER_STAGE_ANY_HIT_BIT_KHR, VK_SHADER_STAGE_ANY_HIT_BIT_KHR};
+  VkPipelineShaderStageCreateInfo stages[kStages];
+  for (uint32_t i = 0; i < kStages; ++i) {
     stages[i] = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     stages[i].stage = stageBits[i];
     stages[i].module = modules[i];
     stages[i].pName = "main";
-    groups[i] = VkRayTracingShaderGroupCreateInfoKHR{VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
-    groups[i].type = i == 3 ? VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR
-                            : VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
-    groups[i].generalShader = i == 3 ? VK_SHADER_UNUSED_KHR : i;
-    groups[i].closestHitShader = i == 3 ? 3 : VK_SHADER_UNUSED_KHR;
-    groups[i].anyHitShader = VK_SHADER_UNUSED_KHR;
-    groups[i].intersectionShader = VK_SHADER_UNUSED_KHR;
   }
+  const auto group = [](VkRayTracingShaderGroupTypeKHR type, uint32_t general, uint32_t closest, uint32_t any) {
+    VkRayTracingShaderGroupCreateInfoKHR g{VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
+    g.type = type;
+    g.generalShader = general;
+    g.closestHitShader = closest;
+    g.anyHitShader = any;
+    g.intersectionShader = VK_SHADER_UNUSED_KHR;
+    return g;
+  };
+  constexpr uint32_t kNone = VK_SHADER_UNUSED_KHR;
+  constexpr auto kGeneral = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
+  constexpr auto kTriangles = VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR;
+  const VkRayTracingShaderGroupCreateInfoKHR groups[kGroups] = {
+      group(kGeneral, 0, kNone, kNone), group(kGeneral, 1, kNone, kNone), group(kGeneral, 2, kNone, kNone),
+      group(kTriangles, kNone, 3, 4), group(kTriangles, kNone, kNone, 5)};
+  static_assert(PT_HIT_GROUP_CLOSEST == 0 && PT_HIT_GROUP_SHADOW == 1 && PT_MISS_CLOSEST == 0 && PT_MISS_SHADOW == 1);
   VkRayTracingPipelineCreateInfoKHR pci{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
-  pci.stageCount = 4;
+  pci.stageCount = kStages;
   pci.pStages = stages;
-  pci.groupCount = 4;
+  pci.groupCount = kGroups;
   pci.pGroups = groups;
   pci.maxPipelineRayRecursionDepth = 1;  // only raygen traces
   pci.layout = pass.layout;
   VK_CHECK(d.vkCreateRayTracingPipelinesKHR(d.device, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &pci, nullptr, &pass.pipeline));
   for (VkShaderModule m : modules) vkDestroyShaderModule(d.device, m, nullptr);
 
-  // Shader binding table: raygen | miss, shadow miss | hit, each region base-aligned.
+  // Shader binding table: raygen | miss, shadow miss | hit, shadow hit, each region base-aligned.
   const auto& rt = d.rtProperties;
   const VkDeviceSize handle = rt.shaderGroupHandleSize;
   const VkDeviceSize stride = alignUp(handle, rt.shaderGroupHandleAlignment);
   const VkDeviceSize base = rt.shaderGroupBaseAlignment;
-  std::vector<uint8_t> handles(handle * 4);
-  VK_CHECK(d.vkGetRayTracingShaderGroupHandlesKHR(d.device, pass.pipeline, 0, 4, handles.size(), handles.data()));
+  std::vector<uint8_t> handles(handle * kGroups);
+  VK_CHECK(d.vkGetRayTracingShaderGroupHandlesKHR(d.device, pass.pipeline, 0, kGroups, handles.size(), handles.data()));
   const VkDeviceSize raygenAt = 0, missAt = alignUp(stride, base), hitAt = alignUp(missAt + 2 * stride, base);
-  pass.sbt = createBuffer(d, hitAt + stride + base,
+  pass.sbt = createBuffer(d, hitAt + 2 * stride + base,
                           VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
   const VkDeviceAddress start = alignUp(pass.sbt.address, base);
   uint8_t* mapped = static_cast<uint8_t*>(pass.sbt.mapped) + (start - pass.sbt.address);
@@ -83,9 +101,10 @@ void createRayTracingPass(VulkanDevice& d, const uint32_t* raygen, size_t raygen
   std::memcpy(mapped + missAt, handles.data() + handle, handle);
   std::memcpy(mapped + missAt + stride, handles.data() + 2 * handle, handle);
   std::memcpy(mapped + hitAt, handles.data() + 3 * handle, handle);
+  std::memcpy(mapped + hitAt + stride, handles.data() + 4 * handle, handle);
   pass.raygen = {start + raygenAt, stride, stride};
   pass.miss = {start + missAt, stride, 2 * stride};
-  pass.hit = {start + hitAt, stride, stride};
+  pass.hit = {start + hitAt, stride, 2 * stride};
 
   VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1},
                                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, PT_BINDING_COUNT - 1}};

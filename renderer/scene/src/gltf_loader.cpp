@@ -1,5 +1,7 @@
 // glTF 2.0 → Scene. The only file that sees tinygltf.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <set>
@@ -15,7 +17,8 @@ namespace probecast::scene {
 namespace {
 
 // Extensions a file may require: ones we implement, or that cannot change what we render.
-const std::set<std::string> kSupportedRequired = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+const std::set<std::string> kSupportedRequired = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                                  "KHR_texture_transform", "KHR_materials_transmission"};
 
 glm::mat4 nodeMatrix(const tinygltf::Node& node) {
   if (node.matrix.size() == 16) {
@@ -128,7 +131,8 @@ glm::vec3 vec3Of(const std::vector<double>& v, glm::vec3 fallback) {
   return v.size() >= 3 ? glm::vec3(v[0], v[1], v[2]) : fallback;
 }
 
-// glTF texture index → Scene::textures index (images converted to RGBA8 once each).
+// glTF texture index → Scene::textures index (images converted to RGBA8 once each). 16-bit
+// images keep their top 8 bits, rounded: the encoded value, so sRGB colour stays sRGB.
 int32_t convertTexture(const tinygltf::Model& model, int textureIndex, std::vector<int32_t>& imageToTexture,
                        Scene& scene) {
   if (textureIndex < 0 || textureIndex >= static_cast<int>(model.textures.size())) return -1;
@@ -137,23 +141,58 @@ int32_t convertTexture(const tinygltf::Model& model, int textureIndex, std::vect
   if (imageToTexture[source] >= 0) return imageToTexture[source];
   const tinygltf::Image& img = model.images[source];
   const int comps = img.component;
-  if (img.width <= 0 || img.height <= 0 || img.bits != 8 || comps < 1 || comps > 4 ||
-      img.image.size() < static_cast<size_t>(img.width) * img.height * comps)
-    return -1;  // undecodable or 16-bit images: the factor alone is used
+  const int bytes = img.bits == 16 ? 2 : 1;
+  if (img.width <= 0 || img.height <= 0 || (img.bits != 8 && img.bits != 16) || comps < 1 || comps > 4 ||
+      img.image.size() < static_cast<size_t>(img.width) * img.height * comps * bytes)
+    return -1;  // undecodable images: the factor alone is used
+  const auto channel = [&](size_t i, int c) -> uint8_t {
+    if (bytes == 1) return img.image[i * comps + c];
+    uint16_t v;  // tinygltf hands 16-bit samples over in host order
+    std::memcpy(&v, &img.image[(i * comps + c) * 2], 2);
+    return static_cast<uint8_t>((v * 255u + 32767u) / 65535u);
+  };
   Texture t;
   t.width = static_cast<uint32_t>(img.width);
   t.height = static_cast<uint32_t>(img.height);
   t.rgba.resize(static_cast<size_t>(t.width) * t.height * 4);
   for (size_t i = 0; i < static_cast<size_t>(t.width) * t.height; ++i) {
-    const unsigned char* src = &img.image[i * comps];
-    t.rgba[i * 4 + 0] = src[0];
-    t.rgba[i * 4 + 1] = comps >= 3 ? src[1] : src[0];
-    t.rgba[i * 4 + 2] = comps >= 3 ? src[2] : src[0];
-    t.rgba[i * 4 + 3] = comps == 4 ? src[3] : (comps == 2 ? src[1] : 255);
+    t.rgba[i * 4 + 0] = channel(i, 0);
+    t.rgba[i * 4 + 1] = comps >= 3 ? channel(i, 1) : channel(i, 0);
+    t.rgba[i * 4 + 2] = comps >= 3 ? channel(i, 2) : channel(i, 0);
+    t.rgba[i * 4 + 3] = comps == 4 ? channel(i, 3) : (comps == 2 ? channel(i, 1) : 255);
   }
   scene.textures.push_back(std::move(t));
   imageToTexture[source] = static_cast<int32_t>(scene.textures.size() - 1);
   return imageToTexture[source];
+}
+
+double numberOr(const tinygltf::Value& object, const char* key, double fallback) {
+  if (!object.Has(key)) return fallback;
+  const tinygltf::Value& v = object.Get(key);
+  return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+// KHR_texture_transform of a texture reference (identity and `texCoord` without it): the matrix
+// translation(offset) × rotation(r) × scale, rotation as the extension defines it (counter-clockwise
+// in uv with v down: [cos r, sin r; −sin r, cos r]).
+TextureTransform textureTransform(const tinygltf::ExtensionMap& extensions, int texCoord) {
+  TextureTransform t;
+  t.texCoord = texCoord == 1 ? 1u : 0u;
+  auto it = extensions.find("KHR_texture_transform");
+  if (it == extensions.end() || !it->second.IsObject()) return t;
+  const tinygltf::Value& x = it->second;
+  glm::vec2 offset(0.0f), scale(1.0f);
+  if (x.Has("offset") && x.Get("offset").IsArray() && x.Get("offset").ArrayLen() == 2)
+    offset = {x.Get("offset").Get(0).GetNumberAsDouble(), x.Get("offset").Get(1).GetNumberAsDouble()};
+  if (x.Has("scale") && x.Get("scale").IsArray() && x.Get("scale").ArrayLen() == 2)
+    scale = {x.Get("scale").Get(0).GetNumberAsDouble(), x.Get("scale").Get(1).GetNumberAsDouble()};
+  const float r = static_cast<float>(numberOr(x, "rotation", 0.0));
+  const float c = std::cos(r), s = std::sin(r);
+  t.row0 = {c * scale.x, s * scale.y, offset.x};
+  t.row1 = {-s * scale.x, c * scale.y, offset.y};
+  if (x.Has("texCoord") && x.Get("texCoord").IsInt()) t.texCoord = x.Get("texCoord").GetNumberAsInt() == 1 ? 1u : 0u;
+  const bool finite = std::isfinite(t.row0.x + t.row0.y + t.row0.z + t.row1.x + t.row1.y + t.row1.z);
+  return finite ? t : TextureTransform{};
 }
 
 void convertMaterials(const tinygltf::Model& model, Scene& scene) {
@@ -172,6 +211,18 @@ void convertMaterials(const tinygltf::Model& model, Scene& scene) {
     out.emission = vec3Of(m.emissiveFactor, glm::vec3(0.0f)) * strength;
     out.baseColorTexture = convertTexture(model, pbr.baseColorTexture.index, imageToTexture, scene);
     out.emissiveTexture = convertTexture(model, m.emissiveTexture.index, imageToTexture, scene);
+    out.baseColorTransform = textureTransform(pbr.baseColorTexture.extensions, pbr.baseColorTexture.texCoord);
+    out.emissiveTransform = textureTransform(m.emissiveTexture.extensions, m.emissiveTexture.texCoord);
+    out.alpha = pbr.baseColorFactor.size() == 4 ? std::clamp(static_cast<float>(pbr.baseColorFactor[3]), 0.0f, 1.0f)
+                                                : 1.0f;
+    out.alphaMode = m.alphaMode == "MASK"    ? AlphaMode::Mask
+                    : m.alphaMode == "BLEND" ? AlphaMode::Blend
+                                             : AlphaMode::Opaque;
+    out.alphaCutoff = std::isfinite(m.alphaCutoff) ? static_cast<float>(m.alphaCutoff) : 0.5f;
+    it = m.extensions.find("KHR_materials_transmission");
+    if (it != m.extensions.end() && it->second.IsObject())
+      out.transmission = std::clamp(static_cast<float>(numberOr(it->second, "transmissionFactor", 0.0)), 0.0f, 1.0f);
+    if (!std::isfinite(out.transmission)) out.transmission = 0.0f;
     scene.materials.push_back(out);
   }
   // Primitives without a material use glTF's default (white, metallic 1 roughness 1 per spec;
@@ -251,18 +302,21 @@ bool addPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim,
     }
   }
   scene.normals.insert(scene.normals.end(), normals.begin(), normals.end());
-  std::vector<glm::vec2> uvs(positions.count(), glm::vec2(0.0f));
-  auto uv = prim.attributes.find("TEXCOORD_0");
-  if (uv != prim.attributes.end()) {
-    AccessorReader t(model, uv->second, error);
-    if (!t.ok()) return false;
-    if (t.count() == positions.count() && t.components() == 2)
-      for (size_t i = 0; i < t.count(); ++i) {
-        const glm::vec2 v(t.component(i, 0), t.component(i, 1));
-        uvs[i] = std::isfinite(v.x) && std::isfinite(v.y) ? v : glm::vec2(0.0f);
-      }
+  for (int set = 0; set < 2; ++set) {
+    std::vector<glm::vec2> uvs(positions.count(), glm::vec2(0.0f));
+    auto uv = prim.attributes.find(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1");
+    if (uv != prim.attributes.end()) {
+      AccessorReader t(model, uv->second, error);
+      if (!t.ok()) return false;
+      if (t.count() == positions.count() && t.components() == 2)
+        for (size_t i = 0; i < t.count(); ++i) {
+          const glm::vec2 v(t.component(i, 0), t.component(i, 1));
+          uvs[i] = std::isfinite(v.x) && std::isfinite(v.y) ? v : glm::vec2(0.0f);
+        }
+    }
+    std::vector<glm::vec2>& out = set == 0 ? scene.texcoords : scene.texcoords1;
+    out.insert(out.end(), uvs.begin(), uvs.end());
   }
-  scene.texcoords.insert(scene.texcoords.end(), uvs.begin(), uvs.end());
   const uint32_t material =
       prim.material >= 0 && prim.material < static_cast<int>(model.materials.size())
           ? static_cast<uint32_t>(prim.material)

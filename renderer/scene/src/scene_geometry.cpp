@@ -22,6 +22,19 @@ uint32_t spreadBits(uint32_t v) {
 
 }  // namespace
 
+uint32_t triangleClass(const Scene& s, uint32_t t) {
+  const uint32_t m = s.triangleMaterial[t];
+  if (m >= s.materials.size()) return 0;
+  const Material& mat = s.materials[m];
+  return mat.transmissive() ? 2u : (mat.opaqueToRays() ? 0u : 1u);
+}
+
+uint32_t leadingTrianglesBelowClass(const Scene& s, uint32_t cls) {
+  uint32_t n = 0;
+  while (n < s.triangleCount() && triangleClass(s, n) < cls) ++n;
+  return n;
+}
+
 void addQuad(Scene& s, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
              uint32_t material) {
   const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
@@ -64,7 +77,9 @@ void finalizeScene(Scene& s) {
     const glm::vec3 c =
         (s.positions[s.indices[3 * t]] + s.positions[s.indices[3 * t + 1]] + s.positions[s.indices[3 * t + 2]]) / 3.0f;
     const glm::vec3 u = glm::clamp((c - s.boundsMin) / extent, 0.0f, 1.0f) * 1023.0f;
-    code[t] = spreadBits(static_cast<uint32_t>(u.x)) | (spreadBits(static_cast<uint32_t>(u.y)) << 1) |
+    // The class in bits 30-31 keeps each class one run; Morton order within it.
+    code[t] = (triangleClass(s, t) << 30) | spreadBits(static_cast<uint32_t>(u.x)) |
+              (spreadBits(static_cast<uint32_t>(u.y)) << 1) |
               (spreadBits(static_cast<uint32_t>(u.z)) << 2);
   }
   std::vector<uint32_t> order(count);

@@ -14,18 +14,47 @@
 
 namespace probecast::scene {
 
+// glTF alphaMode. Opaque ignores alpha; Mask keeps a surface point where alpha >= alphaCutoff and
+// removes it elsewhere; Blend makes the surface a thin partial cover (see Material::transmittance).
+enum class AlphaMode : uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
+
+// Where a texture is read: uv' = (row0 · (u, v, 1), row1 · (u, v, 1)) of TEXCOORD_<texCoord>, the
+// 2×3 matrix of KHR_texture_transform (translation × rotation × scale); identity without it.
+struct TextureTransform {
+  glm::vec3 row0{1.0f, 0.0f, 0.0f};
+  glm::vec3 row1{0.0f, 1.0f, 0.0f};
+  uint32_t texCoord = 0;  // 0 or 1
+};
+
 struct Material {
   std::string name;
   glm::vec3 baseColor{0.8f};
   float metallic = 0.0f;
   float roughness = 1.0f;
   glm::vec3 emission{0.0f};
-  int32_t baseColorTexture = -1;  // index into Scene::textures, multiplies baseColor
+  int32_t baseColorTexture = -1;  // index into Scene::textures, multiplies baseColor (and alpha)
   int32_t emissiveTexture = -1;   // index into Scene::textures, multiplies emission
+  TextureTransform baseColorTransform;
+  TextureTransform emissiveTransform;
+  // Coverage: a = alpha (baseColorFactor.a) × the base colour texture's alpha.
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alpha = 1.0f;
+  float alphaCutoff = 0.5f;  // Mask only
+  // KHR_materials_transmission's transmissionFactor t, as a thin surface (no refraction).
+  float transmission = 0.0f;
+
+  // The transmission rule, one for every renderer: a surface point lets a fraction
+  //   τ = 1 − (1 − b)(1 − t),  b = 1 − a for Blend (else 0),
+  // of the light that reaches it pass straight through, tinted by the base colour (T = τ · base,
+  // coloured glass), and reflects with its BSDF scaled by 1 − τ; emission is added in full.
+  bool transmissive() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }
+  // Rays must look at the material per hit (cut-outs or transmission).
+  bool opaqueToRays() const { return alphaMode == AlphaMode::Opaque && !(transmission > 0.0f); }
 };
 
-// An sRGB-encoded RGBA8 image (glTF base colour and emissive textures are sRGB), sampled with
-// repeat wrapping and bilinear filtering.
+// An sRGB-encoded RGBA8 image (glTF base colour and emissive textures are sRGB; alpha is linear),
+// sampled with repeat wrapping and bilinear filtering. 16-bit PNGs are rounded to 8 bits of their
+// encoded (sRGB) values at load.
 struct Texture {
   uint32_t width = 0;
   uint32_t height = 0;
@@ -61,6 +90,7 @@ struct Scene {
   std::vector<glm::vec3> positions;  // world space
   std::vector<glm::vec3> normals;    // per vertex, unit length (shading normals)
   std::vector<glm::vec2> texcoords;  // per vertex, TEXCOORD_0 (0 when absent)
+  std::vector<glm::vec2> texcoords1; // per vertex, TEXCOORD_1 (empty or 0 when absent)
   std::vector<uint32_t> indices;     // 3 per triangle
   std::vector<uint32_t> triangleMaterial;
   std::vector<Material> materials;
@@ -72,6 +102,11 @@ struct Scene {
 
   uint32_t triangleCount() const { return static_cast<uint32_t>(indices.size() / 3); }
 };
+
+// Material class of a triangle in finalizeScene's order: 0 opaque to rays, 1 cut-out, 2 transmissive.
+uint32_t triangleClass(const Scene& scene, uint32_t triangle);
+// Length of the leading run of triangles of class < `cls` (the whole scene when not finalized).
+uint32_t leadingTrianglesBelowClass(const Scene& scene, uint32_t cls);
 
 // Loads a .gltf or .glb file. On failure returns false and `error` names the file and the problem.
 bool loadGltf(const std::string& path, Scene& scene, std::string& error);
@@ -87,7 +122,9 @@ bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::strin
 bool loadScene(const std::string& spec, float t, Scene& scene, std::string& error);
 
 // Recomputes the bounds and reorders triangles by the Morton code of their centroids, so BVH
-// builders that split at the index midpoint get spatially coherent halves.
+// builders that split at the index midpoint get spatially coherent halves. Triangles come in three
+// runs, each in Morton order: opaque to rays, then cut-out (Mask without transmission), then
+// transmissive (trianglesOpaqueToRays, trianglesDrawnOpaque give the run ends).
 void finalizeScene(Scene& scene);
 
 // Appends a quad (two triangles, counter-clockwise seen from the side `normal` points to).
