@@ -27,8 +27,8 @@ struct EdgeServer::Impl {
 
   explicit Impl(const EdgeConfig& c) : config(c), hub(c.hub, FromBus{}) {}
 
-  static void onMessage(natsConnection*, natsSubscription* sub, natsMsg* msg, void* self) {
-    static_cast<Impl*>(self)->take(sub, msg);
+  static void onMessage(natsConnection*, natsSubscription*, natsMsg* msg, void* self) {
+    static_cast<Impl*>(self)->take(msg);
     natsMsg_Destroy(msg);
   }
 
@@ -39,7 +39,7 @@ struct EdgeServer::Impl {
     s->wake.notify_all();
   }
 
-  void take(natsSubscription* sub, natsMsg* msg) {
+  void take(natsMsg* msg) {
     const auto* data = reinterpret_cast<const uint8_t*>(natsMsg_GetData(msg));
     const size_t size = static_cast<size_t>(std::max(0, natsMsg_GetDataLength(msg)));
     bus::Message m;
@@ -51,10 +51,11 @@ struct EdgeServer::Impl {
       stats.lastError = std::string("refused a message on ") + natsMsg_GetSubject(msg) + ": " + why;
       return;
     }
-    // Subscribers are woken at the end of a producer's batch, or when nothing else is queued.
-    int queued = 0, bytes = 0;
-    natsSubscription_GetPending(sub, &queued, &bytes);
-    const bool wakeNow = (m.flags & bus::kEndOfBatch) != 0 || queued == 0;
+    // Subscribers are woken at the end of a producer's batch, so a lighting update reaches them as
+    // one frame rather than one per brick message. A batch whose end never comes (the producer
+    // died within it) is still served: the server's tick wakes waiting subscribers every
+    // ServerConfig::kTickMs.
+    const bool wakeNow = (m.flags & bus::kEndOfBatch) != 0;
     const ProbeHub::Received r = hub.receive(m, wakeNow, why);
     std::lock_guard<std::mutex> lock(mutex);
     stats.received += 1;
