@@ -1,4 +1,5 @@
 // The stream encoder: quantises frames, versions bricks, encodes each version once.
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -57,7 +58,23 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
 
 StreamEncoder::~StreamEncoder() = default;
 
-uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
+namespace {
+
+// The noise rule of EncoderOptions::noiseScale: true when `candidate` (what a new version would
+// decode to) is within `threshold` of `held` (what the decoder has) in every coefficient.
+bool withinNoise(const float candidate[kProbeFloats], const float held[kProbeFloats], float threshold) {
+  const float luminance = 0.2126f * held[0] + 0.7152f * held[1] + 0.0722f * held[2];
+  float perChannel[3];
+  for (int c = 0; c < 3; ++c)  // the noise of each channel scales with its share of the light
+    perChannel[c] = luminance > 0.0f ? threshold * std::max(held[c], 0.0f) / luminance : threshold;
+  for (int i = 0; i < kProbeFloats; ++i)
+    if (!(std::fabs(candidate[i] - held[i]) <= perChannel[i % 3])) return false;
+  return true;
+}
+
+}  // namespace
+
+uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, const float* noise) {
   Impl& s = *impl_;
   const Representation repr = s.layout.repr;
   const uint32_t bricks = brickCount(s.layout);
@@ -78,6 +95,17 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
       if (isActive) {
         const ProbeSymbols* previous = s.active[p] ? &s.symbols[p] : nullptr;
         quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
+        const float sigma = noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f;
+        if (previous && sigma > 0.0f && s.options.noiseScale > 0.0f &&
+            std::memcmp(&s.next[k], previous, sizeof(ProbeSymbols)) != 0) {
+          float candidate[kProbeFloats];
+          const bool ok = dequantizeProbe(repr, s.next[k], candidate, /*zh3PerPixel=*/false);
+          assert(ok && "the encoder only makes valid symbols");
+          (void)ok;
+          if (withinNoise(candidate, s.reconstruction.data() + static_cast<size_t>(p) * kProbeFloats,
+                          s.options.noiseScale * sigma))
+            s.next[k] = *previous;
+        }
       } else {
         s.next[k] = ProbeSymbols{};
       }

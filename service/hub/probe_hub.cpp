@@ -36,14 +36,14 @@ void ProbeHub::publish(const ProbeVolume& volume) {
   for (int a = 0; a < 3; ++a)
     if (volume.grid.dims[a] != config_.layout.grid[a])
       throw std::invalid_argument("published volume's grid differs from the hub's");
-  publish(volume.probes.data(), volume.active.data());
+  publish(volume.probes.data(), volume.active.data(), volume.noise.empty() ? nullptr : volume.noise.data());
 }
 
-void ProbeHub::publish(const float* probes, const uint8_t* active) {
+void ProbeHub::publish(const float* probes, const uint8_t* active, const float* noise) {
   std::vector<std::function<void()>> wakes;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    encoder_.update(probes, active);
+    encoder_.update(probes, active, noise);
     ++frame_;
     publishedUs_ = nowUs();
     const uint32_t bricks = brickCount(config_.layout);

@@ -64,11 +64,12 @@ class ProbeHub {
   const GridBounds& bounds() const { return config_.bounds; }
   uint64_t epoch() const { return epoch_; }
 
-  // A new lighting frame (27 floats per probe, sh.h layout; active mask or null). Each changed
-  // brick gets a new version, encoded once. Wakes subscribers that wait for data.
-  void publish(const float* probes, const uint8_t* active);
-  // The same for a volume, which must pass checkProbeVolume and have the hub's grid size
-  // (std::invalid_argument otherwise, nothing published).
+  // A new lighting frame (27 floats per probe, sh.h layout; active mask or null; per-probe noise
+  // or null, see EncoderOptions::noiseScale). Each changed brick gets a new version, encoded once.
+  // Wakes subscribers that wait for data.
+  void publish(const float* probes, const uint8_t* active, const float* noise = nullptr);
+  // The same for a volume (its noise too, when it has one), which must pass checkProbeVolume and
+  // have the hub's grid size (std::invalid_argument otherwise, nothing published).
   void publish(const ProbeVolume& volume);
   // Wakes subscribers whose budget has refilled (call at the producer's rate when nothing changes).
   void tick();
