@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "probecast/codec/sh.h"
+#include "probecast/codec/stream.h"
 #include "probecast/renderer/probe_updater.h"
 #include "update_bench.h"
 
@@ -350,6 +351,38 @@ TEST_F(Updater, HistoryRejectionFollowsALightJumpWithinTwoUpdates) {
       bench::irradianceRmseRel(fresh.volume().probes.data(), reference.data(), fresh.volume().active.data(), g.count());
   EXPECT_LT(jumped, 1.5 * fromScratch);
   EXPECT_GT(restarted, active / 2);
+}
+
+TEST_F(Updater, StillVolumeIsRarelyResent) {
+  // The light still: what changes from update to update is noise the updater states, so an
+  // encoder with a noise scale makes new brick versions only now and then, while one without
+  // re-sends the noise above its dead-zone every frame (4³ probes: one brick). Not nothing: the
+  // threshold c·σ shrinks as 1/√n while the mean wanders, so a probe is re-sent each time n has
+  // grown by a factor of about 1 + c² — ever rarer, never never.
+  const Scene s = cornellAt(0.0f);
+  const ProbeGrid g = sceneGrid(s, {4, 4, 4});
+  UpdaterOptions o;
+  o.samplesPerProbe = 32;
+  ProbeUpdater u(*context_, s, g, o);
+  const StreamLayout layout = streamLayoutFor(g, Representation::Zh3, 4);
+  EncoderOptions withNoise;
+  withNoise.deadzone = 1;
+  withNoise.noiseScale = 2.0f;
+  EncoderOptions plain;
+  plain.deadzone = 1;
+  StreamEncoder noiseAware(layout, withNoise), always(layout, plain);
+  uint32_t versions = 0, plainVersions = 0;
+  for (int k = 0; k < 96; ++k) {
+    u.update();
+    const uint32_t a = noiseAware.update(u.volume().probes.data(), u.volume().active.data(), u.volume().noise.data());
+    const uint32_t b = always.update(u.volume().probes.data(), u.volume().active.data());
+    if (k >= 64) {
+      versions += a;
+      plainVersions += b;
+    }
+  }
+  EXPECT_LE(versions, 12u) << "bricks re-sent over the last 32 still updates";
+  EXPECT_EQ(plainVersions, 32u);
 }
 
 TEST_F(Updater, CornellProbesMatchCpuReference) {

@@ -7,6 +7,7 @@
 #include <zstd.h>
 
 #include "brick_section.h"
+#include "probecast/codec/sh.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {
@@ -61,15 +62,29 @@ StreamEncoder::~StreamEncoder() = default;
 namespace {
 
 // The noise rule of EncoderOptions::noiseScale: true when `candidate` (what a new version would
-// decode to) is within `threshold` of `held` (what the decoder has) in every coefficient.
+// decode to) differs from `held` (what the decoder has) by at most `threshold` in the irradiance-
+// weighted RMS over the coefficients, each channel's differences divided by that channel's share
+// of the held luminance (noise scales with the light). One mean over 27 values, not a maximum:
+// noise of standard error σ in every coefficient gives a mean square of σ², where the maximum of
+// 27 values would exceed 2σ in most frames.
 bool withinNoise(const float candidate[kProbeFloats], const float held[kProbeFloats], float threshold) {
+  constexpr float kBandWeight[3] = {1.0f, 4.0f / 9.0f, 1.0f / 16.0f};  // (Â_l / π)², Â = (π, 2π/3, π/4)
   const float luminance = 0.2126f * held[0] + 0.7152f * held[1] + 0.0722f * held[2];
-  float perChannel[3];
-  for (int c = 0; c < 3; ++c)  // the noise of each channel scales with its share of the light
-    perChannel[c] = luminance > 0.0f ? threshold * std::max(held[c], 0.0f) / luminance : threshold;
-  for (int i = 0; i < kProbeFloats; ++i)
-    if (!(std::fabs(candidate[i] - held[i]) <= perChannel[i % 3])) return false;
-  return true;
+  double sum = 0.0, weights = 0.0;
+  for (int i = 0; i < kShCoeffs; ++i) {
+    const float w = kBandWeight[shBand(i)];
+    for (int c = 0; c < 3; ++c) {
+      const float d = candidate[i * 3 + c] - held[i * 3 + c];
+      const float share = luminance > 0.0f ? std::max(held[c], 0.0f) / luminance : 1.0f;
+      if (!(share > 0.0f)) {
+        if (d != 0.0f) return false;
+        continue;
+      }
+      sum += static_cast<double>(w) * (d / share) * (d / share);
+    }
+    weights += 3.0 * w;
+  }
+  return sum <= static_cast<double>(threshold) * threshold * weights;
 }
 
 }  // namespace
@@ -95,6 +110,8 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
       if (isActive) {
         const ProbeSymbols* previous = s.active[p] ? &s.symbols[p] : nullptr;
         quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
+        // A change the input's own noise explains is not sent: keep what the decoder holds while
+        // the would-be new version is within c·σ of it.
         const float sigma = noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f;
         if (previous && sigma > 0.0f && s.options.noiseScale > 0.0f &&
             std::memcmp(&s.next[k], previous, sizeof(ProbeSymbols)) != 0) {

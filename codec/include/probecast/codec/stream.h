@@ -72,9 +72,10 @@ struct EncoderOptions {
   bool compress = true;  // false: every section stored raw (byte-exact across zstd versions)
   // Noise rule: with per-probe noise (the standard error σ of the luminance of c00, see
   // ProbeVolume::noise) and a scale c > 0, a probe is not re-sent while what it would decode to
-  // stays within c·σ of what the decoder holds in every coefficient (each channel's threshold
-  // scaled by its share of the held c00). Compared against the decoder's reconstruction, never
-  // against the last input, so skipped changes cannot add up past the threshold. 0 = off.
+  // stays within c·σ of what the decoder holds, in the irradiance-weighted RMS over its
+  // coefficients (each channel's differences divided by its share of the held c00's luminance).
+  // Compared against the decoder's reconstruction, never against the last input, so skipped
+  // changes cannot add up past the threshold. 0 = off.
   float noiseScale = 0.0f;
 };
 
