@@ -1,10 +1,11 @@
-// `probecast bench codec|update|raster|pipeline|environment|stability|stream|edge`.
+// `probecast bench codec|update|raster|pipeline|environment|stability|stream|edge|adaptive`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "adaptive_bench.h"
 #include "codec_bench.h"
 #include "edge_bench.h"
 #include "environment_bench.h"
@@ -326,6 +327,40 @@ void addBenchEdge(CLI::App* bench) {
   });
 }
 
+// `probecast bench adaptive`: adaptive blending and the noise-aware stream against fixed w_min.
+void addBenchAdaptive(CLI::App* bench) {
+  CLI::App* adaptive = bench->add_subcommand(
+      "adaptive", "history rejection and the noise-aware stream: bytes still/moving, flicker, lag, PSNR loss");
+  struct AdaptiveOptions {
+    std::string json, chart, repr = "zh3";
+    bench::AdaptiveBenchOptions bench;
+  };
+  auto ao = std::make_shared<AdaptiveOptions>();
+  adaptive->add_option("--scene", ao->bench.sceneSpec, "an animated scene (t moves its light)");
+  adaptive->add_option("--spp", ao->bench.samplesPerProbe, "paths per probe per update")->check(CLI::Range(1u, 1u << 16));
+  adaptive->add_option("--still", ao->bench.stillUpdates, "updates of each still phase")->check(CLI::Range(8u, 100000u));
+  adaptive->add_option("--moving", ao->bench.movingUpdates, "updates with the light moving")->check(CLI::Range(1u, 100000u));
+  adaptive->add_option("--light-step", ao->bench.lightStep, "t the light moves per update")->check(CLI::Range(0.0f, 1.0f));
+  adaptive->add_option("--reject-sigmas", ao->bench.rejectSigmas, "k of the adaptive rule")->check(CLI::Range(0.5f, 1000.0f));
+  adaptive->add_option("--w-mins", ao->bench.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
+  adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
+  adaptive->add_option("--deadzone", ao->bench.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
+  addRepresentationOption(adaptive, ao->repr, "l1, zh3h, zh3, l2 or fp16");
+  addJsonOption(adaptive, ao->json);
+  adaptive->add_option("--chart", ao->chart, "SVG prefix: writes PREFIX_bytes.svg and PREFIX_jump.svg");
+  adaptive->callback([ao] {
+    bench::AdaptiveBenchOptions o = ao->bench;
+    o.repr = *parseRepresentation(ao->repr);
+    o.command = commandLine();
+    o.progress = progressLine;
+    const bench::AdaptiveBenchResult r = bench::runAdaptiveBench(o);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", ao->json, "", "");
+    if (!ao->chart.empty())
+      for (const auto& [suffix, svg] : {std::pair{"_bytes.svg", &r.svgBytes}, std::pair{"_jump.svg", &r.svgJump}})
+        writeTextFile(ao->chart + suffix, *svg);
+  });
+}
+
 }  // namespace
 
 void addBenchCommands(CLI::App& app) {
@@ -339,6 +374,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchStability(bench);
   addBenchStream(bench);
   addBenchEdge(bench);
+  addBenchAdaptive(bench);
 }
 
 }  // namespace probecast::app

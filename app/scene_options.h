@@ -137,13 +137,18 @@ struct TracerOptions {
   uint32_t spp = 128;
   uint32_t bounces = 4;
   uint32_t seed = 1;
-  float wMin = 0.05f;
+  float wMin = 0.0f;
+  float rejectSigmas = 4.0f;
   float clamp = 16.0f;
   void add(CLI::App* cmd) {
     addSppOption(cmd, spp);
     cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
     cmd->add_option("--seed", seed, "random seed (same seed, same result)");
-    cmd->add_option("--w-min", wMin, "minimum temporal blend weight")->check(CLI::Range(0.0f, 1.0f));
+    cmd->add_option("--w-min", wMin, "minimum temporal blend weight (0: a true mean until the history is rejected)")
+        ->check(CLI::Range(0.0f, 1.0f));
+    cmd->add_option("--reject-sigmas", rejectSigmas,
+                    "restart a probe's history when new estimates differ by more than this many standard errors (0 = never)")
+        ->check(CLI::Range(0.0f, 1000.0f));
     cmd->add_option("--clamp", clamp, "max luminance of an indirect contribution (0 = off)")->check(CLI::Range(0.0f, 1e9f));
   }
   renderer::UpdaterOptions options() const {
@@ -152,6 +157,7 @@ struct TracerOptions {
     o.maxBounces = bounces;
     o.seed = seed;
     o.minBlendWeight = wMin;
+    o.rejectSigmas = rejectSigmas;
     o.indirectClamp = clamp;
     return o;
   }

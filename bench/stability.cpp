@@ -100,7 +100,7 @@ bool holdsServerVolume(const service::ProbeClient& client, const service::ProbeH
 
 }  // namespace
 
-std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, const std::vector<float>& wMins,
+std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, const std::vector<BlendRule>& rules,
                                           uint32_t samplesPerProbe, uint32_t updatesAfterJump) {
   const scene::Scene before = builtin("cornell", 0.0f), after = builtin("cornell", 0.5f);
   const ProbeGrid grid = renderer::sceneGrid(before, {4, 4, 4});
@@ -109,6 +109,7 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
     renderer::UpdaterOptions o;
     o.samplesPerProbe = 512;
     o.minBlendWeight = 0.0f;
+    o.rejectSigmas = 0.0f;
     o.seed = 99;
     renderer::ProbeUpdater u(context, s, grid, o);
     for (int k = 0; k < 16; ++k) u.update();
@@ -117,13 +118,18 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
   const auto [ref0, active] = converged(before);
   const auto ref1 = converged(after).first;
   std::vector<FlickerLag> out;
-  for (float w : wMins) {
+  for (const BlendRule& rule : rules) {
     FlickerLag r;
-    r.wMin = w;
+    r.wMin = rule.wMin;
+    r.rejectSigmas = rule.rejectSigmas;
     renderer::UpdaterOptions o;
     o.samplesPerProbe = samplesPerProbe;
-    o.minBlendWeight = w;
+    o.minBlendWeight = rule.wMin;
+    o.rejectSigmas = rule.rejectSigmas;
     renderer::ProbeUpdater u(context, before, grid, o);
+    renderer::UpdaterOptions freshOptions = o;
+    freshOptions.seed = o.seed + 1;
+    renderer::ProbeUpdater fresh(context, after, grid, freshOptions);
     std::vector<float> previous;
     std::vector<double> changes;
     const uint32_t settle = 48;
@@ -140,6 +146,10 @@ std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, cons
       r.errorAfterJump.push_back(irradianceRmseRel(u.volume().probes.data(), ref1.data(), active.data(), n));
       if (r.updatesToRecover < 0 && r.errorAfterJump.back() <= 1.5 * r.errorBeforeJump)
         r.updatesToRecover = static_cast<int>(k);
+      fresh.update();
+      r.freshError.push_back(irradianceRmseRel(fresh.volume().probes.data(), ref1.data(), active.data(), n));
+      if (r.updatesToFollow < 0 && r.errorAfterJump.back() <= 1.5 * r.freshError.back())
+        r.updatesToFollow = static_cast<int>(k);
     }
     out.push_back(std::move(r));
   }
@@ -445,7 +455,7 @@ StabilityResult runStabilitySuite(const StabilityOptions& o) {
   std::string& md = out.markdown;
 
   say("stability: flicker and lag against w_min");
-  const auto fl = measureFlickerLag(context, {0.02f, 0.05f, 0.1f, 0.25f}, 32, 48);
+  const auto fl = measureFlickerLag(context, {{0.02f, 0}, {0.05f, 0}, {0.1f, 0}, {0.25f, 0}}, 32, 48);
   md +=
       "### Temporal flicker against lag (builtin:cornell, 4³ probes, 32 samples per probe per update)\n\n"
       "| w_min | flicker per update | error before the jump | updates to recover after the light jumps "

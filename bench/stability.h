@@ -12,16 +12,28 @@
 
 namespace probecast::bench {
 
+// A temporal blending rule of the probe updater: w = max(1/n, w_min), with history rejection at
+// `rejectSigmas` standard errors (0 = none: the fixed blend).
+struct BlendRule {
+  float wMin = 0;
+  float rejectSigmas = 0;
+};
+
 // Temporal flicker at low samples per probe, and the lag it trades against: builtin:cornell
 // (4³ probes) converges with the light at t = 0, then the light jumps to t = 0.5.
 struct FlickerLag {
   float wMin = 0;
+  float rejectSigmas = 0;
   double flickerRel = 0;         // median relative irradiance change per update, settled
   double errorBeforeJump = 0;    // relative irradiance RMSE against the converged t = 0 volume
   std::vector<double> errorAfterJump;  // against the converged t = 0.5 volume, per update after the jump
   int updatesToRecover = -1;     // first update after the jump within 1.5× errorBeforeJump (-1: never)
+  // Against an updater started afresh on the t = 0.5 lighting with the same rule, per update: the
+  // error no blending can avoid with these samples.
+  std::vector<double> freshError;
+  int updatesToFollow = -1;      // first update after the jump within 1.5× freshError (-1: never)
 };
-std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, const std::vector<float>& wMins,
+std::vector<FlickerLag> measureFlickerLag(renderer::VulkanContext& context, const std::vector<BlendRule>& rules,
                                           uint32_t samplesPerProbe, uint32_t updatesAfterJump);
 
 // Blending ZH3 probes whose axes compete (light from +x in one, from +y in the other), over the

@@ -48,6 +48,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
   // Reference: the plain mean of many samples (w_min = 0, no clamp).
   renderer::UpdaterOptions refOptions = opt.updater;
   refOptions.minBlendWeight = 0.0f;
+  refOptions.rejectSigmas = 0.0f;
   refOptions.indirectClamp = 0.0f;
   refOptions.seed = opt.updater.seed + 1000;
   refOptions.samplesPerProbe = std::max(opt.updater.samplesPerProbe, 1024u);
@@ -65,6 +66,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
   // Convergence: accumulate with w_min = 0 and measure error after every update.
   renderer::UpdaterOptions convOptions = opt.updater;
   convOptions.minBlendWeight = 0.0f;
+  convOptions.rejectSigmas = 0.0f;
   renderer::ProbeUpdater updater(context, opt.scene, opt.grid, convOptions);
   std::vector<double> ms, raysPerS, closestPerS, shadowPerS, rmse, cumulativeMs;
   double elapsed = 0;
@@ -89,6 +91,7 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
   for (float w : opt.minBlendWeights) {
     renderer::UpdaterOptions o = opt.updater;
     o.minBlendWeight = w;
+    o.rejectSigmas = 0.0f;  // the fixed blend
     renderer::ProbeUpdater u(context, opt.scene, opt.grid, o);
     std::vector<float> previous;
     std::vector<double> changes;

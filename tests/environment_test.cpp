@@ -281,6 +281,7 @@ TEST(Environment, FurnaceProbeAbovePlaneSeesSkyAndAlbedo) {
   o.indirectClamp = 0.0f;
   o.classify = false;
   o.minBlendWeight = 0.0f;  // a plain mean over the updates
+  o.rejectSigmas = 0.0f;
   o.environment = uniformSky(glm::vec3(2.0f));
   ProbeUpdater u(context, s, ProbeGrid{{1, 1, 1}, {{0, 1, 0}, {0, 1, 0}}}, o);
   for (int k = 0; k < 8; ++k) EXPECT_EQ(u.update().droppedSamples, 0u);

@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "probecast/codec/sh.h"
+#include "probecast/codec/stream.h"
 #include "probecast/renderer/probe_updater.h"
+#include "update_bench.h"
 
 namespace probecast::renderer {
 namespace {
@@ -256,6 +258,133 @@ TEST_F(Updater, MovingLightIsFollowed) {
 namespace probecast::renderer {
 namespace {
 
+// builtin:cornell, 3 × 3 × 3 probes over the room: the small grid of the blending tests.
+ProbeGrid cornellGrid(const Scene& s) { return sceneGrid(s, {3, 3, 3}); }
+
+Scene cornellAt(float t) {
+  Scene s;
+  std::string error;
+  EXPECT_TRUE(scene::makeBuiltinScene("cornell", t, s, error)) << error;
+  return s;
+}
+
+// A converged volume: a plain mean (no rejection) of 16 updates of 2048 paths per probe.
+std::vector<float> convergedProbes(VulkanContext& context, const Scene& s, const ProbeGrid& g) {
+  UpdaterOptions o;
+  o.samplesPerProbe = 2048;
+  o.rejectSigmas = 0.0f;
+  o.seed = 77;
+  ProbeUpdater u(context, s, g, o);
+  for (int k = 0; k < 16; ++k) u.update();
+  return u.volume().probes;
+}
+
+// RMSE of the luminance of c00 against `reference` over the active probes, and the mean noise the
+// updater states for them.
+std::pair<double, double> dcError(const ProbeVolume& v, const std::vector<float>& reference) {
+  double se = 0, noise = 0;
+  int n = 0;
+  for (uint32_t p = 0; p < v.count(); ++p) {
+    if (!v.active[p]) continue;
+    const float* a = v.probes.data() + p * 27;
+    const float* b = reference.data() + p * 27;
+    const double d = 0.2126 * (a[0] - b[0]) + 0.7152 * (a[1] - b[1]) + 0.0722 * (a[2] - b[2]);
+    se += d * d;
+    noise += v.noise.empty() ? 0.0 : v.noise[p] * v.noise[p];
+    ++n;
+  }
+  return {std::sqrt(se / n), std::sqrt(noise / n)};
+}
+
+TEST_F(Updater, StillProbeErrorFallsAsOneOverRootN) {
+  // The light still: with w = 1/n and no false restarts the history is the mean of n updates, so
+  // its error against a converged volume (32× the paths of the longest run) halves every time n
+  // quadruples, and the standard error the updater states tracks the error it actually has.
+  const Scene s = cornellAt(0.0f);
+  const ProbeGrid g = cornellGrid(s);
+  const std::vector<float> reference = convergedProbes(*context_, s, g);
+  UpdaterOptions o;
+  o.samplesPerProbe = 32;
+  ProbeUpdater u(*context_, s, g, o);
+  std::vector<std::pair<double, double>> at;
+  uint32_t restarts = 0;
+  for (uint32_t n = 1; n <= 64; ++n) {
+    restarts += u.update().restartedProbes;
+    if (n == 4 || n == 16 || n == 64) at.push_back(dcError(u.volume(), reference));
+  }
+  for (size_t k = 0; k + 1 < at.size(); ++k) {
+    const double ratio = at[k].first / at[k + 1].first;  // 2 for 1/√n
+    EXPECT_GT(ratio, 1.5) << "n = " << (4 << (2 * k));
+    EXPECT_LT(ratio, 2.7) << "n = " << (4 << (2 * k));
+  }
+  EXPECT_LT(restarts, g.count() / 3) << "restarts with the light still";
+  for (auto [e, noise] : at) {
+    EXPECT_GT(noise, 0.5 * e);
+    EXPECT_LT(noise, 2.0 * e);
+  }
+}
+
+TEST_F(Updater, HistoryRejectionFollowsALightJumpWithinTwoUpdates) {
+  // Converged with the light at t = 0, then it jumps to t = 0.5: a probe whose estimate disagrees
+  // holds it back, and restarts when the next one confirms, so two updates later the volume is
+  // about as close to the new lighting as a fresh updater after two updates — not 16/18 the old
+  // lighting, as a plain running mean would be.
+  const Scene before = cornellAt(0.0f), after = cornellAt(0.5f);
+  const ProbeGrid g = cornellGrid(before);
+  const std::vector<float> reference = convergedProbes(*context_, after, g);
+  UpdaterOptions o;
+  o.samplesPerProbe = 256;
+  ProbeUpdater u(*context_, before, g, o);
+  for (int k = 0; k < 16; ++k) u.update();
+  u.setScene(after);
+  uint32_t restarted = 0, active = 0;
+  for (int k = 0; k < 2; ++k) {
+    const UpdateStats st = u.update();
+    restarted += st.restartedProbes;
+    active = st.activeProbes;
+  }
+  o.seed = 5;
+  ProbeUpdater fresh(*context_, after, g, o);
+  for (int k = 0; k < 2; ++k) fresh.update();
+  const double jumped = bench::irradianceRmseRel(u.volume().probes.data(), reference.data(), u.volume().active.data(), g.count());
+  const double fromScratch =
+      bench::irradianceRmseRel(fresh.volume().probes.data(), reference.data(), fresh.volume().active.data(), g.count());
+  EXPECT_LT(jumped, 1.5 * fromScratch);
+  EXPECT_GT(restarted, active / 2);
+}
+
+TEST_F(Updater, StillVolumeIsRarelyResent) {
+  // The light still: what changes from update to update is noise the updater states, so an
+  // encoder with a noise scale makes new brick versions only now and then, while one without
+  // re-sends the noise above its dead-zone every frame (4³ probes: one brick). Not nothing: the
+  // threshold c·σ shrinks as 1/√n while the mean wanders, so a probe is re-sent each time n has
+  // grown by a factor of about 1 + c² — ever rarer, never never.
+  const Scene s = cornellAt(0.0f);
+  const ProbeGrid g = sceneGrid(s, {4, 4, 4});
+  UpdaterOptions o;
+  o.samplesPerProbe = 32;
+  ProbeUpdater u(*context_, s, g, o);
+  const StreamLayout layout = streamLayoutFor(g, Representation::Zh3, 4);
+  EncoderOptions withNoise;
+  withNoise.deadzone = 1;
+  withNoise.noiseScale = 2.0f;
+  EncoderOptions plain;
+  plain.deadzone = 1;
+  StreamEncoder noiseAware(layout, withNoise), always(layout, plain);
+  uint32_t versions = 0, plainVersions = 0;
+  for (int k = 0; k < 96; ++k) {
+    u.update();
+    const uint32_t a = noiseAware.update(u.volume().probes.data(), u.volume().active.data(), u.volume().noise.data());
+    const uint32_t b = always.update(u.volume().probes.data(), u.volume().active.data());
+    if (k >= 64) {
+      versions += a;
+      plainVersions += b;
+    }
+  }
+  EXPECT_LE(versions, 12u) << "bricks re-sent over the last 32 still updates";
+  EXPECT_EQ(plainVersions, 32u);
+}
+
 TEST_F(Updater, CornellProbesMatchCpuReference) {
   // GPU: 32 updates × 2048 paths with w_min = 0 (the plain mean of 65k paths), no clamp.
   // CPU: 65k independent paths (uniform directions, cosine continuation). Both estimate the same
@@ -269,6 +398,7 @@ TEST_F(Updater, CornellProbesMatchCpuReference) {
   UpdaterOptions o;
   o.samplesPerProbe = 2048;
   o.minBlendWeight = 0.0f;
+  o.rejectSigmas = 0.0f;  // the plain mean
   o.indirectClamp = 0.0f;
   ProbeUpdater updater(*context_, s, g, o);
   for (int u = 0; u < 32; ++u) updater.update();

@@ -58,6 +58,17 @@ TEST(ProbeVolume, CheckRefusesWhatNoConsumerCanUse) {
   v = good;
   v.grid.dims[2] = 0;
   EXPECT_FALSE(checkProbeVolume(v, error));
+  v = good;
+  v.noise.assign(4, 0.5f);  // one standard error per probe is fine
+  EXPECT_TRUE(checkProbeVolume(v, error)) << error;
+  v.noise.pop_back();
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  EXPECT_NE(error.find("noise"), std::string::npos);
+  for (float bad : {-1.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    v.noise.assign(4, 0.5f);
+    v.noise[2] = bad;
+    EXPECT_FALSE(checkProbeVolume(v, error)) << bad;
+  }
 }
 
 TEST(ProbeVolume, StreamLayoutOfAHugeGridIsInvalidNotWrapped) {

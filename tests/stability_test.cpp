@@ -12,7 +12,7 @@ namespace {
 
 TEST(Stability, SmallerWMinFlickersLessAndRecoversSlower) {
   renderer::VulkanContext context(test::validatedContext());
-  const auto r = measureFlickerLag(context, {0.02f, 0.25f}, 32, 32);
+  const auto r = measureFlickerLag(context, {{0.02f, 0}, {0.25f, 0}}, 32, 32);
   ASSERT_EQ(r.size(), 2u);
   for (const FlickerLag& f : r)
     std::printf("w_min %.2f: flicker %.2f%% per update, recovery after the jump %d updates\n", f.wMin,

@@ -1,6 +1,7 @@
 // Brick versions, deltas, keyframes and the container: drift-free, golden bytes, masks, atomicity.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -90,6 +91,71 @@ INSTANTIATE_TEST_SUITE_P(RepresentationsAndDeadzones, DriftFree,
                            return std::string(representationName(p.param.repr)) + "_dz" +
                                   std::to_string(p.param.deadzone);
                          });
+
+// Luminance of c00 (Rec. 709), the unit of the encoder's noise values.
+float dcLuminance(const float* probe) { return 0.2126f * probe[0] + 0.7152f * probe[1] + 0.0722f * probe[2]; }
+
+TEST(Stream, NoiseRuleStaysDriftFreeOver1000Frames) {
+  // Truth still for 300 frames, then drifting so slowly (1/400 of the way per frame) that no single
+  // frame's change passes the threshold, then still again; the input is the truth plus noise of at
+  // most σ/2 per coefficient (scaled per channel), σ stated per probe. What the decoder holds must stay within c·σ (irradiance-
+  // weighted RMS) of what the input would decode to at every frame (it would drift away if the encoder compared each
+  // input with the previous one), and bit-identical to the encoder's reconstruction.
+  const StreamLayout layout = makeLayout(8, 4, 6, Representation::Zh3);
+  EncoderOptions options;
+  options.noiseScale = 2.0f;
+  StreamEncoder enc(layout, options);
+  StreamDecoder dec(layout);
+  const int count = static_cast<int>(probeCount(layout));
+  std::mt19937 rng(99);
+  const std::vector<float> start = test::movingLightFrame(count, 0, 0.0f, rng);
+  const std::vector<float> end = test::movingLightFrame(count, 12, 0.0f, rng);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<float> truth(start.size()), input(start.size()), sigma(count);
+  std::vector<uint8_t> frameBytes;
+  size_t stillBytes = 0;
+  for (int f = 0; f < 1000; ++f) {
+    const float a = std::clamp((static_cast<float>(f) - 300.0f) / 400.0f, 0.0f, 1.0f);
+    for (size_t i = 0; i < truth.size(); ++i) truth[i] = (1.0f - a) * start[i] + a * end[i];
+    for (int p = 0; p < count; ++p) {
+      sigma[p] = 0.02f * dcLuminance(&truth[p * kProbeFloats]);
+      const float* t = &truth[p * kProbeFloats];
+      for (int i = 0; i < kProbeFloats; ++i)  // each channel's noise in proportion to its light
+        input[p * kProbeFloats + i] = t[i] + 0.5f * sigma[p] * t[i % 3] / dcLuminance(t) * unit(rng);
+    }
+    enc.update(input.data(), nullptr, sigma.data());
+    enc.writeChangedFrame(frameBytes);
+    if (f >= 900) stillBytes += frameBytes.size();
+    ASSERT_EQ(dec.apply(frameBytes.data(), frameBytes.size()), CodecStatus::Ok) << "frame " << f;
+    expectSameState(enc, dec, "frame " + std::to_string(f));
+    ProbeVolume sent = makeProbeVolume(ProbeGrid{{8, 4, 6}, {{0, 0, 0}, {1, 1, 1}}});
+    sent.probes = input;
+    const ProbeVolume fresh = decodeAs(sent, Representation::Zh3, false);  // what sending it would give
+    for (int p = 0; p < count; ++p) {
+      const float* have = dec.probes() + p * kProbeFloats;
+      const float lum = dcLuminance(have);
+      const float* want = fresh.probes.data() + p * kProbeFloats;
+      double sum = 0, weights = 0;  // irradiance-weighted mean square, channels over their share
+      for (int i = 0; i < kShCoeffs; ++i) {
+        const double w = i == 0 ? 1.0 : i < 4 ? 4.0 / 9.0 : 1.0 / 16.0;
+        for (int c = 0; c < 3; ++c) {
+          const double d = (have[i * 3 + c] - want[i * 3 + c]) / (have[c] / lum);
+          sum += w * d * d;
+          weights += w;
+        }
+      }
+      const double threshold = options.noiseScale * sigma[p];
+      ASSERT_LE(std::sqrt(sum / weights), threshold * 1.0001 + 1e-6)
+          << "frame " << f << " probe " << p;
+      // Against the truth: the threshold, the noise and the 9-bit mantissa of the DC.
+      const float truthLum = dcLuminance(&truth[p * kProbeFloats]);
+      ASSERT_LE(std::fabs(lum - truthLum), (options.noiseScale + 1.0f) * sigma[p] * 1.1f + 0.004f * truthLum)
+          << "frame " << f << " probe " << p;
+    }
+  }
+  // Still again: noise within the threshold costs almost nothing (frame headers, a rare probe).
+  EXPECT_LT(static_cast<double>(stillBytes) / 100.0 / count, 0.5);
+}
 
 // Probes for the golden stream: deterministic, no randomness.
 std::vector<float> goldenProbes(int frame) {

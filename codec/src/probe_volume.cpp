@@ -62,6 +62,13 @@ bool checkProbeVolume(const ProbeVolume& v, std::string& error) {
   for (size_t i = 0; i < v.probes.size(); ++i)
     if (!std::isfinite(v.probes[i]))
       return error = "probe volume: non-finite coefficient at probe " + std::to_string(i / kProbeFloats), false;
+  if (!v.noise.empty() && v.noise.size() != count)
+    return error = "probe volume: noise of " + std::to_string(v.noise.size()) + " entries for " + std::to_string(count) +
+                   " probes (one each, or none)",
+           false;
+  for (size_t i = 0; i < v.noise.size(); ++i)
+    if (!(std::isfinite(v.noise[i]) && v.noise[i] >= 0.0f))
+      return error = "probe volume: noise of probe " + std::to_string(i) + " is not a finite value >= 0", false;
   return true;
 }
 

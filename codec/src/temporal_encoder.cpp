@@ -1,4 +1,5 @@
 // The stream encoder: quantises frames, versions bricks, encodes each version once.
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -6,6 +7,7 @@
 #include <zstd.h>
 
 #include "brick_section.h"
+#include "probecast/codec/sh.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {
@@ -57,7 +59,37 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
 
 StreamEncoder::~StreamEncoder() = default;
 
-uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
+namespace {
+
+// The noise rule of EncoderOptions::noiseScale: true when `candidate` (what a new version would
+// decode to) differs from `held` (what the decoder has) by at most `threshold` in the irradiance-
+// weighted RMS over the coefficients, each channel's differences divided by that channel's share
+// of the held luminance (noise scales with the light). One mean over 27 values, not a maximum:
+// noise of standard error σ in every coefficient gives a mean square of σ², where the maximum of
+// 27 values would exceed 2σ in most frames.
+bool withinNoise(const float candidate[kProbeFloats], const float held[kProbeFloats], float threshold) {
+  constexpr float kBandWeight[3] = {1.0f, 4.0f / 9.0f, 1.0f / 16.0f};  // (Â_l / π)², Â = (π, 2π/3, π/4)
+  const float luminance = 0.2126f * held[0] + 0.7152f * held[1] + 0.0722f * held[2];
+  double sum = 0.0, weights = 0.0;
+  for (int i = 0; i < kShCoeffs; ++i) {
+    const float w = kBandWeight[shBand(i)];
+    for (int c = 0; c < 3; ++c) {
+      const float d = candidate[i * 3 + c] - held[i * 3 + c];
+      const float share = luminance > 0.0f ? std::max(held[c], 0.0f) / luminance : 1.0f;
+      if (!(share > 0.0f)) {
+        if (d != 0.0f) return false;
+        continue;
+      }
+      sum += static_cast<double>(w) * (d / share) * (d / share);
+    }
+    weights += 3.0 * w;
+  }
+  return sum <= static_cast<double>(threshold) * threshold * weights;
+}
+
+}  // namespace
+
+uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, const float* noise) {
   Impl& s = *impl_;
   const Representation repr = s.layout.repr;
   const uint32_t bricks = brickCount(s.layout);
@@ -78,6 +110,19 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn) {
       if (isActive) {
         const ProbeSymbols* previous = s.active[p] ? &s.symbols[p] : nullptr;
         quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
+        // A change the input's own noise explains is not sent: keep what the decoder holds while
+        // the would-be new version is within c·σ of it.
+        const float sigma = noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f;
+        if (previous && sigma > 0.0f && s.options.noiseScale > 0.0f &&
+            std::memcmp(&s.next[k], previous, sizeof(ProbeSymbols)) != 0) {
+          float candidate[kProbeFloats];
+          const bool ok = dequantizeProbe(repr, s.next[k], candidate, /*zh3PerPixel=*/false);
+          assert(ok && "the encoder only makes valid symbols");
+          (void)ok;
+          if (withinNoise(candidate, s.reconstruction.data() + static_cast<size_t>(p) * kProbeFloats,
+                          s.options.noiseScale * sigma))
+            s.next[k] = *previous;
+        }
       } else {
         s.next[k] = ProbeSymbols{};
       }

@@ -10,6 +10,7 @@
 
 #include "probe_trace.rgen.h"
 #include "gpu_scene.h"
+#include "probe_history.h"
 #include "vk_raytracing.h"
 
 namespace probecast::renderer {
@@ -97,7 +98,7 @@ struct ProbeUpdater::Impl {
   UpdaterOptions options;
   uint32_t samples = 0;
   std::vector<uint32_t> activeList;
-  std::vector<uint32_t> blendCount;
+  std::vector<ProbeHistory> history;  // per probe: blend count and noise statistics
   size_t geometryVertices = 0, geometryTriangles = 0;
   std::vector<glm::vec3> geometryPositions;
   std::vector<uint32_t> geometryIndices;
@@ -156,8 +157,13 @@ struct ProbeUpdater::Impl {
     }
     activeList.clear();
     for (uint32_t p = 0; p < volume.count(); ++p) {
-      if (active[p]) activeList.push_back(p);
-      else std::fill_n(volume.probes.begin() + p * 27, 27, 0.0f);
+      if (active[p]) {
+        activeList.push_back(p);
+        continue;
+      }
+      std::fill_n(volume.probes.begin() + p * 27, 27, 0.0f);
+      history[p] = ProbeHistory{};  // starts afresh if it becomes active again
+      if (!volume.noise.empty()) volume.noise[p] = 0.0f;
     }
     uploadProbeList(activeList);
   }
@@ -180,7 +186,7 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   s.samples = roundUpLanes(options.samplesPerProbe);
   s.volume = makeProbeVolume(grid);
   s.volume.samplesPerProbe = s.samples;
-  s.blendCount.assign(grid.count(), 0);
+  s.history.assign(grid.count(), ProbeHistory{});
   createRayTracingPass(*s.d, kProbeTraceRgen, sizeof kProbeTraceRgen, sizeof(PtPushConstants), s.pass);
   const auto dirs = coherentFibonacci(s.samples);
   s.directions = createBufferWithData(*s.d, dirs.data(), dirs.size() * sizeof(shaders::vec4), kStorage);
@@ -219,9 +225,13 @@ UpdateStats ProbeUpdater::update() {
   if (!s.activeList.empty()) {
     s.dispatch(static_cast<uint32_t>(s.activeList.size()), s.samples, s.directions, PT_MODE_TRACE,
                randomRotation(s.options.seed, s.volume.updates));
-    // ĉ = (4π/S) Σ lanes, summed in a fixed order (deterministic), then c ← (1−w) c + w ĉ.
+    // ĉ = (4π/S) Σ lanes, summed in a fixed order (deterministic). The lanes' partial sums are
+    // independent estimates over interleaved subsets of the directions: their spread estimates
+    // the variance of ĉ before any history exists.
     const float* part = static_cast<const float*>(s.partials.mapped);
     const float scale = 4.0f * 3.14159265358979f / static_cast<float>(s.samples);
+    const HistoryOptions blend{s.options.minBlendWeight, s.options.rejectSigmas};
+    s.volume.noise.resize(s.volume.count(), 0.0f);
     for (size_t i = 0; i < s.activeList.size(); ++i) {
       const uint32_t p = s.activeList[i];
       float sum[27] = {};
@@ -232,13 +242,27 @@ UpdateStats ProbeUpdater::update() {
         stats.shadowRays += static_cast<uint64_t>(src[29]);
         stats.droppedSamples += static_cast<uint64_t>(src[30]);
       }
-      const uint32_t n = ++s.blendCount[p];
-      const float w = std::max(1.0f / static_cast<float>(n), s.options.minBlendWeight);
-      float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
+      float fresh[27];
+      bool finite = true;
       for (int k = 0; k < 27; ++k) {
-        const float fresh = sum[k] * scale;
-        c[k] = std::isfinite(fresh) ? (1.0f - w) * c[k] + w * fresh : c[k];
+        fresh[k] = sum[k] * scale;
+        finite = finite && std::isfinite(fresh[k]);
       }
+      if (!finite) continue;  // an overflowing estimate is dropped whole, the history kept
+      float spread[kHistoryLuma] = {};
+      for (uint32_t lane = 0; lane < kLanes; ++lane) {
+        const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
+        for (int k = 0; k < kHistoryLuma; ++k) {
+          const float d = coefficientLuminance(src, k) * scale * static_cast<float>(kLanes) - coefficientLuminance(fresh, k);
+          spread[k] += d * d;
+        }
+      }
+      for (float& v : spread) v /= static_cast<float>(kLanes) * static_cast<float>(kLanes - 1);
+      float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
+      const BlendOutcome outcome = blendEstimate(s.history[p], c, fresh, spread, blend);
+      stats.restartedProbes +=
+          outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage ? 1u : 0u;
+      s.volume.noise[p] = historyStandardError(s.history[p]);
     }
     stats.paths = static_cast<uint64_t>(s.activeList.size()) * s.samples;
   }

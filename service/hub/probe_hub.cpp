@@ -99,16 +99,16 @@ void ProbeHub::publish(const ProbeVolume& volume) {
   for (int a = 0; a < 3; ++a)
     if (volume.grid.dims[a] != config_.layout.grid[a])
       throw std::invalid_argument("published volume's grid differs from the hub's");
-  publish(volume.probes.data(), volume.active.data());
+  publish(volume.probes.data(), volume.active.data(), volume.noise.empty() ? nullptr : volume.noise.data());
 }
 
-void ProbeHub::publish(const float* probes, const uint8_t* active) {
+void ProbeHub::publish(const float* probes, const uint8_t* active, const float* noise) {
   std::vector<std::function<void()>> wakes;
   std::vector<BrickVersionBytes> made;
   BusOutput output;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    encoderSource("publish").encoder().update(probes, active);
+    encoderSource("publish").encoder().update(probes, active, noise);
     ++frame_;
     publishedUs_ = nowUs();
     const uint32_t bricks = brickCount(config_.layout);

@@ -48,6 +48,12 @@ struct ProbeVolume {
   bool zh3PerPixel = false;
   uint32_t updates = 0;          // updates accumulated into the samples (0 = unknown)
   uint32_t samplesPerProbe = 0;  // paths per probe per update (0 = unknown)
+  // Monte Carlo noise of the samples: per probe, the standard error of the luminance of c00
+  // (Rec. 709 weights, same radiance units as the samples); every other coefficient of a traced
+  // probe has about the same standard error (for noise uncorrelated with direction, every
+  // orthonormal SH coefficient's estimator has the same variance). Empty when unknown; 0 for
+  // inactive probes. A stream encoder with a noise scale does not re-send changes within it.
+  std::vector<float> noise;
 
   uint32_t count() const { return grid.count(); }
 };
@@ -57,7 +63,8 @@ ProbeVolume makeProbeVolume(const ProbeGrid& grid);
 
 // Checks what every consumer relies on: 1 to kMaxGridDim probes per axis and at most kMaxProbes,
 // finite bounds with max > min along every axis of two or more probes, 27 floats and one active
-// byte (0 or 1) per probe, every coefficient finite. False with the reason in `error`.
+// byte (0 or 1) per probe, every coefficient finite, and `noise` empty or one finite value >= 0 per
+// probe. False with the reason in `error`.
 bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back

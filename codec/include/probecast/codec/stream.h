@@ -70,6 +70,13 @@ struct EncoderOptions {
   int deadzone = 0;    // changes of at most this many quantisation steps are not sent
   int zstdLevel = 3;
   bool compress = true;  // false: every section stored raw (byte-exact across zstd versions)
+  // Noise rule: with per-probe noise (the standard error σ of the luminance of c00, see
+  // ProbeVolume::noise) and a scale c > 0, a probe is not re-sent while what it would decode to
+  // stays within c·σ of what the decoder holds, in the irradiance-weighted RMS over its
+  // coefficients (each channel's differences divided by its share of the held c00's luminance).
+  // Compared against the decoder's reconstruction, never against the last input, so skipped
+  // changes cannot add up past the threshold. 0 = off.
+  float noiseScale = 0.0f;
 };
 
 struct FrameHeader {
@@ -117,8 +124,9 @@ class StreamEncoder {
   StreamEncoder& operator=(const StreamEncoder&) = delete;
 
   // Ingests a frame: probeCount(layout) probes of 27 floats (sh.h layout) and one state byte each
-  // (nonzero = active; null = all active). Returns the number of bricks given a new version.
-  uint32_t update(const float* probes, const uint8_t* active);
+  // (nonzero = active; null = all active), and optionally one noise value per probe (null: none;
+  // negative or non-finite values count as 0). Returns the number of bricks given a new version.
+  uint32_t update(const float* probes, const uint8_t* active, const float* noise = nullptr);
 
   const StreamLayout& layout() const;
   uint32_t frameSequence() const;  // number of update() calls so far

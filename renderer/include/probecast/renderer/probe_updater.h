@@ -2,7 +2,13 @@
 //
 // Per update, every active probe traces S paths over a spherical Fibonacci set rotated by a fresh
 // random rotation; path radiance is projected ĉ = (4π/S) Σ L(ω) Y(ω) and blended into the probe
-// with w = max(1/n, w_min). Probes whose rays see back faces too often are inside geometry: they
+// with w = max(1/n, w_min). Each probe keeps running statistics of its per-update estimates (the
+// luminance of c00 and of the three L1 coefficients): their variance σ² per update, hence the
+// standard error of the blended history, published as ProbeVolume::noise. With history rejection
+// (rejectSigmas = k > 0) a probe accumulates while each new estimate agrees with its history within
+// k standard errors of the difference, and restarts from the new estimate (n = 1) when one does not
+// (a light or an object moved); a short moving average catches changes smaller than one update's
+// noise within a few updates. Probes whose rays see back faces too often are inside geometry: they
 // are inactive, get no rays and stay zero. Output is the codec's ProbeVolume (probe_volume.h): 27
 // floats per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
 #pragma once
@@ -26,7 +32,10 @@ struct UpdaterOptions {
   uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32
   uint32_t maxBounces = 4;         // surface interactions per path
   float indirectClamp = 16.0f;     // max luminance of one contribution after the first bounce; 0 = off
-  float minBlendWeight = 0.05f;    // w_min of the temporal blend
+  float minBlendWeight = 0.0f;     // w_min of the temporal blend (0: a true mean until rejected)
+  // History rejection: restart a probe whose new estimate (or short moving average) differs from
+  // its history by more than this many standard errors of the difference; 0 = off (plain blend).
+  float rejectSigmas = 4.0f;
   uint32_t seed = 1;
   bool classify = true;            // mark probes inside geometry inactive
   uint32_t classifySamples = 64;
@@ -44,6 +53,7 @@ struct UpdateStats {
   uint64_t shadowRays = 0;      // next-event rays (first hit ends them)
   uint32_t activeProbes = 0;
   uint64_t droppedSamples = 0;  // non-finite path samples replaced by 0 (a defect if ever nonzero)
+  uint32_t restartedProbes = 0; // probes whose history was rejected this update
 };
 
 class ProbeUpdater {

@@ -98,12 +98,12 @@ class ProbeHub {
   // Layout, bounds and epoch read together (an edge's change with the producer's epoch).
   bus::Volume volume() const;
 
-  // A new lighting frame (27 floats per probe, sh.h layout; active mask or null). Each changed
-  // brick gets a new version, encoded once. Wakes subscribers that wait for data. Producer hubs
-  // only (std::logic_error on an edge's).
-  void publish(const float* probes, const uint8_t* active);
-  // The same for a volume, which must pass checkProbeVolume and have the hub's grid size
-  // (std::invalid_argument otherwise, nothing published).
+  // A new lighting frame (27 floats per probe, sh.h layout; active mask or null; per-probe noise
+  // or null, see EncoderOptions::noiseScale). Each changed brick gets a new version, encoded once.
+  // Wakes subscribers that wait for data. Producer hubs only (std::logic_error on an edge's).
+  void publish(const float* probes, const uint8_t* active, const float* noise = nullptr);
+  // The same for a volume (its noise too, when it has one), which must pass checkProbeVolume and
+  // have the hub's grid size (std::invalid_argument otherwise, nothing published).
   void publish(const ProbeVolume& volume);
   // Every brick version publish() makes, keyframe and delta, is handed to `output` (called on the
   // publishing thread, outside the hub's lock). Producer hubs only.

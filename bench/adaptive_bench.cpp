@@ -1,0 +1,249 @@
+#include "adaptive_bench.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "probecast/codec/stream.h"
+#include "probecast/imaging/image_metrics.h"
+#include "probecast/imaging/svg_chart.h"
+#include "probecast/renderer/raster_client.h"
+#include "probecast/renderer/reference_camera.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/stats.h"
+#include "stability.h"
+#include "update_bench.h"
+
+namespace probecast::bench {
+namespace {
+
+// One stream a rule's volumes go through: what it cost per frame, and what it holds.
+struct Stream {
+  std::string name;
+  EncoderOptions options;
+  bool withNoise = false;
+  std::unique_ptr<StreamEncoder> encoder;
+  std::vector<double> bytesPerProbe;  // per frame
+};
+
+double mean(const std::vector<double>& v, size_t from, size_t to) {
+  if (to <= from) return 0.0;
+  return std::accumulate(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(to), 0.0) /
+         static_cast<double>(to - from);
+}
+
+struct Moment {
+  const char* name;
+  uint32_t frame;  // the update after which it is measured
+  float t;
+};
+
+}  // namespace
+
+AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
+  const auto say = [&](const std::string& s) {
+    if (o.progress) o.progress(s);
+  };
+  renderer::VulkanContext context(o.context);
+  const auto sceneAt = [&](float t) { return session::loadSceneOrThrow(o.sceneSpec, t); };
+  const scene::Scene first = sceneAt(0.0f);
+  const ProbeGrid grid = renderer::sceneGrid(first, o.dims);
+  const uint32_t count = grid.count();
+  const uint32_t frames = 2 * o.stillUpdates + o.movingUpdates;
+  const float movedT = o.lightStep * static_cast<float>(o.movingUpdates);
+  const auto tAt = [&](uint32_t frame) {  // the light's t during update `frame` (0-based)
+    if (frame < o.stillUpdates) return 0.0f;
+    return o.lightStep * static_cast<float>(std::min(frame - o.stillUpdates + 1, o.movingUpdates));
+  };
+  const StreamLayout layout = streamLayoutFor(grid, o.repr, 4);
+
+  // Converged float volumes where images are scored: end of each phase.
+  const std::vector<Moment> moments = {{"still", o.stillUpdates - 1, 0.0f},
+                                       {"moving", o.stillUpdates + o.movingUpdates - 1, movedT},
+                                       {"still_again", frames - 1, movedT}};
+  const renderer::CameraView camera = renderer::CameraView::fromScene(first);
+  std::vector<ProbeVolume> converged;
+  for (const Moment& m : moments) {
+    say(fmt::format("adaptive bench: converged volume at t = {:g}", m.t));
+    renderer::UpdaterOptions ro;
+    ro.samplesPerProbe = 512;
+    ro.rejectSigmas = 0.0f;
+    ro.seed = 4242;
+    renderer::ProbeUpdater u(context, sceneAt(m.t), grid, ro);
+    for (int k = 0; k < 16; ++k) u.update();
+    converged.push_back(u.volume());
+  }
+  const auto render = [&](const ProbeVolume& v, float t) {
+    renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
+    raster.setProbes(v);
+    return raster.render(raster.viewProjection(camera), camera.position);
+  };
+  std::vector<renderer::Image> truthImages;
+  for (size_t i = 0; i < moments.size(); ++i) truthImages.push_back(render(converged[i], moments[i].t));
+
+  AdaptiveBenchResult r;
+  nlohmann::json& j = r.json;
+  j["command"] = o.command;
+  j["device"] = context.deviceName();
+  j["scene"] = first.name;
+  j["grid"] = {o.dims[0], o.dims[1], o.dims[2]};
+  j["samples_per_probe"] = o.samplesPerProbe;
+  j["phases"] = {{"still", o.stillUpdates}, {"moving", o.movingUpdates}, {"still_again", o.stillUpdates},
+                 {"light_step_t", o.lightStep}};
+  j["representation"] = representationName(o.repr);
+  j["deadzone"] = o.deadzone;
+  j["noise_scale"] = o.noiseScale;
+  j["metric"] = "flicker: median relative irradiance change per update over the last half of a still phase; PSNR of "
+                "the raster view against the one from a converged float volume (plain gamma 2.2)";
+  std::string& table = r.table;
+  table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", first.name, o.dims[0],
+                      o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
+                      context.deviceName());
+  table += fmt::format("{:<14} {:<7} {:>9} {:>9} {:>9} {:>9} {:>11}\n", "rule", "stream", "still B", "moving B",
+                       "again B", "flicker", "PSNR loss");
+
+  std::vector<BlendRule> rules;
+  for (float w : o.fixedWMins) rules.push_back({w, 0.0f});
+  rules.push_back({0.0f, o.rejectSigmas});
+  const auto ruleName = [](const BlendRule& b) {
+    return b.rejectSigmas > 0 ? fmt::format("adaptive k={:g}", b.rejectSigmas) : fmt::format("w_min {:g}", b.wMin);
+  };
+  std::vector<imaging::ChartSeries> bytesSeries;
+  for (const BlendRule& rule : rules) {
+    say(fmt::format("adaptive bench: {}", ruleName(rule)));
+    renderer::UpdaterOptions uo;
+    uo.samplesPerProbe = o.samplesPerProbe;
+    uo.minBlendWeight = rule.wMin;
+    uo.rejectSigmas = rule.rejectSigmas;
+    renderer::ProbeUpdater u(context, first, grid, uo);
+    std::vector<Stream> streams(3);
+    streams[0].name = "full";  // every quantised change
+    streams[1].name = "deadzone";
+    streams[1].options.deadzone = o.deadzone;
+    streams[2].name = "noise";
+    streams[2].options.deadzone = o.deadzone;
+    streams[2].options.noiseScale = o.noiseScale;
+    streams[2].withNoise = true;
+    for (Stream& s : streams) s.encoder = std::make_unique<StreamEncoder>(layout, s.options);
+    std::vector<double> changes;
+    std::vector<uint32_t> restarts;
+    std::vector<float> previous;
+    nlohmann::json ruleJson = {{"rule", ruleName(rule)}, {"w_min", rule.wMin}, {"reject_sigmas", rule.rejectSigmas}};
+    std::vector<std::vector<double>> psnr(streams.size());
+    std::vector<uint8_t> frame;
+    for (uint32_t f = 0; f < frames; ++f) {
+      if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) u.setScene(sceneAt(tAt(f)));
+      restarts.push_back(u.update().restartedProbes);
+      const ProbeVolume& v = u.volume();
+      changes.push_back(previous.empty() ? 0.0 : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), count));
+      previous = v.probes;
+      for (Stream& s : streams) {
+        const uint32_t changed = s.encoder->update(v.probes.data(), v.active.data(), s.withNoise ? v.noise.data() : nullptr);
+        s.encoder->writeChangedFrame(frame);
+        // Frame 0 is the keyframe; a frame that changes no brick is never sent.
+        s.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / count);
+      }
+      for (size_t m = 0; m < moments.size(); ++m) {
+        if (moments[m].frame != f) continue;
+        for (size_t k = 0; k < streams.size(); ++k) {
+          ProbeVolume held;
+          streams[k].encoder->copyVolume(grid.bounds, held);
+          const renderer::Image img = render(held, moments[m].t);
+          psnr[k].push_back(imaging::compareImages(img.rgb, truthImages[m].rgb, static_cast<int>(o.width),
+                                                   static_cast<int>(o.height))
+                                .psnrDb);
+        }
+      }
+    }
+    const auto flickerOver = [&](uint32_t end) {
+      const std::vector<double> tail(changes.begin() + (end - o.stillUpdates / 2), changes.begin() + end);
+      return session::median(tail);
+    };
+    ruleJson["flicker_rel"] = flickerOver(frames);
+    ruleJson["restarted_probes_per_update"] = restarts;
+    ruleJson["flicker_rel_first_still"] = flickerOver(o.stillUpdates);
+    for (size_t k = 0; k < streams.size(); ++k) {
+      const Stream& s = streams[k];
+      const size_t a = o.stillUpdates, b = o.stillUpdates + o.movingUpdates;
+      nlohmann::json sj = {{"stream", s.name},
+                           {"static_bytes_per_probe_frame", mean(s.bytesPerProbe, frames - o.stillUpdates / 2, frames)},
+                           {"first_still_bytes_per_probe_frame", mean(s.bytesPerProbe, a / 2, a)},
+                           {"moving_bytes_per_probe_frame", mean(s.bytesPerProbe, a, b)},
+                           {"bytes_per_probe_frame", s.bytesPerProbe}};
+      for (size_t m = 0; m < moments.size(); ++m) {
+        sj["psnr_db"][moments[m].name] = psnr[k][m];
+        sj["psnr_loss_db"][moments[m].name] = psnr[0][m] - psnr[k][m];
+      }
+      double worstLoss = 0;
+      for (size_t m = 0; m < moments.size(); ++m) worstLoss = std::max(worstLoss, psnr[0][m] - psnr[k][m]);
+      sj["worst_psnr_loss_db"] = worstLoss;
+      table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>8.3f} dB\n", ruleName(rule), s.name,
+                           mean(s.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),
+                           sj["static_bytes_per_probe_frame"].get<double>(), 100 * ruleJson["flicker_rel"].get<double>(),
+                           worstLoss);
+      ruleJson["streams"].push_back(sj);
+      if (s.name == "full") continue;
+      const bool adaptiveNoise = rule.rejectSigmas > 0 && s.withNoise;
+      if (!adaptiveNoise && s.withNoise) continue;  // the chart: fixed rules as streamed today, adaptive both ways
+      imaging::ChartSeries series{ruleName(rule) + ", " + s.name + " stream", {}, true};
+      for (uint32_t f = 1; f < frames; ++f) series.points.push_back({static_cast<double>(f), s.bytesPerProbe[f], ""});
+      bytesSeries.push_back(std::move(series));
+    }
+    j["rules"].push_back(ruleJson);
+  }
+  imaging::ChartSpec bytesSpec;
+  bytesSpec.title = fmt::format("Wire bytes per probe per frame: light still, moving (updates {}-{}), still", o.stillUpdates,
+                                o.stillUpdates + o.movingUpdates);
+  bytesSpec.xLabel = "update";
+  bytesSpec.yLabel = "bytes per probe per frame";
+  bytesSpec.footnote = o.command;
+  r.svgBytes = imaging::renderSvgChart(bytesSpec, bytesSeries);
+
+  say("adaptive bench: light jump");
+  const std::vector<FlickerLag> jump = measureFlickerLag(context, rules, o.samplesPerProbe, o.jumpUpdates);
+  std::vector<imaging::ChartSeries> jumpSeries;
+  table += "light jump (builtin:cornell 4x4x4, t 0 -> 0.5):\n";
+  for (size_t i = 0; i < jump.size(); ++i) {
+    const FlickerLag& f = jump[i];
+    j["jump"].push_back({{"rule", ruleName(rules[i])},
+                         {"flicker_rel", f.flickerRel},
+                         {"error_before_jump", f.errorBeforeJump},
+                         {"error_after_jump", f.errorAfterJump},
+                         {"fresh_error", f.freshError},
+                         {"follow_updates", f.updatesToFollow},
+                         {"reconvergence_updates", f.updatesToRecover}});
+    table += fmt::format("  {:<14} follows in {} updates, back to the pre-jump error in {} (flicker {:.2f}%)\n",
+                         ruleName(rules[i]), f.updatesToFollow < 0 ? "> " + std::to_string(o.jumpUpdates) : std::to_string(f.updatesToFollow),
+                         f.updatesToRecover < 0 ? "> " + std::to_string(o.jumpUpdates) : std::to_string(f.updatesToRecover),
+                         100 * f.flickerRel);
+    imaging::ChartSeries series{ruleName(rules[i]), {}, true};
+    for (size_t k = 0; k < f.errorAfterJump.size(); ++k)
+      series.points.push_back({static_cast<double>(k + 1), f.errorAfterJump[k], ""});
+    jumpSeries.push_back(std::move(series));
+  }
+  imaging::ChartSeries freshSeries{"fresh start on the new lighting", {}, true};
+  for (size_t k = 0; k < jump.back().freshError.size(); ++k)
+    freshSeries.points.push_back({static_cast<double>(k + 1), jump.back().freshError[k], ""});
+  jumpSeries.push_back(std::move(freshSeries));
+  imaging::ChartSpec jumpSpec;
+  jumpSpec.title = "Irradiance error after the light jumps (builtin:cornell, 4x4x4)";
+  jumpSpec.xLabel = "updates after the jump";
+  jumpSpec.yLabel = "relative irradiance RMSE against the converged new lighting";
+  jumpSpec.logY = true;
+  jumpSpec.footnote = o.command;
+  r.svgJump = imaging::renderSvgChart(jumpSpec, jumpSeries);
+
+  // The headline: the adaptive rule with the noise-aware stream.
+  const nlohmann::json& adaptive = j["rules"].back();
+  const nlohmann::json& noise = adaptive["streams"][2];
+  j["summary"] = {{"static_bytes_per_probe_frame", noise["static_bytes_per_probe_frame"]},
+                  {"moving_bytes_per_probe_frame", noise["moving_bytes_per_probe_frame"]},
+                  {"flicker_rel", adaptive["flicker_rel"]},
+                  {"follow_updates", j["jump"].back()["follow_updates"]},
+                  {"reconvergence_updates", j["jump"].back()["reconvergence_updates"]},
+                  {"worst_psnr_loss_db", noise["worst_psnr_loss_db"]}};
+  return r;
+}
+
+}  // namespace probecast::bench

@@ -1,0 +1,47 @@
+// `probecast bench adaptive`: adaptive blending (history rejection) and the noise-aware stream
+// against fixed blend weights, on an animated scene: light still → moving → still. Wire bytes per
+// probe per frame through the phases, flicker when still, updates to follow a light jump, and the
+// image cost of not re-sending noise (PSNR of a raster view against a converged volume).
+#pragma once
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "probecast/codec/record.h"
+#include "probecast/renderer/probe_updater.h"
+
+namespace probecast::bench {
+
+struct AdaptiveBenchOptions {
+  std::string sceneSpec = "builtin:cornell";  // an animated scene: t moves its light
+  std::array<uint32_t, 3> dims = {4, 4, 4};
+  uint32_t samplesPerProbe = 32;
+  uint32_t stillUpdates = 96;        // light still at t = 0 (then the same after moving)
+  uint32_t movingUpdates = 32;       // light moving by lightStep of t per update
+  float lightStep = 0.004f;
+  float rejectSigmas = 4.0f;         // the adaptive rule (w_min = 0)
+  std::vector<float> fixedWMins = {0.02f, 0.05f, 0.25f};  // the fixed rules compared
+  float noiseScale = 2.0f;           // the noise-aware stream's c
+  int deadzone = 1;                  // both streams
+  Representation repr = Representation::Zh3;
+  uint32_t jumpUpdates = 48;         // updates charted after the light jump
+  uint32_t width = 160, height = 100;
+  renderer::ContextOptions context;
+  std::string command;
+  std::function<void(const std::string&)> progress;
+};
+
+struct AdaptiveBenchResult {
+  nlohmann::json json;
+  std::string table;
+  std::string svgBytes;  // bytes per probe per frame through still → moving → still
+  std::string svgJump;   // error against updates after a light jump
+};
+
+AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& options);
+
+}  // namespace probecast::bench

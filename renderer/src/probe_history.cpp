@@ -1,0 +1,134 @@
+// History rejection and the running noise estimate of each probe (probe_history.h).
+#include "probe_history.h"
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <utility>
+
+namespace probecast::renderer {
+namespace {
+
+constexpr float kFastWeight = 0.25f;  // the short moving average: ≈ the last 7 estimates
+// The within-update estimate counts as this many degrees of freedom next to the Welford sum of
+// squares (m − 1 of them after m estimates): it decides right after a restart, then fades.
+constexpr float kSpreadDegrees = 4.0f;
+// A change of this fraction of the history's luminance is never called noise-free: it keeps a
+// probe with a (near) deterministic estimate from restarting on rounding.
+constexpr float kRelativeFloor = 1e-3f;
+
+void addStatistics(ProbeHistory& h, const float estimate[27], const float spread[kHistoryLuma]) {
+  ++h.welfordCount;
+  ++h.spreadCount;
+  for (int k = 0; k < kHistoryLuma; ++k) {
+    const float x = coefficientLuminance(estimate, k);
+    const float delta = x - h.mean[k];
+    h.mean[k] += delta / static_cast<float>(h.welfordCount);
+    h.m2[k] += delta * (x - h.mean[k]);
+    h.spreadVariance[k] += (spread[k] - h.spreadVariance[k]) / static_cast<float>(h.spreadCount);
+  }
+}
+
+// The history becomes `probe`, worth `n` estimates; the statistics restart from `estimates`.
+void restart(ProbeHistory& h, float probe[27], const float value[27], uint32_t n,
+             std::initializer_list<std::pair<const float*, const float*>> estimates) {
+  std::copy(value, value + 27, probe);
+  std::copy(value, value + 27, h.fast);
+  h.n = n;
+  h.varianceFactor = 1.0f / static_cast<float>(n);
+  h.fastCount = n;
+  h.fastFactor = h.varianceFactor;
+  h.welfordCount = 0;
+  h.spreadCount = 0;
+  std::fill(h.mean, h.mean + kHistoryLuma, 0.0f);
+  std::fill(h.m2, h.m2 + kHistoryLuma, 0.0f);
+  std::fill(h.spreadVariance, h.spreadVariance + kHistoryLuma, 0.0f);
+  for (auto [estimate, spread] : estimates) addStatistics(h, estimate, spread);
+  h.pending = false;
+}
+
+// Blends one estimate into the history; `fastInput` is what the short average gets (the history
+// itself for an estimate that disagreed on its own, so one outlier cannot move it far).
+void accumulate(ProbeHistory& h, float probe[27], const float estimate[27], const float spread[kHistoryLuma],
+                const float fastInput[27], float minBlendWeight) {
+  ++h.n;
+  const float w = std::max(1.0f / static_cast<float>(h.n), minBlendWeight);
+  for (int i = 0; i < 27; ++i) probe[i] = (1.0f - w) * probe[i] + w * estimate[i];
+  h.varianceFactor = (1.0f - w) * (1.0f - w) * h.varianceFactor + w * w;
+  addStatistics(h, estimate, spread);
+  ++h.fastCount;
+  const float wf = std::max(1.0f / static_cast<float>(h.fastCount), kFastWeight);
+  for (int i = 0; i < 27; ++i) h.fast[i] = (1.0f - wf) * h.fast[i] + wf * fastInput[i];
+  h.fastFactor = (1.0f - wf) * (1.0f - wf) * h.fastFactor + wf * wf;
+}
+
+// True when `a` and `b` differ by more than k standard errors in any of the luminances, the
+// difference having variance σ² · factor.
+bool disagree(const ProbeHistory& h, const float a[27], const float b[27], float factor, float k) {
+  for (int c = 0; c < kHistoryLuma; ++c) {
+    const float d = coefficientLuminance(a, c) - coefficientLuminance(b, c);
+    const float floor = kRelativeFloor * std::fabs(coefficientLuminance(b, 0));
+    const float variance = estimateVariance(h, c) * factor + floor * floor;
+    if (d * d > k * k * variance) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+float coefficientLuminance(const float probe[27], int coefficient) {
+  const float* c = probe + coefficient * 3;
+  return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+float estimateVariance(const ProbeHistory& h, int k) {
+  const float dof = h.welfordCount > 1 ? static_cast<float>(h.welfordCount - 1) : 0.0f;
+  return (h.m2[k] + kSpreadDegrees * h.spreadVariance[k]) / (dof + kSpreadDegrees);
+}
+
+float historyStandardError(const ProbeHistory& h) {
+  return h.n == 0 ? 0.0f : std::sqrt(std::max(0.0f, estimateVariance(h, 0) * h.varianceFactor));
+}
+
+BlendOutcome blendEstimate(ProbeHistory& h, float probe[27], const float estimate[27],
+                           const float spread[kHistoryLuma], const HistoryOptions& o) {
+  if (h.n == 0) {
+    restart(h, probe, estimate, 1, {{estimate, spread}});
+    return BlendOutcome::Accumulated;
+  }
+  if (!(o.rejectSigmas > 0.0f)) {
+    accumulate(h, probe, estimate, spread, estimate, o.minBlendWeight);
+    return BlendOutcome::Accumulated;
+  }
+  const float k = o.rejectSigmas;
+  // A new estimate and the history differ by noise of variance σ² (1 + f) when nothing moved.
+  const bool alone = disagree(h, estimate, probe, 1.0f + h.varianceFactor, k);
+  if (h.pending) {
+    float pair[27];
+    for (int i = 0; i < 27; ++i) pair[i] = 0.5f * (h.pendingEstimate[i] + estimate[i]);
+    if (disagree(h, pair, probe, 0.5f + h.varianceFactor, k)) {
+      restart(h, probe, pair, 2, {{h.pendingEstimate, h.pendingSpread}, {estimate, spread}});
+      return BlendOutcome::Restarted;
+    }
+    h.pending = false;
+    accumulate(h, probe, h.pendingEstimate, h.pendingSpread, probe, o.minBlendWeight);
+  } else if (alone) {
+    std::copy(estimate, estimate + 27, h.pendingEstimate);
+    std::copy(spread, spread + kHistoryLuma, h.pendingSpread);
+    h.pending = true;
+    return BlendOutcome::Held;
+  }
+  accumulate(h, probe, estimate, spread, alone ? probe : estimate, o.minBlendWeight);
+  // A change below one update's noise shows in the short average within a few updates. Their
+  // difference has variance at most σ² (f_fast + f) (the two share samples, which only lowers it).
+  if (disagree(h, h.fast, probe, h.fastFactor + h.varianceFactor, k)) {
+    float fast[27];
+    std::copy(h.fast, h.fast + 27, fast);
+    const uint32_t n = std::max(1u, static_cast<uint32_t>(std::lround(1.0f / h.fastFactor)));
+    restart(h, probe, fast, n, {{estimate, spread}});
+    return BlendOutcome::RestartedFromAverage;
+  }
+  return BlendOutcome::Accumulated;
+}
+
+}  // namespace probecast::renderer

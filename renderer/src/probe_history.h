@@ -1,0 +1,58 @@
+// Per-probe temporal statistics and the blending rule of the probe updater (probe_updater.h).
+//
+// Every update gives each probe a fresh estimate x (27 floats) and, from the spread of the
+// estimate's independent partial sums, an estimate of its variance. Path-traced estimates have a
+// heavy tail (a bright path now and then), so one disagreeing estimate only raises suspicion: it
+// is held back, and the history restarts when the mean of it and the next estimate disagrees too
+// (an outlier followed by a normal estimate is blended in as usual, keeping the mean unbiased). The history keeps, for the
+// luminance of c00 and of the three L1 coefficients, a Welford mean and sum of squares of the
+// per-update estimates since its last restart; their variance σ² (pooled with the within-update
+// estimate, which is all there is right after a restart) sets the standard error of the history,
+// σ √f, where f = Var(history) / σ² follows the blend weights (f = 1/n for a true mean).
+#pragma once
+
+#include <cstdint>
+
+namespace probecast::renderer {
+
+constexpr int kHistoryLuma = 4;  // c00 and the L1 coefficients (sh.h order), as luminance
+
+struct HistoryOptions {
+  float minBlendWeight = 0.0f;  // w_min: w = max(1/n, w_min)
+  float rejectSigmas = 0.0f;    // k: restart beyond k standard errors of the difference; 0 = never
+};
+
+struct ProbeHistory {
+  uint32_t n = 0;                   // estimates blended since the last restart
+  float varianceFactor = 0.0f;      // f = Var(history) / σ²
+  uint32_t welfordCount = 0;
+  float mean[kHistoryLuma] = {};    // Welford mean of the per-update luminance estimates
+  float m2[kHistoryLuma] = {};      // and their sum of squared deviations
+  uint32_t spreadCount = 0;
+  float spreadVariance[kHistoryLuma] = {};  // mean within-update variance estimate since the restart
+  uint32_t fastCount = 0;
+  float fastFactor = 0.0f;          // Var(fast) / σ²
+  float fast[27] = {};              // short moving average of the estimates
+  bool pending = false;             // the last estimate disagreed: held back until the next one
+  float pendingEstimate[27] = {};
+  float pendingSpread[kHistoryLuma] = {};
+};
+
+// Accumulated: blended in. Held: it disagreed, the next estimate decides. Restarted: it and the
+// held one agree with each other, not with the history. RestartedFromAverage: the short average
+// drifted away from the history.
+enum class BlendOutcome { Accumulated, Held, Restarted, RestartedFromAverage };
+
+// Blends `estimate` into `probe` (27 floats) under the rule above; `spreadVariance` is this
+// update's within-update variance estimate of the kHistoryLuma luminances.
+BlendOutcome blendEstimate(ProbeHistory& history, float probe[27], const float estimate[27],
+                           const float spreadVariance[kHistoryLuma], const HistoryOptions& options);
+
+// σ² of one update's estimate of luminance `k` (0 = c00), as the history knows it.
+float estimateVariance(const ProbeHistory& history, int k);
+// Standard error of the luminance of the history's c00 (ProbeVolume::noise).
+float historyStandardError(const ProbeHistory& history);
+
+float coefficientLuminance(const float probe[27], int coefficient);
+
+}  // namespace probecast::renderer
