@@ -137,7 +137,7 @@ struct TracerOptions {
   uint32_t spp = 128;
   uint32_t bounces = 4;
   uint32_t seed = 1;
-  float wMin = 0.0f;
+  float wMin = 0.05f;
   float rejectSigmas = 4.0f;
   float clamp = 16.0f;
   void add(CLI::App* cmd) {

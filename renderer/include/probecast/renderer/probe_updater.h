@@ -32,7 +32,7 @@ struct UpdaterOptions {
   uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32
   uint32_t maxBounces = 4;         // surface interactions per path
   float indirectClamp = 16.0f;     // max luminance of one contribution after the first bounce; 0 = off
-  float minBlendWeight = 0.0f;     // w_min of the temporal blend (0: a true mean until rejected)
+  float minBlendWeight = 0.05f;    // w_min of the temporal blend (0: a true mean until rejected)
   // History rejection: restart a probe whose new estimate (or short moving average) differs from
   // its history by more than this many standard errors of the difference; 0 = off (plain blend).
   float rejectSigmas = 4.0f;
