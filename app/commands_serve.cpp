@@ -24,6 +24,7 @@ struct ServeOptions {
   std::string probes, repr = "zh3";
   std::string publish, stream = "probes";
   int brick = 4, deadzone = 1;
+  float noiseScale = 0.0f;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
 
@@ -39,6 +40,8 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   if (!o.probes.empty()) {
     if (tr.scene.environment.given())
       throw std::runtime_error("--environment and --sky light live tracing; a --probes file was traced already");
+    if (o.noiseScale > 0.0f)
+      throw std::runtime_error("--noise-scale needs live tracing: a --probes file carries no per-probe noise");
     std::string error;
     orThrow(readProbeFile(o.probes, file, error), error);
     hub = service::hubConfigFor(file.grid, repr, o.brick, o.deadzone);
@@ -49,6 +52,7 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     hub = service::hubConfigFor(g, repr, o.brick, o.deadzone);
     what = s.name;
   }
+  hub.encoder.noiseScale = o.noiseScale;
   if (!isValidLayout(hub.layout)) throw std::runtime_error("grid too large for the stream format");
   auto producer = std::make_unique<session::ProbeProducer>(hub);
   if (o.probes.empty()) {
@@ -72,6 +76,10 @@ void addServeCommand(CLI::App& app) {
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
   serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
       ->check(CLI::Range(0, 127));
+  serve->add_option("--noise-scale", o->noiseScale,
+                    "live: a probe is not re-sent while its change stays within this many standard errors of its "
+                    "Monte Carlo noise (0 = off; bench adaptive measures 2)")
+      ->check(CLI::Range(0.0f, 1000.0f));
   o->server.add(serve);
   CLI::Option* publish =
       serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
