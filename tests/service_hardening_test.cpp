@@ -429,3 +429,38 @@ TEST(ServiceHardening, LightFieldViewSetsUpToTheRendererLimit) {
 
 }  // namespace
 }  // namespace probecast::service
+
+namespace probecast::service {
+namespace {
+
+// A resuming Hello lists every brick it holds; the message limit grows with the volume's bricks,
+// so a client holding a large volume can resume (it was refused above about 8k bricks).
+TEST(ServiceHardening, ResumingHelloOfManyBricksIsAccepted) {
+  HubConfig hc = volumeConfig();
+  hc.layout.grid[0] = 32;
+  hc.layout.grid[1] = 8;
+  hc.layout.grid[2] = 32;
+  hc.layout.brickDim = 1;  // 8192 bricks
+  ProbeHub hub(hc);
+  ProbeServer server(plaintextConfig(), hub);
+  auto stub = stubFor(server.port());
+  auto helloHolding = [](uint32_t entries) {
+    pb::ClientMessage hello = helloMessage();
+    for (uint32_t i = 0; i < entries; ++i) {
+      pb::BrickVersion* held = hello.mutable_hello()->add_held();
+      held->set_brick(i % 8192);
+      held->set_version(0x7fffffffu - i);
+    }
+    return hello;
+  };
+  const pb::ClientMessage holdsAll = helloHolding(8192);
+  ASSERT_GT(holdsAll.ByteSizeLong(), plaintextConfig().maxMessageBytes);
+  EXPECT_EQ(statusAfter(*stub, holdsAll, nullptr, 300ms).error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  // Far more entries than bricks is still refused, by size.
+  const grpc::Status tooLong = statusAfter(*stub, helloHolding(8192 * 3));
+  EXPECT_EQ(tooLong.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(tooLong.error_message().find("exceeds the limit"), std::string::npos) << tooLong.error_message();
+}
+
+}  // namespace
+}  // namespace probecast::service

@@ -26,6 +26,15 @@ namespace pb = probecast::v1;
 // does not parse is refused, where the generated code would end the stream as if it were closed.
 using RawReactor = grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>;
 
+// The most one held brick adds to a Hello: the field's tag and length, then brick and version as
+// tagged varints of up to 5 bytes each.
+constexpr size_t kHeldBrickWireBytes = 14;
+
+// A resuming Hello lists every brick it holds, so its limit grows with the volume's bricks.
+size_t helloLimit(const ServerConfig& config, const StreamLayout& layout) {
+  return config.maxMessageBytes + (isValidLayout(layout) ? kHeldBrickWireBytes * brickCount(layout) : 0);
+}
+
 bool authorized(grpc::CallbackServerContext* ctx, const std::string& token, bool noAuth) {
   if (token.empty()) return noAuth;  // the constructor refuses an empty token without noAuth
   const auto& md = ctx->client_metadata();
@@ -190,9 +199,9 @@ class SubscribeReactor : public RawReactor {
 
   grpc::Status handleBytes() {
     const size_t size = inBytes_.Length();
-    if (size > config_.maxMessageBytes)
-      return invalid("message of " + std::to_string(size) + " bytes exceeds the limit of " +
-                     std::to_string(config_.maxMessageBytes));
+    const size_t limit = id_ ? config_.maxMessageBytes : helloLimit(config_, hub_.layout());
+    if (size > limit)
+      return invalid("message of " + std::to_string(size) + " bytes exceeds the limit of " + std::to_string(limit));
     in_.Clear();
     if (!grpc::SerializationTraits<pb::ClientMessage>::Deserialize(&inBytes_, &in_).ok())
       return invalid("a message of " + std::to_string(size) + " bytes is not a valid probecast.v1.ClientMessage");
@@ -375,7 +384,11 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
   builder.AddListeningPort(config.listen, creds, &s.port);
   builder.RegisterService(s.service.get());
   // gRPC's own cap sits above ours so an oversized message reaches the reactor's clear refusal.
-  builder.SetMaxReceiveMessageSize(static_cast<int>(std::max<uint32_t>(config.maxMessageBytes * 4, 1 << 20)));
+  // An edge learns its layout from the bus later: its cap covers a Hello of a million bricks.
+  const StreamLayout layout = hub.layout();
+  const size_t hello = isValidLayout(layout) ? helloLimit(config, layout) : config.maxMessageBytes + (size_t{16} << 20);
+  const size_t cap = std::max<size_t>({size_t{config.maxMessageBytes} * 4, size_t{1} << 20, hello * 2});
+  builder.SetMaxReceiveMessageSize(static_cast<int>(std::min<size_t>(cap, size_t{1} << 30)));
   s.server = builder.BuildAndStart();
   if (!s.server || s.port == 0) throw std::runtime_error("cannot listen on " + config.listen);
   if (auto* health = s.server->GetHealthCheckService()) health->SetServingStatus("probecast.v1.ProbeStream", true);

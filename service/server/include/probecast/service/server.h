@@ -21,7 +21,8 @@ struct ServerConfig {
   uint32_t maxSubscribers = 1024;
   uint32_t maxViews = kMaxViewsPerSet;  // per view update: any view set a renderer draws
   // Largest client message accepted. A view is about 83 bytes on the wire (16 packed floats and
-  // three eye floats), so kMaxViewsPerSet views take about 21 KiB.
+  // three eye floats), so kMaxViewsPerSet views take about 21 KiB. A Hello may add 14 bytes per
+  // brick of the volume for the versions a resuming client holds.
   uint32_t maxMessageBytes = 64 * 1024;
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
