@@ -14,6 +14,7 @@
 #include "probecast/service/bus_nats.h"
 #include "probecast/service/client.h"
 #include "probecast/service/edge_server.h"
+#include "probecast/session/edge_process.h"
 #include "probecast/session/nats_server.h"
 #include "service_test_support.h"
 #include "test_probes.h"
@@ -135,6 +136,38 @@ TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyfra
         << "client " << i << "; versions superseded before publishing: " << producer.publisher.stats().superseded;
     EXPECT_GT(st.deltasReceived, before[i].deltasReceived) << "client " << i;
   }
+}
+
+// An edge that hangs (SIGSTOP) keeps its TCP connections open and sends nothing: only keepalive
+// pings notice. Its subscribers must fail over to the other edge, not wait forever.
+TEST_F(Edge, AFrozenEdgeIsNoticedByKeepaliveAndItsSubscribersFailOver) {
+  BusProducer producer(bus);
+  EdgeConfig fast = edgeConfig();
+  fast.server.minClientPingMs = 100;
+  session::EdgeProcess a(fast);
+  const int portA = a.start();
+  EdgeServer b(fast);
+  const std::string onA = "127.0.0.1:" + std::to_string(portA), onB = "127.0.0.1:" + std::to_string(b.port());
+  producer.publish(1);
+  ProbeClient probe(clientFor({portA}));  // the edge process serves once it holds the volume
+  probe.start();
+  ASSERT_TRUE(waitFor([&] { return matchesServer(probe, producer.hub); }, 10s));
+  probe.stop();
+  ClientConfig cc = clientFor({portA, b.port()});
+  cc.keepaliveMs = 200;
+  cc.keepaliveTimeoutMs = 500;
+  ProbeClient client(cc);
+  client.start();
+  producer.publish(5);
+  ASSERT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
+  ASSERT_EQ(client.stats().address, onA);
+  a.freeze();
+  producer.publish(5);
+  EXPECT_TRUE(waitFor([&] { return client.stats().connected && client.stats().address == onB; }, 10s))
+      << client.stats().lastError;
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
+  EXPECT_GE(client.stats().failovers, 1u);
+  a.thaw();
 }
 
 TEST_F(Edge, NatsServerRestartedEdgesAndProducerRecoverAndSubscribersConverge) {

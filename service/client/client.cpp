@@ -48,6 +48,10 @@ struct ProbeClient::Impl {
   std::shared_ptr<grpc::Channel> channel(const std::string& address) const {
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(256 << 20);
+    args.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, config.keepaliveMs);
+    args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, config.keepaliveTimeoutMs);
+    args.SetInt(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+    args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);  // a still volume sends nothing for long
     std::shared_ptr<grpc::ChannelCredentials> creds;
     if (config.tls) {
       grpc::SslCredentialsOptions options;

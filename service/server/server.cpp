@@ -389,6 +389,11 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
   const size_t hello = isValidLayout(layout) ? helloLimit(config, layout) : config.maxMessageBytes + (size_t{16} << 20);
   const size_t cap = std::max<size_t>({size_t{config.maxMessageBytes} * 4, size_t{1} << 20, hello * 2});
   builder.SetMaxReceiveMessageSize(static_cast<int>(std::min<size_t>(cap, size_t{1} << 30)));
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, config.minClientPingMs);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, config.keepaliveMs);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, config.keepaliveTimeoutMs);
   s.server = builder.BuildAndStart();
   if (!s.server || s.port == 0) throw std::runtime_error("cannot listen on " + config.listen);
   if (auto* health = s.server->GetHealthCheckService()) health->SetServingStatus("probecast.v1.ProbeStream", true);

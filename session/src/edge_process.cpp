@@ -50,7 +50,12 @@ void EdgeProcess::kill() {
   ended_ = true;
 }
 
+void EdgeProcess::freeze() { child_.signal(SIGSTOP); }
+
+void EdgeProcess::thaw() { child_.signal(SIGCONT); }
+
 int EdgeProcess::stop() {
+  child_.signal(SIGCONT);  // a frozen child would hold SIGTERM until it runs again
   child_.signal(SIGTERM);
   ended_ = true;
   return child_.wait();

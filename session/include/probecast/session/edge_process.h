@@ -21,6 +21,10 @@ class EdgeProcess {
   int start();
   // SIGKILL: the edge dies at once, its connections cut as a crashed machine's would.
   void kill();
+  // SIGSTOP: the edge hangs with its connections open, as a frozen machine does (only keepalive
+  // pings notice); thaw() (SIGCONT) lets it run on.
+  void freeze();
+  void thaw();
   // SIGTERM: it shuts down (ends its streams) and exits; returns its exit status.
   int stop();
 

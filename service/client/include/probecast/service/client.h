@@ -26,6 +26,11 @@ struct ClientConfig {
   std::string name = "probecast-client";
   int reconnectMinMs = 50;   // back-off after every server has failed in turn
   int reconnectMaxMs = 2000;
+  // HTTP/2 pings on the connection: a server that does not answer one within keepaliveTimeoutMs
+  // is gone (a frozen or unplugged machine never closes its TCP connections), and the client
+  // fails over. The server accepts pings this often (ServerConfig::minClientPingMs).
+  int keepaliveMs = 10000;
+  int keepaliveTimeoutMs = 5000;
   // zh3h streams: decode L1 only (ProbeVolume::zh3PerPixel) so a renderer can interpolate first
   // and hallucinate per pixel; false: hallucinate per probe when decoding.
   bool zh3PerPixel = false;

@@ -24,6 +24,12 @@ struct ServerConfig {
   // three eye floats), so kMaxViewsPerSet views take about 21 KiB. A Hello may add 14 bytes per
   // brick of the volume for the versions a resuming client holds.
   uint32_t maxMessageBytes = 64 * 1024;
+  // Keepalive: clients may ping this often (ClientConfig::keepaliveMs must not be shorter, or the
+  // server ends their connections); the server pings its own clients every keepaliveMs and drops
+  // one that does not answer within keepaliveTimeoutMs, so a vanished subscriber frees its slot.
+  int minClientPingMs = 5000;
+  int keepaliveMs = 30000;
+  int keepaliveTimeoutMs = 10000;
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
   static constexpr int kTickMs = 50;
