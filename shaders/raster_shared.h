@@ -25,7 +25,8 @@
 #define RS_SHADOW_NONE 0u              // unshadowed (no layer left for it)
 #define RS_SHADOW_CUBE 1u              // point light: six 90° faces +x −x +y −y +z −z
 #define RS_SHADOW_PERSPECTIVE 2u       // spot light: one perspective layer
-#define RS_SHADOW_ORTHO 3u             // directional light: one orthographic layer over the scene
+#define RS_SHADOW_ORTHO 3u             // directional light: 1..RS_MAX_CASCADES orthographic cascades
+#define RS_MAX_CASCADES 4u
 
 #ifdef __cplusplus
 namespace probecast::shaders {
@@ -39,12 +40,13 @@ struct RsView {
 struct RsShadowLight {
   uint kind;           // RS_SHADOW_*
   uint firstLayer;     // its first layer in the shadow map
-  float texelScale;    // world size of one texel: × distance to the light (perspective) or as is (ortho)
-  float pad;
+  float texelScale;    // world size of one texel: × distance to the light (perspective); ortho: per layer
+  uint cascades;       // layers of a directional light, finest first (1 for the other kinds)
 };
 
 struct RsShadowLayer {
   mat4 viewProj;       // world → the layer's clip space (same conventions as a view)
+  vec4 texel;          // x: world size of one texel of an orthographic layer (0 for the others)
 };
 
 struct RsPushConstants {
@@ -77,6 +79,7 @@ static_assert(sizeof(RsPushConstants) == 112);
 static_assert(sizeof(RsShadowPush) == 80);
 static_assert(sizeof(RsView) == 80);
 static_assert(sizeof(RsShadowLight) == 16);
+static_assert(sizeof(RsShadowLayer) == 80);
 }  // namespace probecast::shaders
 #endif
 

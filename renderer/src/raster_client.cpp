@@ -362,6 +362,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
   if (options.shadowMapSize < 16 || options.shadowMapSize > 8192)
     throw std::invalid_argument("shadow map size must be 16..8192");
+  if (options.shadowCascades < 1 || options.shadowCascades > RS_MAX_CASCADES)
+    throw std::invalid_argument("shadow cascades must be 1.." + std::to_string(RS_MAX_CASCADES));
   Impl& s = *impl_;
   s.d = &context.device();
   VulkanDevice& d = *s.d;
@@ -411,7 +413,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.layout = createPipelineLayout(d, s.setLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                                   sizeof(shaders::RsPushConstants));
   s.pipelineFor(0, RS_PASS_OPAQUE);
-  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, s.setLayout, s.shadows);
+  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, options.shadowCascades, s.setLayout, s.shadows);
 
   const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 2}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
@@ -493,6 +495,7 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   if (views.size() > Impl::kMaxViews)
     throw std::invalid_argument("at most " + std::to_string(Impl::kMaxViews) + " views per view set");
   std::vector<Image> out(views.size());
+  fitShadowCascades(views, s.shadows);
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;
   const auto t0 = Clock::now();
