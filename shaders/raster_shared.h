@@ -16,7 +16,10 @@
 #define RS_BINDING_SHADOW_LIGHTS 8     // RsShadowLight[], one per light
 #define RS_BINDING_SHADOW_LAYERS 9     // RsShadowLayer[], one per shadow-map layer
 #define RS_BINDING_SHADOW_MAP 10       // sampler2DArrayShadow: depth of every shadow layer
-#define RS_BINDING_COUNT 11
+#define RS_BINDING_SHADOW_TRANSMIT 11  // sampler2DArray: per shadow layer, rgb = transmittance of the
+                                       // transmissive casters before the opaque depth, a = the nearest one's depth
+#define RS_BINDING_COUNT 12
+#define RS_TRANSMIT_CLEAR_DEPTH 65504.0  // a of a texel no transmissive caster covers (largest half float)
 
 #define RS_PASS_OPAQUE 0u              // opaque and cut-out triangles, depth written
 #define RS_PASS_TRANSMIT 1u            // transmissive triangles: colour × T (blend: dst · src)
@@ -46,7 +49,8 @@ struct RsShadowLight {
 
 struct RsShadowLayer {
   mat4 viewProj;       // world → the layer's clip space (same conventions as a view)
-  vec4 texel;          // x: world size of one texel of an orthographic layer (0 for the others)
+  vec4 texel;          // x: world size of one texel of an orthographic layer (0 for the others);
+                       // y: 1 for a perspective layer (point, spot), 0 for an orthographic one
 };
 
 struct RsPushConstants {
@@ -69,7 +73,7 @@ struct RsPushConstants {
 struct RsShadowPush {
   mat4 viewProj;
   uint primitiveBase;
-  uint pad0;
+  uint perspective;    // 1: a perspective layer (transmit depth in metres along the view), 0: ndc z
   uint pad1;
   uint pad2;
 };

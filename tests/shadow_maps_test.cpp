@@ -126,6 +126,56 @@ TEST_F(ShadowMaps, CascadesAreRefittedWhenTheViewsChange) {
   EXPECT_LT(back.farShadow, 0.1f * back.lit);
 }
 
+// A white floor lit from 3 m above (a sun straight down, then a point light) through a 2 × 2 m pane
+// 1 m up, seen from below the pane: clear glass (transmission 1, white) leaves the floor as lit as
+// without it; red glass (Blend, alpha 0.5: T = (0.5, 0, 0), the tracers' thin rule) tints it red.
+TEST_F(ShadowMaps, TransmissivePanesCastColouredShadows) {
+  for (scene::LightType type : {scene::LightType::Directional, scene::LightType::Point}) {
+    Scene s;
+    Material white;
+    white.baseColor = glm::vec3(1.0f);
+    scene::addQuad(s, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}, addMaterial(s, white));
+    scene::Light light;
+    light.type = type;
+    light.position = {0, 3, 0};
+    light.direction = {0, -1, 0};
+    light.intensity = 3.0f;
+    s.lights.push_back(light);
+    Scene bare = s;
+    scene::finalizeScene(bare);
+    Material clear;
+    clear.baseColor = glm::vec3(1.0f);
+    clear.transmission = 1.0f;
+    Material red;
+    red.baseColor = {1, 0, 0};
+    red.alphaMode = scene::AlphaMode::Blend;
+    red.alpha = 0.5f;
+    Scene clearPane = s, redPane = s;
+    scene::addQuad(clearPane, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {-1, 1, -1}, addMaterial(clearPane, clear));
+    scene::addQuad(redPane, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {-1, 1, -1}, addMaterial(redPane, red));
+    scene::finalizeScene(clearPane);
+    scene::finalizeScene(redPane);
+    CameraView down;
+    down.position = {0, 0.5f, 0};
+    down.forward = {0, -1, 0};
+    down.up = {0, 0, -1};
+    down.yfov = 1.5707963f;
+    const auto mean = [&](const Scene& scene, int c) {
+      RasterRenderer raster(*context_, scene, 32, 32);
+      const Image img = raster.render(raster.viewProjection(down), down.position);
+      double sum = 0;
+      for (size_t i = static_cast<size_t>(c); i < img.rgb.size(); i += 3) sum += img.rgb[i];
+      return sum / static_cast<double>(img.rgb.size() / 3);
+    };
+    const double lit[3] = {mean(bare, 0), mean(bare, 1), mean(bare, 2)};
+    ASSERT_GT(lit[0], 0.1) << static_cast<int>(type);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean(clearPane, c) / lit[c], 1.0, 0.03) << "clear, channel " << c;
+    EXPECT_NEAR(mean(redPane, 0) / lit[0], 0.5, 0.03) << "red pane, light type " << static_cast<int>(type);
+    EXPECT_LT(mean(redPane, 1) / lit[1], 0.01) << "red pane, light type " << static_cast<int>(type);
+    EXPECT_LT(mean(redPane, 2) / lit[2], 0.01) << "red pane, light type " << static_cast<int>(type);
+  }
+}
+
 TEST_F(ShadowMaps, CascadeCountOutsideOneToFourIsRefused) {
   const PostScene ps;
   for (uint32_t n : {0u, 5u, 0xffffffffu}) {

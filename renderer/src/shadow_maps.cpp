@@ -11,6 +11,7 @@
 #include "probecast/renderer/view_sets.h"
 #include "raster_shared.h"
 #include "shadow.frag.h"
+#include "shadow_transmit.frag.h"
 #include "shadow.vert.h"
 #include "vk_pipeline.h"
 
@@ -19,6 +20,25 @@ namespace probecast::renderer {
 constexpr VkShaderStageFlags kShadowStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
 namespace {
+
+constexpr VkFormat kTransmitFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkClearColorValue kTransmitClear = {{1.0f, 1.0f, 1.0f, static_cast<float>(RS_TRANSMIT_CLEAR_DEPTH)}};
+
+// The transmittance layers: full size for a scene with transmissive triangles, else one clear texel.
+void createTransmitLayers(VulkanDevice& d, uint32_t layers, bool needed, ShadowMaps& maps) {
+  const uint32_t n = needed ? maps.size : 1;
+  if (maps.transmit.layers == layers && maps.transmit.extent.width == n) return;
+  destroyImage(d, maps.transmit);
+  maps.transmit = createImageArray(d, kTransmitFormat, {n, n}, layers,
+                                   VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                       VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  submitAndWait(d, [&](VkCommandBuffer cmd) {
+    transitionImage(cmd, maps.transmit, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, layers};
+    vkCmdClearColorImage(cmd, maps.transmit.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &kTransmitClear, 1, &all);
+    transitionImage(cmd, maps.transmit, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  });
+}
 
 // Cascade splits: a blend of logarithmic (even texel density in depth) and uniform (not all
 // texels spent next to a small near plane) splits.
@@ -81,6 +101,12 @@ void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, uint32
   desc.fragmentBytes = sizeof kShadowFrag;
   desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard
   out.cutoutPipeline = createGraphicsPipeline(d, desc);
+  desc.fragmentCode = kShadowTransmitFrag;
+  desc.fragmentBytes = sizeof kShadowTransmitFrag;
+  desc.colorFormat = kTransmitFormat;
+  desc.blend = ColorBlend::MultiplyMinAlpha;
+  desc.depthBias = false;
+  out.transmitPipeline = createGraphicsPipeline(d, desc);
 }
 
 void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps) {
@@ -93,6 +119,7 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
   maps.fittedViews.clear();
   maps.sceneMin = scene.boundsMin;
   maps.sceneMax = scene.boundsMax;
+  maps.transmissiveFirst = scene::leadingTrianglesBelowClass(scene, 2);
   for (const scene::Light& l : scene.lights) {
     shaders::RsShadowLight r{RS_SHADOW_NONE, static_cast<uint32_t>(maps.matrices.size()), 0.0f, 1u};
     const float zfar = l.range > 0.0f ? l.range : 2.0f * radius + glm::length(l.position - center);
@@ -141,9 +168,12 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
   }
   if (records.empty()) records.push_back({RS_SHADOW_NONE, 0, 0.0f, 1u});
   maps.texels.assign(maps.matrices.size(), glm::vec4(0.0f));
+
   for (const shaders::RsShadowLight& r : records)
     if (r.kind == RS_SHADOW_ORTHO)
       for (uint32_t k = 0; k < r.cascades; ++k) maps.texels[r.firstLayer + k].x = r.texelScale;
+    else if (r.kind != RS_SHADOW_NONE)
+      for (uint32_t k = 0; k < (r.kind == RS_SHADOW_CUBE ? 6u : 1u); ++k) maps.texels[r.firstLayer + k].y = 1.0f;
   destroyBuffer(d, maps.lights);
   destroyBuffer(d, maps.layers);
   maps.lights =
@@ -160,6 +190,7 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
       transitionImage(cmd, maps.depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     });
   }
+  createTransmitLayers(d, layers, maps.transmissiveFirst < scene.triangleCount(), maps);
   maps.layerDirty.assign(maps.matrices.size(), 1);
 }
 
@@ -261,7 +292,12 @@ void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, V
                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
     const VkBuffer streams[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
     const VkDeviceSize offsets[3] = {0, 0, 0};
-    const uint32_t opaque = std::min(gpu.accel.opaqueTriangles, indexCount / 3);
+    const uint32_t triangles = indexCount / 3, opaque = std::min(gpu.accel.opaqueTriangles, triangles);
+    const uint32_t transmissive = std::min(maps.transmissiveFirst, triangles);
+    const bool transmit = transmissive < triangles;  // then `transmit` has full-size layers
+    if (transmit)
+      transitionImage(cmd, maps.transmit, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
     for (size_t k = 0; k < maps.matrices.size(); ++k) {
       if (!maps.layerDirty[k]) continue;
       const VkRenderingAttachmentInfo depthInfo = clearedAttachment(
@@ -277,17 +313,44 @@ void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, V
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, maps.layout, 0, 1, &materials, 0, nullptr);
       shaders::RsShadowPush push{};
       std::memcpy(&push.viewProj, &maps.matrices[k][0][0], sizeof push.viewProj);
-      // Opaque triangles first (the leading run, finalizeScene's order), then the rest.
-      for (int part = 0; part < 2; ++part) {
-        const uint32_t first = part == 0 ? 0 : opaque, count = part == 0 ? opaque : indexCount / 3 - opaque;
-        if (count == 0) continue;
+      push.perspective = maps.texels[k].y != 0.0f ? 1u : 0u;
+      // Opaque triangles first (the leading run, finalizeScene's order), then the cut-outs.
+      const auto drawRun = [&](uint32_t first, uint32_t end, VkPipeline pipeline) {
+        if (end <= first) return;
         push.primitiveBase = first;
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, part == 0 ? maps.pipeline : maps.cutoutPipeline);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
         vkCmdPushConstants(cmd, maps.layout, kShadowStages, 0, sizeof push, &push);
-        vkCmdDrawIndexed(cmd, 3 * count, 1, 3 * first, 0, 0);
-      }
+        vkCmdDrawIndexed(cmd, 3 * (end - first), 1, 3 * first, 0, 0);
+      };
+      drawRun(0, opaque, maps.pipeline);
+      drawRun(opaque, transmissive, maps.cutoutPipeline);
       vkCmdEndRendering(cmd);
+      if (!transmit) continue;
+      // The transmissive run over the finished depth: colour only.
+      VkRenderingAttachmentInfo depthRead{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+      depthRead.imageView = maps.depth.layerViews[k];
+      depthRead.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+      depthRead.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+      depthRead.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+      VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+      colour.imageView = maps.transmit.layerViews[k];
+      colour.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+      colour.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+      colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+      colour.clearValue.color = kTransmitClear;
+      ri.colorAttachmentCount = 1;
+      ri.pColorAttachments = &colour;
+      ri.pDepthAttachment = &depthRead;
+      vkCmdBeginRendering(cmd, &ri);
+      setViewportScissor(cmd, n, n);
+      drawRun(transmissive, triangles, maps.transmitPipeline);
+      vkCmdEndRendering(cmd);
+      ri.colorAttachmentCount = 0;
+      ri.pColorAttachments = nullptr;
     }
+    if (transmit)
+      transitionImage(cmd, maps.transmit, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     transitionImage(cmd, maps.depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   });
@@ -297,9 +360,10 @@ void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, V
 
 void destroyShadowMaps(VulkanDevice& d, ShadowMaps& maps) {
   destroyImage(d, maps.depth);
+  destroyImage(d, maps.transmit);
   destroyBuffer(d, maps.lights);
   destroyBuffer(d, maps.layers);
-  for (VkPipeline p : {maps.pipeline, maps.cutoutPipeline})
+  for (VkPipeline p : {maps.pipeline, maps.cutoutPipeline, maps.transmitPipeline})
     if (p) vkDestroyPipeline(d.device, p, nullptr);
   if (maps.layout) vkDestroyPipelineLayout(d.device, maps.layout, nullptr);
   maps = ShadowMaps{};

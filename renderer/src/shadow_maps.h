@@ -3,8 +3,11 @@
 // treated the same), one perspective layer for a spot light, and for a directional light either
 // one orthographic layer over the scene (1 cascade) or 2..4 cascades fitted to slices of the
 // current view set's depth range (fitShadowCascades) — drawn depth-only with a slope-scaled bias;
-// non-opaque triangles with shadow.frag (cut-outs pass light, transmissive surfaces dithered). The
-// fragment shader reads them through RsShadowLight / RsShadowLayer (raster_shared.h). Lights past
+// cut-outs with shadow.frag (their holes pass light). Transmissive triangles (scene.h's rule) go
+// to a colour layer per depth layer instead (shadow_transmit.frag): the product of their T in front
+// of the opaque depth and the nearest one's depth, so light through glass is tinted and attenuated
+// as the tracers' visibility rays have it. The fragment shader reads them through RsShadowLight /
+// RsShadowLayer (raster_shared.h). Lights past
 // the layer budget (in scene order) stay unshadowed; a directional light takes all its cascades or
 // none.
 #pragma once
@@ -24,11 +27,13 @@ struct ShadowMaps {
   uint32_t size = 1024;      // texels per side of a layer
   uint32_t maxLayers = 24;
   GpuImage depth;            // at least 2 layers, so the shaders always see an array
+  GpuImage transmit;         // RGBA16F, a layer per depth layer; 1 × 1 (clear) without transmissive triangles
+  uint32_t transmissiveFirst = 0;  // scene triangle index where the transmissive run starts
   Buffer lights;             // RsShadowLight per scene light
   Buffer layers;             // RsShadowLayer per layer in use
   uint32_t cascades = 1;     // per directional light, 1..RS_MAX_CASCADES
   std::vector<glm::mat4> matrices;
-  std::vector<glm::vec4> texels;          // RsShadowLayer::texel per layer
+  std::vector<glm::vec4> texels;          // RsShadowLayer::texel per layer (y = 1: perspective)
   std::vector<uint8_t> layerDirty;        // per layer: planned or refitted, not drawn yet
   struct Sun {
     uint32_t firstLayer, count;  // its layers (count < cascades where the budget ran out)
@@ -39,7 +44,8 @@ struct ShadowMaps {
   std::vector<float> fittedViews;         // the view set the cascades were fitted to
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline pipeline = VK_NULL_HANDLE;         // opaque triangles, depth only
-  VkPipeline cutoutPipeline = VK_NULL_HANDLE;   // the rest, through shadow.frag
+  VkPipeline cutoutPipeline = VK_NULL_HANDLE;   // cut-outs, through shadow.frag
+  VkPipeline transmitPipeline = VK_NULL_HANDLE; // transmissive triangles into `transmit`
   double lastDrawMs = 0.0;
 };
 
