@@ -14,16 +14,10 @@ namespace {
 using scene::Material;
 using scene::Scene;
 
-class ShadowMaps : public ::testing::Test {
- protected:
-  void SetUp() override { context_ = std::make_unique<VulkanContext>(test::validatedContext()); }
-  void TearDown() override { EXPECT_EQ(context_->validationMessages(), 0u) << "Vulkan validation messages"; }
-  std::unique_ptr<VulkanContext> context_;
-};
-
-uint32_t addMaterial(Scene& s, const Material& m) {
+// Appends material m to s and returns its index.
+uint32_t withMaterial(Scene& s, const Material& m) {
   s.materials.push_back(m);
-  return static_cast<uint32_t>(s.materials.size() - 1);
+  return static_cast<uint32_t>(s.materials.size()) - 1u;
 }
 
 // The red channel of the pixel that world point p falls on (NAN off the image).
@@ -47,15 +41,12 @@ struct PostScene {
   PostScene() {
     Material white;
     white.baseColor = glm::vec3(1.0f);
-    const uint32_t m = addMaterial(scene, white);
+    const uint32_t m = withMaterial(scene, white);
     scene::addQuad(scene, {-8, 0, 4}, {8, 0, 4}, {8, 0, -60}, {-8, 0, -60}, m);
     scene::addBox(scene, {0, 1.5f, -6}, {0.1f, 1.5f, 0.5f}, 0.0f, m);
     scene::addBox(scene, {0, 1.5f, -40}, {0.1f, 1.5f, 10.0f}, 0.0f, m);
-    scene::Light sun;
-    sun.type = scene::LightType::Directional;
-    sun.direction = glm::normalize(glm::vec3(1, -1, 0));
-    sun.intensity = 3.0f;
-    scene.lights.push_back(sun);
+    scene.lights.push_back(
+        {.type = scene::LightType::Directional, .direction = glm::normalize(glm::vec3(1, -1, 0)), .intensity = 3.0f});
     scene::finalizeScene(scene);
     camera.position = {1, 8, 2};
     camera.forward = glm::normalize(glm::vec3(0, -1, -3));
@@ -96,9 +87,10 @@ RasterOptions postOptions(uint32_t cascades) {
 
 // Both posts' shadows show with one layer and with four cascades; the cascades' near edge is
 // sharper (the finest cascade has texels of a few cm next to the camera).
-TEST_F(ShadowMaps, CascadesSharpenTheNearShadowAndKeepTheFarOne) {
+TEST(ShadowMaps, CascadesSharpenTheNearShadowAndKeepTheFarOne) {
+  VulkanContext context(test::validatedContext());
   const PostScene ps;
-  RasterRenderer layer(*context_, ps.scene, 192, 128, postOptions(1)), cascaded(*context_, ps.scene, 192, 128, postOptions(4));
+  RasterRenderer layer(context, ps.scene, 192, 128, postOptions(1)), cascaded(context, ps.scene, 192, 128, postOptions(4));
   const PostShadow one = measurePosts(layer, ps.camera), four = measurePosts(cascaded, ps.camera);
   for (const PostShadow* r : {&one, &four}) {
     ASSERT_GT(r->lit, 0.3f);
@@ -109,13 +101,15 @@ TEST_F(ShadowMaps, CascadesSharpenTheNearShadowAndKeepTheFarOne) {
   EXPECT_GE(one.nearRampPixels, 4u);
   EXPECT_LT(four.nearRampPixels * 2, one.nearRampPixels) << "4 cascades: " << four.nearRampPixels
                                                          << " ramp pixels, 1: " << one.nearRampPixels;
+  EXPECT_EQ(context.validationMessages(), 0u);
 }
 
 // The cascades follow the view set: after a view 20 m further on (whose cascades leave the near
 // post to the coarsest one), the first view gets its sharp near shadow back.
-TEST_F(ShadowMaps, CascadesAreRefittedWhenTheViewsChange) {
+TEST(ShadowMaps, CascadesAreRefittedWhenTheViewsChange) {
+  VulkanContext context(test::validatedContext());
   const PostScene ps;
-  RasterRenderer first(*context_, ps.scene, 192, 128, postOptions(4)), moved(*context_, ps.scene, 192, 128, postOptions(4));
+  RasterRenderer first(context, ps.scene, 192, 128, postOptions(4)), moved(context, ps.scene, 192, 128, postOptions(4));
   const PostShadow fresh = measurePosts(first, ps.camera);
   CameraView ahead = ps.camera;
   ahead.position.z -= 20.0f;
@@ -124,17 +118,19 @@ TEST_F(ShadowMaps, CascadesAreRefittedWhenTheViewsChange) {
   EXPECT_EQ(back.nearRampPixels, fresh.nearRampPixels);
   EXPECT_LT(back.nearShadow, 0.05f * back.lit);
   EXPECT_LT(back.farShadow, 0.1f * back.lit);
+  EXPECT_EQ(context.validationMessages(), 0u);
 }
 
 // A white floor lit from 3 m above (a sun straight down, then a point light) through a 2 × 2 m pane
 // 1 m up, seen from below the pane: clear glass (transmission 1, white) leaves the floor as lit as
 // without it; red glass (Blend, alpha 0.5: T = (0.5, 0, 0), the tracers' thin rule) tints it red.
-TEST_F(ShadowMaps, TransmissivePanesCastColouredShadows) {
+TEST(ShadowMaps, TransmissivePanesCastColouredShadows) {
+  VulkanContext context(test::validatedContext());
   for (scene::LightType type : {scene::LightType::Directional, scene::LightType::Point}) {
     Scene s;
     Material white;
     white.baseColor = glm::vec3(1.0f);
-    scene::addQuad(s, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}, addMaterial(s, white));
+    scene::addQuad(s, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}, withMaterial(s, white));
     scene::Light light;
     light.type = type;
     light.position = {0, 3, 0};
@@ -151,8 +147,8 @@ TEST_F(ShadowMaps, TransmissivePanesCastColouredShadows) {
     red.alphaMode = scene::AlphaMode::Blend;
     red.alpha = 0.5f;
     Scene clearPane = s, redPane = s;
-    scene::addQuad(clearPane, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {-1, 1, -1}, addMaterial(clearPane, clear));
-    scene::addQuad(redPane, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {-1, 1, -1}, addMaterial(redPane, red));
+    scene::addQuad(clearPane, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {-1, 1, -1}, withMaterial(clearPane, clear));
+    scene::addQuad(redPane, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {-1, 1, -1}, withMaterial(redPane, red));
     scene::finalizeScene(clearPane);
     scene::finalizeScene(redPane);
     CameraView down;
@@ -161,7 +157,7 @@ TEST_F(ShadowMaps, TransmissivePanesCastColouredShadows) {
     down.up = {0, 0, -1};
     down.yfov = 1.5707963f;
     const auto mean = [&](const Scene& scene, int c) {
-      RasterRenderer raster(*context_, scene, 32, 32);
+      RasterRenderer raster(context, scene, 32, 32);
       const Image img = raster.render(raster.viewProjection(down), down.position);
       double sum = 0;
       for (size_t i = static_cast<size_t>(c); i < img.rgb.size(); i += 3) sum += img.rgb[i];
@@ -174,15 +170,18 @@ TEST_F(ShadowMaps, TransmissivePanesCastColouredShadows) {
     EXPECT_LT(mean(redPane, 1) / lit[1], 0.01) << "red pane, light type " << static_cast<int>(type);
     EXPECT_LT(mean(redPane, 2) / lit[2], 0.01) << "red pane, light type " << static_cast<int>(type);
   }
+  EXPECT_EQ(context.validationMessages(), 0u);
 }
 
-TEST_F(ShadowMaps, CascadeCountOutsideOneToFourIsRefused) {
+TEST(ShadowMaps, CascadeCountOutsideOneToFourIsRefused) {
+  VulkanContext context(test::validatedContext());
   const PostScene ps;
   for (uint32_t n : {0u, 5u, 0xffffffffu}) {
     RasterOptions o;
     o.shadowCascades = n;
-    EXPECT_THROW(RasterRenderer(*context_, ps.scene, 8, 8, o), std::invalid_argument) << n;
+    EXPECT_THROW(RasterRenderer(context, ps.scene, 8, 8, o), std::invalid_argument) << n;
   }
+  EXPECT_EQ(context.validationMessages(), 0u);
 }
 
 }  // namespace
