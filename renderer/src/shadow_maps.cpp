@@ -44,6 +44,12 @@ void createTransmitLayers(VulkanDevice& d, uint32_t layers, bool needed, ShadowM
 // texels spent next to a small near plane) splits.
 constexpr float kLogSplitWeight = 0.75f;
 
+// Corner k (bits: x, y, z at the maximum) of the scene's bounds.
+glm::vec3 sceneCorner(const ShadowMaps& maps, int k) {
+  return {(k & 1 ? maps.sceneMax : maps.sceneMin).x, (k & 2 ? maps.sceneMax : maps.sceneMin).y,
+          (k & 4 ? maps.sceneMax : maps.sceneMin).z};
+}
+
 // An orthographic layer looking along `dir` over a square of half-size `radius` around `center`,
 // whose light-space x, y snap to whole texels (the layer then moves by whole texels only, so
 // shadow edges do not shimmer as the views move), deep enough for every caster of the scene.
@@ -56,9 +62,7 @@ glm::mat4 cascadeLayer(glm::vec3 dir, glm::vec3 center, float radius, const Shad
   c.y = std::floor(c.y / texel) * texel;
   float zmin = INFINITY, zmax = -INFINITY;  // light-space z of the scene's corners (the view looks down −z)
   for (int k = 0; k < 8; ++k) {
-    const glm::vec3 corner{(k & 1 ? maps.sceneMax : maps.sceneMin).x, (k & 2 ? maps.sceneMax : maps.sceneMin).y,
-                           (k & 4 ? maps.sceneMax : maps.sceneMin).z};
-    const float z = (view * glm::vec4(corner, 1.0f)).z;
+    const float z = (view * glm::vec4(sceneCorner(maps, k), 1.0f)).z;
     zmin = std::min(zmin, z);
     zmax = std::max(zmax, z);
   }
@@ -226,11 +230,7 @@ void fitShadowCascades(const std::vector<ViewInfo>& views, ShadowMaps& maps) {
     float farDepth = glm::dot(farCorner - f.eye, axis);
     if (!std::isfinite(farDepth) || farDepth <= f.nearDepth) farDepth = INFINITY;  // an infinite far plane
     float sceneDepth = 0.0f;
-    for (int k = 0; k < 8; ++k) {
-      const glm::vec3 corner{(k & 1 ? maps.sceneMax : maps.sceneMin).x, (k & 2 ? maps.sceneMax : maps.sceneMin).y,
-                             (k & 4 ? maps.sceneMax : maps.sceneMin).z};
-      sceneDepth = std::max(sceneDepth, glm::dot(corner - f.eye, axis));
-    }
+    for (int k = 0; k < 8; ++k) sceneDepth = std::max(sceneDepth, glm::dot(sceneCorner(maps, k) - f.eye, axis));
     // A view that is not a finite perspective frustum (NaN, or an eye off its apex) keeps the last fit.
     if (!(f.nearDepth > 0.0f) || !std::isfinite(f.nearDepth) || !std::isfinite(sceneDepth)) return;
     nearest = std::min(nearest, f.nearDepth);
