@@ -2,7 +2,9 @@
 // moving light and streams it over loopback gRPC; a stereo headset and a light-field display
 // subscribe, re-render whenever new lighting arrives (direct light at the current light position,
 // indirect light from the probes they hold), and the run ends with both compared against the
-// reference path tracer. Writes images, charts, report.md and report.json to --out.
+// reference path tracer. With --environment or --sky, the same sky lights the server's probes, shows
+// behind the viewers' scene and lights the references. Writes images, charts, report.md and
+// report.json to --out.
 #include <filesystem>
 
 #include "commands.h"
@@ -25,7 +27,9 @@ void addDemoCommand(CLI::App& app) {
       ->check(CLI::Range(1, 10000));
   addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
+  o->environment.add(demo);
   demo->callback([o] {
+    o->sky = o->environment.load();  // a bad map or sky fails here, before the server starts
     DemoRun run;
     run.wallStart = DemoClock::now();
     std::filesystem::create_directories(o->out);

@@ -21,7 +21,7 @@ struct ViewOptions {
   ConnectOptions connection;
   std::string probes = "live", views = "lf:5x5", out = "out/view";
   std::string repr = "float", passes = "per-view", toneMap = "filmic";
-  uint32_t shadowMap = 1024;
+  uint32_t shadowMap = 1024, shadowCascades = 4;
   double waitSeconds = 3.0;
   std::vector<uint32_t> size{320, 200};
   uint32_t updates = 4;
@@ -31,7 +31,7 @@ struct ViewOptions {
 
 struct Rendered {
   std::vector<renderer::Image> images;
-  double viewsMs = 0.0;
+  double viewsMs = 0.0, shadowMs = 0.0;
 };
 
 // A viewer of a server's stream: subscribe for --wait seconds, then render what it holds.
@@ -57,7 +57,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o.connection.connect);
   if (o.repr != "float") throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
   viewer.render();
-  return {viewer.images(), viewer.timings().viewsMs};
+  return {viewer.images(), viewer.timings().viewsMs, viewer.timings().shadowMs};
 }
 
 // Local probes: traced now (--probes live) or read from a file, through --repr when given.
@@ -84,6 +84,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   Rendered r;
   r.images = raster.renderViews(views);
   r.viewsMs = raster.timings().viewsMs;
+  r.shadowMs = raster.timings().shadowMs;
   return r;
 }
 
@@ -126,6 +127,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--passes", o->passes, "per-view (one pass per view) or multiview (chunks of views per pass)")
       ->check(CLI::IsMember({"per-view", "multiview"}));
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
+  addShadowCascadesOption(cmd, o->shadowCascades);
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
     renderer::ViewSetSpec spec;
@@ -139,13 +141,15 @@ void addViewCommand(CLI::App& app) {
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
+    ro.shadowCascades = o->shadowCascades;
     ro.environment = environment;
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);
     writeViews(*o, r, views, spec);
-    fmt::print("view: {} {} views of {}x{} on {}: {:.1f} ms per view; wrote {}/quilt.png and quilt.exr\n", o->views,
-               views.size(), o->size[0], o->size[1], context.deviceName(), r.viewsMs / static_cast<double>(views.size()),
-               o->out);
+    fmt::print("view: {} {} views of {}x{} on {}: {:.1f} ms per view, shadow maps {:.1f} ms; wrote {}/quilt.png and "
+               "quilt.exr\n",
+               o->views, views.size(), o->size[0], o->size[1], context.deviceName(),
+               r.viewsMs / static_cast<double>(views.size()), r.shadowMs, o->out);
   });
 }
 

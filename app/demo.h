@@ -37,6 +37,8 @@ struct DemoOptions {
   uint32_t referenceSpp = 256;
   uint64_t lightFieldBudget = 6 * 1024;  // bytes/s: the display sits on a thin link
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
+  EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
+  std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
 };
 
 struct DemoViewer {

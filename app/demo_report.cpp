@@ -34,6 +34,7 @@ std::string runSuites(const DemoOptions& o, const std::string& dir, const scene:
   po.width = 128;
   po.height = 80;
   po.referenceSpp = 2 * o.referenceSpp;
+  po.environment = o.sky;
   po.spps = {32, 128};
   po.bounces = {1, 4};
   po.deadzones = {0, 4, 16};
@@ -172,6 +173,7 @@ void compareWithReferences(const DemoOptions& o, DemoRun& run, const scene::Scen
     ro.width = v.width;
     ro.height = v.height;
     ro.samplesPerPixel = o.referenceSpp;
+    ro.environment = o.sky;
     for (size_t i : compared[k]) {
       references[i] = renderer::renderReference(*run.viewerContext, finalScene, views[i].camera, ro);
       const imaging::ImageMetrics m = imaging::compareImages(images[i].rgb, references[i].rgb, static_cast<int>(v.width),
@@ -258,6 +260,9 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
   report["scene"] = run.scene0.name;
   report["grid"] = {run.grid.dims[0], run.grid.dims[1], run.grid.dims[2]};
   report["representation"] = o.repr;
+  report["environment"] = !o.environment.file.empty() ? nlohmann::json(o.environment.file)
+                          : !o.environment.sky.empty() ? nlohmann::json({{"sky", o.environment.sky}})
+                                                       : nlohmann::json(nullptr);
   report["spp_per_update"] = o.spp;
   report["stream_seconds"] = run.streamSeconds;
   report["updates"] = producer.updates;

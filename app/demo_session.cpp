@@ -41,6 +41,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
       service::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1));
   renderer::UpdaterOptions uo;
   uo.samplesPerProbe = o.spp;
+  uo.environment = o.sky;
   session::Animation animation;
   animation.mode = session::Animation::Mode::WallClock;
   animation.ratePerSecond = o.turnsPerMinute / 60.0;
@@ -83,6 +84,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
     vc.client.name = v.name;
     vc.client.budgetBytesPerSecond = v.budget;
     vc.client.zh3PerPixel = true;
+    vc.raster.environment = o.sky;  // the background; its light comes through the probes
     if (session::sceneAnimates(o.scene)) {  // direct light is local: the light now
       vc.sceneSpec = o.scene;
       vc.lightT = [&producer] { return producer.t(); };

@@ -113,6 +113,12 @@ inline CLI::Option* addReferenceSppOption(CLI::App* cmd, uint32_t& spp, uint32_t
   return cmd->add_option("--reference-spp", spp, what)->check(CLI::Range(1, static_cast<int>(max)));
 }
 
+// --shadow-cascades N: orthographic layers per directional light (RasterOptions::shadowCascades).
+inline CLI::Option* addShadowCascadesOption(CLI::App* cmd, uint32_t& cascades) {
+  return cmd->add_option("--shadow-cascades", cascades, "shadow cascades per directional light (1 = one layer over the scene)")
+      ->check(CLI::Range(1, 4));
+}
+
 // --size WxH, each in [min, max].
 inline CLI::Option* addSizeOption(CLI::App* cmd, std::vector<uint32_t>& size, const std::string& what, uint32_t min,
                                   uint32_t max) {

@@ -187,6 +187,17 @@ vec3 sampleEnvironment(inout uint rng, out vec3 wi, out float pdf) {
   return le;
 }
 
+// The environment's share through direction wi (radiance le, drawn with pdf `pdf`), times an MIS
+// weight: 0 where wi is below either normal, blocked, or had no chance of being drawn.
+vec3 environmentAlong(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha, vec3 wi, vec3 le,
+                      float pdf, float weight) {
+  float cosSurface = dot(n, wi);
+  if (!(pdf > 1e-8) || cosSurface <= 0.0 || dot(ng, wi) <= 0.0) return vec3(0.0);
+  vec3 t = transmittance(p + ng * rayOffset(p), wi, 1e30);
+  if (!anyLight(t)) return vec3(0.0);
+  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * t * (weight / pdf);
+}
+
 // One environment sample for next-event estimation, MIS-weighted against BSDF sampling.
 vec3 environmentLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha, float specProb,
                       inout uint rng) {
@@ -194,13 +205,28 @@ vec3 environmentLight(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metalli
   vec3 wi;
   float pdfLight;
   vec3 le = sampleEnvironment(rng, wi, pdfLight);
-  float cosSurface = dot(n, wi);
-  if (!(pdfLight > 0.0) || cosSurface <= 0.0 || dot(ng, wi) <= 0.0) return vec3(0.0);
-  vec3 origin = p + ng * rayOffset(p);
-  vec3 t = transmittance(origin, wi, 1e30);
-  if (!anyLight(t)) return vec3(0.0);
-  float weight = powerHeuristic(pdfLight, pdfBsdf(n, wo, wi, alpha, specProb));
-  return evalBsdf(n, wo, wi, base, metallic, alpha) * cosSurface * le * t * (weight / pdfLight);
+  return environmentAlong(p, n, ng, wo, base, metallic, alpha, wi, le, pdfLight,
+                          powerHeuristic(pdfLight, pdfBsdf(n, wo, wi, alpha, specProb)));
+}
+
+// The environment at a path's last interaction, where no BSDF sample follows to find it on a
+// miss, so one sample carries all of it (weight 1): drawn from the map, or with environment
+// sampling off from the BSDF, with a visibility ray either way — as punctual lights are lit at
+// every interaction, `--bounces 1` included.
+vec3 environmentLightLast(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 base, float metallic, float alpha, float specProb,
+                          inout uint rng) {
+  if (environment.mode == PT_ENV_NONE) return vec3(0.0);
+  vec3 wi;
+  float pdf;
+  vec3 le;
+  if (environment.sampling != 0u) {
+    le = sampleEnvironment(rng, wi, pdf);
+  } else {
+    wi = sampleBsdf(n, wo, alpha, specProb, rng);
+    pdf = pdfBsdf(n, wo, wi, alpha, specProb);
+    le = environmentRadiance(wi);
+  }
+  return environmentAlong(p, n, ng, wo, base, metallic, alpha, wi, le, pdf, 1.0);
 }
 
 // Solid-angle pdf with which emitter sampling picks a direction that reaches a point of triangle
@@ -319,7 +345,10 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
     float specProb = mix(0.2, 0.9, metallic);
     radiance += clampIndirect(throughput * directLight(p, n, ngf, wo, base, metallic, alpha), bounce);
-    if (bounce + 1u >= PATH_MAX_BOUNCES) break;
+    if (bounce + 1u >= PATH_MAX_BOUNCES) {
+      radiance += clampIndirect(throughput * environmentLightLast(p, n, ngf, wo, base, metallic, alpha, specProb, rng), bounce);
+      break;
+    }
     radiance += clampIndirect(throughput * emitterLight(p, n, ngf, wo, base, metallic, alpha, specProb, rng), bounce);
     radiance += clampIndirect(throughput * environmentLight(p, n, ngf, wo, base, metallic, alpha, specProb, rng), bounce);
     vec3 wi = sampleBsdf(n, wo, alpha, specProb, rng);

@@ -27,6 +27,7 @@ layout(std430, binding = RS_BINDING_VIEWS) readonly buffer Views { RsView views[
 layout(std430, binding = RS_BINDING_SHADOW_LIGHTS) readonly buffer ShadowLights { RsShadowLight shadowLights[]; };
 layout(std430, binding = RS_BINDING_SHADOW_LAYERS) readonly buffer ShadowLayers { RsShadowLayer shadowLayers[]; };
 layout(binding = RS_BINDING_SHADOW_MAP) uniform sampler2DArrayShadow shadowMap;
+layout(binding = RS_BINDING_SHADOW_TRANSMIT) uniform sampler2DArray shadowTransmit;
 
 #include "material.glsl"
 
@@ -75,11 +76,57 @@ void hallucinateZh3(inout float c[28]) {
   }
 }
 
-// Visibility of light `i` from p (normal n) by its shadow map: 3×3 PCF of hardware 2×2
-// comparisons, normal offset of 1.5 texels against acne.
-float shadowVisibility(uint i, vec3 p, vec3 n) {
+// Light reaching world point q through `layer`: 3×3 PCF of hardware 2×2 comparisons against the
+// opaque depth, times the transmittance of the transmissive casters when q lies behind the
+// nearest of them (shadow_transmit.frag; depth as ndc z, or metres along a perspective layer's
+// view); 1 outside the layer.
+vec3 layerVisibility(uint layer, vec3 q) {
+  vec4 clip = shadowLayers[layer].viewProj * vec4(q, 1.0);
+  if (clip.w <= 0.0) return vec3(1.0);
+  vec3 ndc = clip.xyz / clip.w;
+  if (any(greaterThan(abs(ndc.xy), vec2(1.0))) || ndc.z > 1.0) return vec3(1.0);
+  vec2 uv = ndc.xy * 0.5 + 0.5;
+  float step = 1.0 / float(pc.shadowMapSize);
+  float lit = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x) lit += texture(shadowMap, vec4(uv + vec2(x, y) * step, float(layer), ndc.z));
+  vec4 t = texture(shadowTransmit, vec3(uv, float(layer)));
+  bool perspective = shadowLayers[layer].texel.y != 0.0;
+  float depth = perspective ? clip.w : ndc.z;
+  bool behind = t.a < RS_TRANSMIT_CLEAR_DEPTH * 0.5 && depth > t.a * 1.001 + (perspective ? 1e-3 : 2e-4);
+  return lit / 9.0 * (behind ? clamp(t.rgb, 0.0, 1.0) : vec3(1.0));
+}
+
+// A directional light's cascades (finest first): the finest layer whose square holds p, blended
+// into the next one over the outer 10 % of its square so that no seam shows where they meet. The
+// normal offset grows with the layer's texel size and with the slope to the light (grazing light
+// stretches a texel over more of the surface).
+vec3 cascadeVisibility(RsShadowLight s, vec3 p, vec3 n, vec3 wi) {
+  const float band = 0.1;
+  float cosine = clamp(dot(n, wi), 0.0, 1.0);
+  float offset = 1.0 + 0.5 * min(sqrt(1.0 - cosine * cosine) / max(cosine, 0.05), 2.0);  // texels
+  for (uint k = 0u; k < s.cascades; ++k) {
+    uint layer = s.firstLayer + k;
+    vec4 clip = shadowLayers[layer].viewProj * vec4(p, 1.0);
+    float edge = max(abs(clip.x), abs(clip.y));
+    if (edge >= 1.0 && k + 1u < s.cascades) continue;
+    vec3 v = layerVisibility(layer, p + n * (offset * shadowLayers[layer].texel.x));
+    float w = k + 1u < s.cascades ? clamp((edge - (1.0 - band)) / band, 0.0, 1.0) : 0.0;
+    if (w > 0.0) {
+      float next = shadowLayers[layer + 1u].texel.x;
+      v = mix(v, layerVisibility(layer + 1u, p + n * (offset * next)), w);
+    }
+    return v;
+  }
+  return vec3(1.0);
+}
+
+// Light of light `i` reaching p (normal n) by its shadow map: 3×3 PCF of hardware 2×2
+// comparisons, normal offset of 1.5 texels against acne, tinted by transmissive casters.
+vec3 shadowVisibility(uint i, vec3 p, vec3 n) {
   RsShadowLight s = shadowLights[i];
-  if (s.kind == RS_SHADOW_NONE) return 1.0;
+  if (s.kind == RS_SHADOW_NONE) return vec3(1.0);
+  if (s.kind == RS_SHADOW_ORTHO && s.cascades > 1u) return cascadeVisibility(s, p, n, -lights[i].directionRange.xyz);
   uint layer = s.firstLayer;
   float texel = s.texelScale;
   if (s.kind != RS_SHADOW_ORTHO) {
@@ -89,16 +136,7 @@ float shadowVisibility(uint i, vec3 p, vec3 n) {
       layer += ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u) : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
     texel *= length(d);
   }
-  vec4 clip = shadowLayers[layer].viewProj * vec4(p + n * (1.5 * texel), 1.0);
-  if (clip.w <= 0.0) return 1.0;
-  vec3 ndc = clip.xyz / clip.w;
-  if (any(greaterThan(abs(ndc.xy), vec2(1.0))) || ndc.z > 1.0) return 1.0;
-  vec2 uv = ndc.xy * 0.5 + 0.5;
-  float step = 1.0 / float(pc.shadowMapSize);
-  float lit = 0.0;
-  for (int y = -1; y <= 1; ++y)
-    for (int x = -1; x <= 1; ++x) lit += texture(shadowMap, vec4(uv + vec2(x, y) * step, float(layer), ndc.z));
-  return lit / 9.0;
+  return layerVisibility(layer, p + n * (1.5 * texel));
 }
 
 // L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) (CODEC.md §1), clamped ≥ 0.

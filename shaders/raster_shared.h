@@ -16,7 +16,10 @@
 #define RS_BINDING_SHADOW_LIGHTS 8     // RsShadowLight[], one per light
 #define RS_BINDING_SHADOW_LAYERS 9     // RsShadowLayer[], one per shadow-map layer
 #define RS_BINDING_SHADOW_MAP 10       // sampler2DArrayShadow: depth of every shadow layer
-#define RS_BINDING_COUNT 11
+#define RS_BINDING_SHADOW_TRANSMIT 11  // sampler2DArray: per shadow layer, rgb = transmittance of the
+                                       // transmissive casters before the opaque depth, a = the nearest one's depth
+#define RS_BINDING_COUNT 12
+#define RS_TRANSMIT_CLEAR_DEPTH 65504.0  // a of a texel no transmissive caster covers (largest half float)
 
 #define RS_PASS_OPAQUE 0u              // opaque and cut-out triangles, depth written
 #define RS_PASS_TRANSMIT 1u            // transmissive triangles: colour × T (blend: dst · src)
@@ -25,7 +28,8 @@
 #define RS_SHADOW_NONE 0u              // unshadowed (no layer left for it)
 #define RS_SHADOW_CUBE 1u              // point light: six 90° faces +x −x +y −y +z −z
 #define RS_SHADOW_PERSPECTIVE 2u       // spot light: one perspective layer
-#define RS_SHADOW_ORTHO 3u             // directional light: one orthographic layer over the scene
+#define RS_SHADOW_ORTHO 3u             // directional light: 1..RS_MAX_CASCADES orthographic cascades
+#define RS_MAX_CASCADES 4u
 
 #ifdef __cplusplus
 namespace probecast::shaders {
@@ -39,12 +43,14 @@ struct RsView {
 struct RsShadowLight {
   uint kind;           // RS_SHADOW_*
   uint firstLayer;     // its first layer in the shadow map
-  float texelScale;    // world size of one texel: × distance to the light (perspective) or as is (ortho)
-  float pad;
+  float texelScale;    // world size of one texel: × distance to the light (perspective); ortho: per layer
+  uint cascades;       // layers of a directional light, finest first (1 for the other kinds)
 };
 
 struct RsShadowLayer {
   mat4 viewProj;       // world → the layer's clip space (same conventions as a view)
+  vec4 texel;          // x: world size of one texel of an orthographic layer (0 for the others);
+                       // y: 1 for a perspective layer (point, spot), 0 for an orthographic one
 };
 
 struct RsPushConstants {
@@ -67,7 +73,7 @@ struct RsPushConstants {
 struct RsShadowPush {
   mat4 viewProj;
   uint primitiveBase;
-  uint pad0;
+  uint perspective;    // 1: a perspective layer (transmit depth in metres along the view), 0: ndc z
   uint pad1;
   uint pad2;
 };
@@ -77,6 +83,7 @@ static_assert(sizeof(RsPushConstants) == 112);
 static_assert(sizeof(RsShadowPush) == 80);
 static_assert(sizeof(RsView) == 80);
 static_assert(sizeof(RsShadowLight) == 16);
+static_assert(sizeof(RsShadowLayer) == 80);
 }  // namespace probecast::shaders
 #endif
 

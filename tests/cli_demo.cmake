@@ -1,7 +1,7 @@
 # Runs a short `probecast demo` and checks what it wrote: report, images, charts, convergence.
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${PROBECAST} demo --out ${WORK} --seconds 3 --settle-updates 4 --reference-spp 4
-                        --light-field lf:2x2 --grid 4,4,4 --skip-suites
+                        --light-field lf:2x2 --grid 4,4,4 --skip-suites ${EXTRA}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "demo failed (${rc}): ${out} ${err}")
@@ -29,4 +29,10 @@ endforeach()
 string(JSON quiltViews GET "${json}" viewers 1 view_count)
 if(NOT quiltViews EQUAL 4)
   message(FATAL_ERROR "the light-field viewer has ${quiltViews} views, expected 4 (lf:2x2)")
+endif()
+if(EXTRA MATCHES "--sky")
+  string(JSON sky ERROR_VARIABLE noSky GET "${json}" environment sky)
+  if(noSky)
+    message(FATAL_ERROR "the report does not name the sky it ran under: ${noSky}")
+  endif()
 endif()

@@ -158,7 +158,7 @@ struct RasterRenderer::Impl {
                                   RS_BINDING_TEXELS, RS_BINDING_TEXTURES, RS_BINDING_VIEWS,
                                   RS_BINDING_SHADOW_LIGHTS, RS_BINDING_SHADOW_LAYERS};
     VkDescriptorBufferInfo infos[8];
-    VkWriteDescriptorSet writes[11];
+    VkWriteDescriptorSet writes[12];
     for (uint32_t b = 0; b < 8; ++b) {
       infos[b] = {buffers[b]->buffer, 0, VK_WHOLE_SIZE};
       writes[b] = bufferWrite(set, bindings[b], &infos[b]);
@@ -171,7 +171,9 @@ struct RasterRenderer::Impl {
     writes[8] = imageWrite(set, RS_BINDING_PROBES, images, RS_PROBE_TEXTURES);
     writes[9] = imageWrite(set, RS_BINDING_ENV_BRDF, &envInfo, 1);
     writes[10] = imageWrite(set, RS_BINDING_SHADOW_MAP, &shadowInfo, 1);
-    vkUpdateDescriptorSets(d->device, 11, writes, 0, nullptr);
+    const VkDescriptorImageInfo transmitInfo{sampler, shadows.transmit.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    writes[11] = imageWrite(set, RS_BINDING_SHADOW_TRANSMIT, &transmitInfo, 1);
+    vkUpdateDescriptorSets(d->device, 12, writes, 0, nullptr);
   }
 
   // Coefficients premultiplied by a weight, the weight in the last texel's w: after trilinear
@@ -362,6 +364,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
   if (options.shadowMapSize < 16 || options.shadowMapSize > 8192)
     throw std::invalid_argument("shadow map size must be 16..8192");
+  if (options.shadowCascades < 1 || options.shadowCascades > RS_MAX_CASCADES)
+    throw std::invalid_argument("shadow cascades must be 1.." + std::to_string(RS_MAX_CASCADES));
   Impl& s = *impl_;
   s.d = &context.device();
   VulkanDevice& d = *s.d;
@@ -403,7 +407,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
       layoutBinding(RS_BINDING_VIEWS, kSsbo, 1, VK_SHADER_STAGE_VERTEX_BIT | kFrag),
       layoutBinding(RS_BINDING_SHADOW_LIGHTS, kSsbo, 1, kFrag),
       layoutBinding(RS_BINDING_SHADOW_LAYERS, kSsbo, 1, kFrag),
-      layoutBinding(RS_BINDING_SHADOW_MAP, kImage, 1, kFrag)};
+      layoutBinding(RS_BINDING_SHADOW_MAP, kImage, 1, kFrag),
+      layoutBinding(RS_BINDING_SHADOW_TRANSMIT, kImage, 1, kFrag)};
   VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   lci.bindingCount = RS_BINDING_COUNT;
   lci.pBindings = bindings;
@@ -411,9 +416,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.layout = createPipelineLayout(d, s.setLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                                   sizeof(shaders::RsPushConstants));
   s.pipelineFor(0, RS_PASS_OPAQUE);
-  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, s.setLayout, s.shadows);
+  createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, options.shadowCascades, s.setLayout, s.shadows);
 
-  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 2}};
+  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 3}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
   // The environment BRDF table, computed at start-up (glossy_sh.h), and the lobe fit.
   {
@@ -493,6 +498,7 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   if (views.size() > Impl::kMaxViews)
     throw std::invalid_argument("at most " + std::to_string(Impl::kMaxViews) + " views per view set");
   std::vector<Image> out(views.size());
+  fitShadowCascades(views, s.shadows);
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;
   const auto t0 = Clock::now();

@@ -48,13 +48,13 @@ VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& d
   cba.colorWriteMask = 0xF;
   if (desc.blend != ColorBlend::None) {
     cba.blendEnable = VK_TRUE;
-    const bool multiply = desc.blend == ColorBlend::Multiply;
+    const bool multiply = desc.blend == ColorBlend::Multiply || desc.blend == ColorBlend::MultiplyMinAlpha;
     cba.srcColorBlendFactor = multiply ? VK_BLEND_FACTOR_ZERO : VK_BLEND_FACTOR_ONE;
     cba.dstColorBlendFactor = multiply ? VK_BLEND_FACTOR_SRC_COLOR : VK_BLEND_FACTOR_ONE;
     cba.colorBlendOp = VK_BLEND_OP_ADD;
     cba.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
     cba.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
-    cba.alphaBlendOp = VK_BLEND_OP_ADD;
+    cba.alphaBlendOp = desc.blend == ColorBlend::MultiplyMinAlpha ? VK_BLEND_OP_MIN : VK_BLEND_OP_ADD;
   }
   VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   cb.attachmentCount = colorless ? 0 : 1;

@@ -10,8 +10,9 @@
 namespace probecast::renderer {
 
 // Colour blending of a pass: none (depth written), or depth-tested passes that do not write depth
-// and combine the colour with what is there: dst · src, or dst + src (alpha kept).
-enum class ColorBlend { None, Multiply, Add };
+// and combine the colour with what is there: dst · src, or dst + src (alpha kept), or dst · src
+// with the smaller alpha kept (shadow maps' transmittance layers).
+enum class ColorBlend { None, Multiply, Add, MultiplyMinAlpha };
 
 struct GraphicsPipelineDesc {
   const uint32_t* vertexCode = nullptr;

@@ -30,8 +30,12 @@ enum class ViewPasses {
 
 struct RasterOptions {
   uint32_t shadowMapSize = 1024;  // texels per side of each shadow layer
-  uint32_t maxShadowLayers = 24;  // point lights take 6, spot and directional lights 1; lights past
+  uint32_t maxShadowLayers = 24;  // point lights take 6, spot lights 1, directional ones
+                                  // shadowCascades (or what is left, at least 1); lights past
                                   // the budget (in scene order) are lit unshadowed
+  // Orthographic layers per directional light (1..4): 1 covers the whole scene; more are cascades
+  // fitted to slices of each view set's depth range (the union of its views' frusta), finest first.
+  uint32_t shadowCascades = 4;
   ViewPasses passes = ViewPasses::PerView;
   // Drawn as background where no surface covers a pixel (linear radiance like the rest, so the
   // same exposure and tone map apply); its light reaches surfaces through the probes only.
