@@ -453,6 +453,7 @@ TEST_F(Updater, RelocationKeepsAProbeInAThinWallUseful) {
   EXPECT_EQ(updater.classifyStats().inactive, 0u);
   ASSERT_EQ(v.offsets.size(), 9u);
   const float dx = v.offsets[3];
+  RecordProperty("offset_x_m", std::to_string(dx));
   EXPECT_GT(std::fabs(dx), 0.1f);                      // out of the wall
   EXPECT_LE(std::fabs(dx), 0.45f * (4.0f / 9.0f));     // within its allowed box
   std::string why;
