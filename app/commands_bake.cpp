@@ -25,9 +25,11 @@ void addBakeCommand(CLI::App& app) {
     fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe, environment {}\n", s.name,
                s.triangleCount(), context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp,
                env ? env->name : "none");
-    uint32_t active = 0;
-    for (uint8_t a : updater.volume().active) active += a;
-    fmt::print("bake: {} of {} probes active ({} inside geometry)\n", active, g.count(), g.count() - active);
+    const renderer::ClassifyStats& cs = updater.classifyStats();
+    fmt::print("bake: {} of {} probes active ({} inside geometry at grid positions, {} left inactive); relocation {}: "
+               "{} moved, mean |offset| {:.3f} m, max {:.2f} cell, {} rounds, {:.1f} ms\n",
+               g.count() - cs.inactive, g.count(), cs.insideAtGrid, cs.inactive, tr->tracer.relocate ? "on" : "off",
+               cs.moved, cs.meanOffsetMetres, cs.maxOffsetCells, cs.rounds, cs.milliseconds);
     for (uint32_t u = 0; u < *updates; ++u) {
       const renderer::UpdateStats st = updater.update();
       fmt::print("bake: update {}/{}: {:.1f} ms, {} paths, {:.2f} M rays/s\n", u + 1, *updates, st.milliseconds, st.paths,

@@ -146,6 +146,7 @@ struct TracerOptions {
   float wMin = 0.05f;
   float rejectSigmas = 4.0f;
   float clamp = 16.0f;
+  bool relocate = true;
   void add(CLI::App* cmd) {
     addSppOption(cmd, spp);
     cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
@@ -156,6 +157,9 @@ struct TracerOptions {
                     "restart a probe's history when new estimates differ by more than this many standard errors (0 = never)")
         ->check(CLI::Range(0.0f, 1000.0f));
     cmd->add_option("--clamp", clamp, "max luminance of an indirect contribution (0 = off)")->check(CLI::Range(0.0f, 1e9f));
+    cmd->add_flag("--relocate,!--no-relocate", relocate,
+                  "move probes inside or too close to geometry (up to 45 % of a cell per axis) instead of only "
+                  "switching them off (default on)");
   }
   renderer::UpdaterOptions options() const {
     renderer::UpdaterOptions o;
@@ -165,6 +169,7 @@ struct TracerOptions {
     o.minBlendWeight = wMin;
     o.rejectSigmas = rejectSigmas;
     o.indirectClamp = clamp;
+    o.relocate = relocate;
     return o;
   }
 };

@@ -122,7 +122,8 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
     StreamLayout layout;
     GridBounds bounds;
     std::string why;
-    if (!service::volumeFromWire(v, layout, bounds, why)) {
+    std::vector<float> offsets;  // where the probes are: not needed to count bytes
+    if (!service::volumeFromWire(v, layout, bounds, offsets, why)) {
       tally_.error("bad volume description: " + why);
       return;
     }

@@ -241,6 +241,7 @@ WallLeak measureWallLeak(renderer::VulkanContext& context) {
     renderer::UpdaterOptions o;
     o.samplesPerProbe = 128;
     o.classify = classify;
+    o.relocate = false;  // classification alone: probes in the wall switch off rather than move
     renderer::ProbeUpdater u(context, s, grid, o);
     u.update();
     u.update();

@@ -8,6 +8,11 @@
 
 #define PT_MODE_TRACE 0u        // full paths, projected to SH
 #define PT_MODE_CLASSIFY 1u     // first segment only: count back-face hits
+// Classify mode's use of a lane's 27 SH floats: distance then unit direction (4 floats each) of
+// the nearest back face and of the nearest front face its rays hit.
+#define PT_CLASSIFY_BACK 0
+#define PT_CLASSIFY_FRONT 4
+#define PT_CLASSIFY_FAR 1e30    // distance when no ray hit a face of that kind
 
 #define PT_BINDING_TLAS 0
 #define PT_BINDING_POSITIONS 1  // float[3 * vertices]

@@ -69,14 +69,15 @@ void reseal(std::vector<uint8_t>& m) {
 }
 
 TEST(BusFormat, VolumeMessageGoldenBytes) {
-  // Written out by hand from the format in bus_format.h; the CRC-32C is of bytes 0-11 and 16-67,
+  // Written out by hand from the format in bus_format.h; the CRC-32C is of bytes 0-11 and 16-71,
   // computed independently.
   const uint8_t golden[] = {
-      0x50, 0x43, 0x42, 0x4d, 0x01, 0x01, 0x01, 0x00, 0x34, 0x00, 0x00, 0x00, 0x08, 0xaa, 0x49, 0xd9,  // header
+      0x50, 0x43, 0x42, 0x4d, 0x02, 0x01, 0x01, 0x00, 0x38, 0x00, 0x00, 0x00, 0x42, 0x00, 0x46, 0x95,  // header
       0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01, 0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11,  // epoch, time
-      0x01, 0x03, 0x04, 0x00, 0x10, 0x00, 0x04, 0x00, 0x10, 0x00, 0x00, 0x00,                          // layout
+      0x01, 0x03, 0x04, 0x00, 0x10, 0x00, 0x04, 0x00, 0x10, 0x00, 0x00, 0x00,                          // layout, no offsets
       0x00, 0x00, 0x00, 0xc0, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xc0,                          // min
-      0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xb0, 0x40};                         // max
+      0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xb0, 0x40,                          // max
+      0x00, 0x00, 0x00, 0x00};                                                                         // offsets CRC
   std::vector<uint8_t> out;
   writeVolumeMessage(sampleVolume(), kEndOfBatch, out);
   EXPECT_EQ(out, std::vector<uint8_t>(std::begin(golden), std::end(golden)));
@@ -147,12 +148,12 @@ TEST(BusFormat, FieldsBehindTheChecksumAreCheckedToo) {
     reseal(m);
     return refusal(m);
   };
-  const uint8_t version2 = 2, kindBad = 7, reprBad = 9;
+  const uint8_t version1 = 1, kindBad = 7, reprBad = 9;
   const uint16_t flagsBad = 2, gridHuge = 60000;
   const uint64_t epoch0 = 0;
   const uint32_t brickOut = 64, version0 = 0, lying = 0xffffffffu;
   const float nan = std::nanf(""), negative = -1.0f, inf = INFINITY;
-  EXPECT_NE(with(4, &version2, 1).find("bus format version 2"), std::string::npos);
+  EXPECT_NE(with(4, &version1, 1).find("bus format version 1"), std::string::npos);  // before the offsets
   EXPECT_NE(with(5, &kindBad, 1).find("kind"), std::string::npos);
   EXPECT_NE(with(6, &flagsBad, 2).find("flags"), std::string::npos);
   EXPECT_NE(with(kHeaderSize, &epoch0, 8).find("epoch"), std::string::npos);
@@ -182,7 +183,97 @@ TEST(BusFormat, FieldsBehindTheChecksumAreCheckedToo) {
   std::vector<uint8_t> asVolume = good;
   asVolume[5] = static_cast<uint8_t>(Kind::Volume);
   reseal(asVolume);
-  EXPECT_NE(refusal(asVolume).find("volume message has 52"), std::string::npos);
+  EXPECT_NE(refusal(asVolume).find("offset bytes, its volume 0"), std::string::npos);
+}
+
+// Sample offsets for the sample volume: probe p moves (p % 7 - 3) × 20 steps along x and 5 along z.
+std::vector<int8_t> sampleOffsets() {
+  std::vector<int8_t> q(16 * 4 * 16 * 3, 0);
+  for (size_t p = 0; p < q.size() / 3; ++p) {
+    q[p * 3] = static_cast<int8_t>((static_cast<int>(p % 7) - 3) * 20);
+    q[p * 3 + 2] = 5;
+  }
+  return q;
+}
+
+TEST(BusFormat, OffsetsTravelOnceInTheVolumeMessageAndBrickMessagesCarryTheirChecksum) {
+  Volume v = sampleVolume();
+  v.offsets = sampleOffsets();
+  std::vector<uint8_t> volumeBytes, plainBytes;
+  writeVolumeMessage(v, 0, volumeBytes);
+  writeVolumeMessage(sampleVolume(), 0, plainBytes);
+  EXPECT_EQ(volumeBytes.size(), plainBytes.size() + 16 * 4 * 16 * 3);  // 3 bytes per probe, once
+  Message m;
+  std::string why;
+  ASSERT_TRUE(readMessage(volumeBytes.data(), volumeBytes.size(), m, why)) << why;
+  EXPECT_EQ(m.volume.offsets, v.offsets);
+  EXPECT_TRUE(m.volume.hasOffsets);
+  EXPECT_EQ(m.volume.offsetsCrc, offsetsChecksum(v.offsets));
+  std::vector<uint8_t> again;
+  writeVolumeMessage(m.volume, m.flags, again);
+  EXPECT_EQ(again, volumeBytes);
+
+  // A brick message of that volume: the same size as without offsets, announcing their checksum.
+  Encoded e;
+  Brick b;
+  b.brick = 2;
+  b.version = e.encoder.brickVersion(2);
+  b.keyframe = e.keyframes[2];
+  std::vector<uint8_t> brickBytes, plainBrick;
+  writeBrickMessage(v, b, 0, brickBytes);
+  writeBrickMessage(sampleVolume(), b, 0, plainBrick);
+  EXPECT_EQ(brickBytes.size(), plainBrick.size());
+  ASSERT_TRUE(readMessage(brickBytes.data(), brickBytes.size(), m, why)) << why;
+  EXPECT_TRUE(m.volume.hasOffsets);
+  EXPECT_TRUE(m.volume.offsets.empty());
+  EXPECT_EQ(m.volume.offsetsCrc, offsetsChecksum(v.offsets));
+  writeBrickMessage(m.volume, m.brick, m.flags, again);
+  EXPECT_EQ(again, brickBytes);
+}
+
+TEST(BusFormat, MalformedOffsetsAreRefused) {
+  Volume v = sampleVolume();
+  v.offsets = sampleOffsets();
+  std::vector<uint8_t> good;
+  writeVolumeMessage(v, 0, good);
+  const size_t at = kHeaderSize + kVolumeSize;  // the first offset byte
+  // One offset byte short (sizes and checksums made consistent): the count is wrong.
+  std::vector<uint8_t> shorter(good.begin(), good.end() - 1);
+  const uint32_t body = static_cast<uint32_t>(shorter.size() - kHeaderSize);
+  std::memcpy(shorter.data() + 8, &body, 4);
+  reseal(shorter);
+  EXPECT_NE(refusal(shorter).find("3071 offset bytes, its volume 3072"), std::string::npos) << refusal(shorter);
+  // -128 steps (outside the symmetric range), with the offsets checksum made to match.
+  std::vector<uint8_t> beyond = good;
+  beyond[at + 3 * 9 + 2] = 0x80;
+  const uint32_t crc = crc32c(beyond.data() + at, 16 * 4 * 16 * 3);
+  std::memcpy(beyond.data() + kHeaderSize + 52, &crc, 4);
+  reseal(beyond);
+  EXPECT_NE(refusal(beyond).find("probe 9 z offset of -128 steps"), std::string::npos) << refusal(beyond);
+  // Offsets that are not the ones announced.
+  std::vector<uint8_t> changed = good;
+  changed[at + 4] ^= 1;
+  reseal(changed);
+  EXPECT_NE(refusal(changed).find("checksum"), std::string::npos);
+  // A flag that is neither 0 nor 1, and a checksum without offsets.
+  std::vector<uint8_t> flag = good;
+  flag[kHeaderSize + 19] = 2;
+  reseal(flag);
+  EXPECT_NE(refusal(flag).find("offsets flag 2"), std::string::npos);
+  std::vector<uint8_t> plain;
+  writeVolumeMessage(sampleVolume(), 0, plain);
+  const uint32_t someCrc = 7;
+  std::memcpy(plain.data() + kHeaderSize + 52, &someCrc, 4);
+  reseal(plain);
+  EXPECT_NE(refusal(plain).find("announces an offsets checksum"), std::string::npos);
+  // Movement along an axis of one probe.
+  Volume flat = sampleVolume();
+  flat.layout.grid[1] = 1;
+  flat.offsets.assign(16 * 1 * 16 * 3, 0);
+  flat.offsets[3 * 4 + 1] = 1;
+  std::vector<uint8_t> flatBytes;
+  writeVolumeMessage(flat, 0, flatBytes);
+  EXPECT_NE(refusal(flatBytes).find("an axis of one probe"), std::string::npos) << refusal(flatBytes);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "probecast/codec/crc32c.h"
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/service/bus_format.h"
 #include "probecast/service/probe_hub.h"
 #include "test_probes.h"
@@ -91,6 +92,33 @@ TEST(EdgeHub, ServesBitForBitWhatTheProducerMadeWithItsEpoch) {
   StreamDecoder dec(edge.layout());
   EXPECT_EQ(drain(edge, id, dec), 4u);
   EXPECT_TRUE(same(p.hub.reconstruction(), dec.probes(), floats));
+}
+
+TEST(EdgeHub, ProbeOffsetsComeOnceInTheVolumeMessageAndTheEdgeWaitsForThem) {
+  Producer p;
+  const ProbeGrid g = gridOf(p.hub.layout(), p.hub.bounds());
+  std::vector<float> offsets(g.count() * 3, 0.0f);
+  for (uint32_t i = 0; i < g.count(); ++i) offsets[i * 3 + 1] = 0.01f * static_cast<float>(i % 40);  // cell 1 m
+  p.hub.setProbeOffsets(offsets);
+  snapProbeOffsets(g, offsets);
+  for (int f = 0; f < 2; ++f) p.publish();
+  ProbeHub edge(gridConfig(), FromBus{});
+  feedAll(edge, p.messages);  // brick messages: the offsets' checksum only
+  EXPECT_FALSE(edge.ready()) << "an edge must not describe the volume before its offsets arrive";
+  std::vector<uint8_t> volume;
+  bus::writeVolumeMessage(p.hub.volume(), bus::kEndOfBatch, volume);
+  EXPECT_EQ(feed(edge, volume), ProbeHub::Received::Applied);
+  ASSERT_TRUE(edge.ready());
+  EXPECT_EQ(edge.volume().offsets, p.hub.volume().offsets);
+  EXPECT_EQ(edge.reconstruction().offsets, offsets);
+  // A volume message of the same epoch with other offsets is refused and changes nothing.
+  bus::Volume other = p.hub.volume();
+  other.offsets[7] = static_cast<int8_t>(other.offsets[7] + 1);
+  bus::writeVolumeMessage(other, 0, volume);
+  std::string why;
+  EXPECT_EQ(feed(edge, volume, &why), ProbeHub::Received::Refused);
+  EXPECT_NE(why.find("another volume"), std::string::npos) << why;
+  EXPECT_EQ(edge.reconstruction().offsets, offsets);
 }
 
 TEST(EdgeHub, ASubscriberMovingToAnotherEdgeResumesWithDeltas) {

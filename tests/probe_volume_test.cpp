@@ -2,9 +2,12 @@
 // codec round trip with its one zh3h flag.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/probe_volume.h"
 #include "probecast/codec/stream.h"
 #include "probecast/codec/zh3.h"
@@ -69,6 +72,69 @@ TEST(ProbeVolume, CheckRefusesWhatNoConsumerCanUse) {
     v.noise[2] = bad;
     EXPECT_FALSE(checkProbeVolume(v, error)) << bad;
   }
+}
+
+TEST(ProbeOffsets, CheckRefusesOffsetsNoViewerCanPlace) {
+  // 3 × 2 × 1 probes over x in [0, 2], y in [0, 0.5]: cells 1 m and 0.5 m, z a single probe.
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{3, 2, 1}, {{0, 0, 0}, {2, 0.5f, 0}}});
+  std::string error;
+  v.offsets.assign(18, 0.0f);
+  v.offsets[0] = 0.5f;    // exactly half a cell is allowed
+  v.offsets[4] = -0.25f;
+  EXPECT_TRUE(checkProbeVolume(v, error)) << error;
+  const auto refused = [&](size_t at, float value, const std::string& why) {
+    ProbeVolume bad = v;
+    bad.offsets[at] = value;
+    EXPECT_FALSE(checkProbeVolume(bad, error)) << at << " " << value;
+    EXPECT_NE(error.find(why), std::string::npos) << error;
+  };
+  refused(3, 0.5001f, "probe 1 moves");                         // beyond half of the 1 m cell along x
+  refused(7, 0.2501f, "more than half its cell");               // beyond half of the 0.5 m cell along y
+  refused(2, 1e-6f, "along z");                                 // z has one probe
+  refused(9, std::numeric_limits<float>::quiet_NaN(), "non-finite x offset");
+  refused(10, -std::numeric_limits<float>::infinity(), "non-finite y offset");
+  v.offsets.pop_back();
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  EXPECT_NE(error.find("17 floats for 6 probes"), std::string::npos) << error;
+}
+
+TEST(ProbeOffsets, QuantisedOffsetsAreWhatEveryViewerReconstructs) {
+  const ProbeGrid g{{5, 3, 2}, {{-1.3f, 0.1f, 2.0f}, {2.9f, 1.7f, 2.7f}}};
+  EXPECT_FLOAT_EQ(probeCellSize(g, 0), 1.05f);
+  std::mt19937 rng(5);
+  std::vector<float> o(g.count() * 3);
+  for (size_t i = 0; i < o.size(); ++i) {
+    const float half = 0.5f * probeCellSize(g, static_cast<int>(i % 3));
+    o[i] = std::uniform_real_distribution<float>(-half, half)(rng);
+  }
+  std::string error;
+  ASSERT_TRUE(checkProbeOffsets(g, o, error)) << error;
+  std::vector<float> snapped = o;
+  snapProbeOffsets(g, snapped);
+  const std::vector<int8_t> q = quantizeProbeOffsets(g, o);
+  std::vector<float> back;
+  ASSERT_TRUE(dequantizeProbeOffsets(g, q.data(), q.size(), back, error)) << error;
+  EXPECT_EQ(back, snapped);                         // the producer's snapped floats are the viewers', bit for bit
+  EXPECT_EQ(quantizeProbeOffsets(g, snapped), q);   // and snapping is idempotent
+  for (size_t i = 0; i < o.size(); ++i) {
+    const float cell = probeCellSize(g, static_cast<int>(i % 3));
+    const float step = cell / 256.0f;  // within half a step, or clamped to 127 steps
+    EXPECT_LE(std::fabs(back[i] - o[i]), std::max(0.5f * step, std::fabs(o[i]) - 127.0f * step) + 1e-6f) << i;
+    EXPECT_LT(std::fabs(back[i]), 0.5f * cell) << i;                            // ±127 steps: under half a cell
+  }
+  ASSERT_TRUE(checkProbeOffsets(g, back, error)) << error;
+  // Bytes off the wire: wrong counts and -128 are refused, out unchanged.
+  std::vector<int8_t> bad = q;
+  bad.pop_back();
+  EXPECT_FALSE(dequantizeProbeOffsets(g, bad.data(), bad.size(), back, error));
+  EXPECT_NE(error.find("89 bytes for 30 probes"), std::string::npos) << error;
+  bad = q;
+  bad[7] = -128;
+  EXPECT_FALSE(dequantizeProbeOffsets(g, bad.data(), bad.size(), back, error));
+  EXPECT_NE(error.find("probe 2 y offset of -128"), std::string::npos) << error;
+  EXPECT_EQ(back, snapped);
+  EXPECT_TRUE(dequantizeProbeOffsets(g, nullptr, 0, back, error));
+  EXPECT_TRUE(back.empty());
 }
 
 TEST(ProbeVolume, StreamLayoutOfAHugeGridIsInvalidNotWrapped) {

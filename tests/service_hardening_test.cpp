@@ -30,7 +30,7 @@ std::unique_ptr<pb::ProbeStream::Stub> stubFor(int port) {
 
 pb::ClientMessage helloMessage() {
   pb::ClientMessage m;
-  m.mutable_hello()->set_protocol_version(1);
+  m.mutable_hello()->set_protocol_version(2);
   return m;
 }
 
@@ -310,7 +310,7 @@ class FixedVolumeServer final : public pb::ProbeStream::Service {
 // Defect 6, client side: a bad server's numbers are range-checked before narrowing, not wrapped.
 TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
   pb::VolumeDescription good;
-  good.set_protocol_version(1);
+  good.set_protocol_version(2);
   good.set_codec_format_version(kFormatVersion);
   good.set_grid_x(16);
   good.set_grid_y(4);
@@ -332,6 +332,16 @@ TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
       {[](pb::VolumeDescription& v) { v.set_representation(static_cast<pb::Representation>(260)); },
        "representation 260"},
       {[](pb::VolumeDescription& v) { v.set_representation(pb::REPRESENTATION_UNSPECIFIED); }, "representation 0"},
+      // Probe offsets: 3 bytes per probe (16 × 4 × 16 probes) or none, each within ±127 steps.
+      {[](pb::VolumeDescription& v) { v.set_probe_offsets(std::string(16 * 4 * 16 * 3 - 1, '\0')); },
+       "3071 bytes for 1024 probes"},
+      {[](pb::VolumeDescription& v) { v.set_probe_offsets(std::string(5, '\0')); }, "5 bytes for 1024 probes"},
+      {[](pb::VolumeDescription& v) {
+         std::string q(16 * 4 * 16 * 3, '\0');
+         q[3 * 17 + 1] = static_cast<char>(-128);  // probe 17's y: -128 steps, beyond the symmetric range
+         v.set_probe_offsets(q);
+       },
+       "probe 17 y offset of -128 steps"},
   };
   for (const Case& c : cases) {
     pb::VolumeDescription bad = good;
@@ -355,6 +365,22 @@ TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
   EXPECT_TRUE(waitFor([&] { return client.stats().connects >= 1; }, 5s)) << client.stats().lastError;
   VolumeSnapshot snap;
   EXPECT_TRUE(client.snapshot(snap));
+  EXPECT_TRUE(snap.volume.offsets.empty());
+  // And with good offsets: probe 17 moved 100 steps along +x (100/256 of the 1/15 m spacing).
+  pb::VolumeDescription moved = good;
+  std::string q(16 * 4 * 16 * 3, '\0');
+  q[3 * 17] = 100;
+  moved.set_probe_offsets(q);
+  FixedVolumeServer movedServer(moved);
+  ProbeClient movedClient(clientFor(movedServer.port()));
+  movedClient.start();
+  EXPECT_TRUE(waitFor([&] { return movedClient.stats().connects >= 1; }, 5s)) << movedClient.stats().lastError;
+  ASSERT_TRUE(movedClient.snapshot(snap));
+  ASSERT_EQ(snap.volume.offsets.size(), 16u * 4 * 16 * 3);
+  EXPECT_FLOAT_EQ(snap.volume.offsets[3 * 17], (1.0f / 15.0f) * (100.0f / 256.0f));
+  EXPECT_EQ(snap.volume.offsets[3 * 17 + 1], 0.0f);
+  std::string error;
+  EXPECT_TRUE(checkProbeVolume(snap.volume, error)) << error;
 }
 
 // Defect 7: a server without a token used to serve anyone; now only when asked for explicitly.

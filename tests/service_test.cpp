@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "probecast.grpc.pb.h"
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
 #include "service_test_support.h"
@@ -130,7 +131,7 @@ TEST(Service, StalledSubscriberDoesNotDelayOthers) {
   stalledCtx.AddMetadata("authorization", std::string("Bearer ") + kToken);
   auto stalled = stub->Subscribe(&stalledCtx);
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(1);
+  hello.mutable_hello()->set_protocol_version(2);
   ASSERT_TRUE(stalled->Write(hello));
 
   Producer producer(hub, 60, 10ms);
@@ -158,7 +159,7 @@ TEST(Service, WrongTokenIsUnauthenticatedAndGetsNoPayload) {
   ctx.AddMetadata("authorization", "Bearer nope");
   auto stream = stub->Subscribe(&ctx);
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(1);
+  hello.mutable_hello()->set_protocol_version(2);
   stream->Write(hello);
   pb::ServerMessage msg;
   EXPECT_FALSE(stream->Read(&msg));
@@ -189,13 +190,13 @@ TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {
       grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
 
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(1);
+  hello.mutable_hello()->set_protocol_version(2);
   pb::ClientMessage views;  // a first message that is not hello
   views.mutable_views()->add_views()->add_view_projection(1.0f);
   EXPECT_EQ(statusAfter(*stub, views).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
   pb::ClientMessage v2 = hello;
-  v2.mutable_hello()->set_protocol_version(2);
+  v2.mutable_hello()->set_protocol_version(1);  // before the probe offsets
   const grpc::Status wrongVersion = statusAfter(*stub, v2);
   EXPECT_EQ(wrongVersion.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_NE(wrongVersion.error_message().find("protocol version"), std::string::npos);
@@ -321,6 +322,57 @@ TEST(Service, GetVolumeAndHealth) {
   std::string body;
   for (auto& s : slices) body.append(reinterpret_cast<const char*>(s.begin()), s.size());
   EXPECT_EQ(body, std::string("\x08\x01", 2));  // status: SERVING
+}
+
+// Offsets as a relocating updater hands them over: probe p of the 16 × 4 × 16 volume moves
+// along x by a fraction of its 0.233 m cell that varies with p, and probe 5 along y too.
+std::vector<float> sampleOffsets(const ProbeGrid& g) {
+  std::vector<float> o(g.count() * 3, 0.0f);
+  for (uint32_t p = 0; p < g.count(); ++p) o[p * 3] = 0.45f * probeCellSize(g, 0) * (static_cast<float>(p % 9) - 4.0f) / 4.0f;
+  o[5 * 3 + 1] = -0.3f * probeCellSize(g, 1);
+  return o;
+}
+
+TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
+  ProbeHub hub(volumeConfig());
+  const ProbeGrid g = gridOf(hub.layout(), hub.bounds());
+  std::vector<float> offsets = sampleOffsets(g);
+  hub.setProbeOffsets(offsets);
+  EXPECT_THROW(hub.setProbeOffsets(std::vector<float>(7, 0.0f)), std::invalid_argument);  // wrong count
+  std::vector<float> tooFar = offsets;
+  tooFar[4] = 0.51f * probeCellSize(g, 1);
+  EXPECT_THROW(hub.setProbeOffsets(tooFar), std::invalid_argument);
+  const uint64_t epoch = hub.epoch();  // nothing published and nobody subscribed yet: same epoch
+  snapProbeOffsets(g, offsets);         // what every viewer reconstructs from 3 bytes per probe
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 3, 20ms);
+  ProbeClient client(clientFor(server.port()));
+  client.start();
+  ASSERT_TRUE(waitFor([&] { return matchesServer(client, hub) && producer.published() == 3; }, 10s))
+      << client.stats().lastError;
+  VolumeSnapshot snap;
+  ASSERT_TRUE(client.snapshot(snap));
+  EXPECT_EQ(snap.volume.offsets, offsets);  // bit for bit
+  EXPECT_EQ(hub.reconstruction().offsets, offsets);
+  EXPECT_EQ(hub.epoch(), epoch);
+  // GetVolume carries them too: 3 bytes per probe.
+  auto stub = pb::ProbeStream::NewStub(
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  pb::VolumeDescription v;
+  ASSERT_TRUE(stub->GetVolume(&ctx, pb::GetVolumeRequest(), &v).ok());
+  EXPECT_EQ(v.probe_offsets().size(), g.count() * 3u);
+  // New offsets (the geometry changed): a new epoch, the client subscribes again and gets them.
+  producer.stop();
+  std::vector<float> next(g.count() * 3, 0.0f);
+  next[3 * 100 + 2] = 0.2f * probeCellSize(g, 2);
+  hub.setProbeOffsets(next);
+  snapProbeOffsets(g, next);
+  EXPECT_NE(hub.epoch(), epoch);
+  ASSERT_TRUE(waitFor([&] { return client.snapshot(snap) && snap.volume.offsets == next; }, 10s))
+      << client.stats().lastError;
+  client.stop();
 }
 
 }  // namespace

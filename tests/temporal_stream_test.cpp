@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "probecast/codec/crc32c.h"
 #include "probecast/codec/stream.h"
 #include "test_probes.h"
 
@@ -403,6 +404,46 @@ TEST(ProbeFile, RoundTripAndRejections) {
   serializeProbeVolume(v, bytes);
   EXPECT_FALSE(parseProbeVolume(bytes.data(), bytes.size(), back, error));
   EXPECT_NE(error.find("NaN"), std::string::npos);
+}
+
+TEST(ProbeFile, OffsetsRoundTripAndVersion1FilesAreStillRead) {
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{3, 2, 1}, {{-1, 0, 0}, {1, 1, 0}}});  // cells 1 m (x), 1 m (y)
+  for (size_t i = 0; i < v.probes.size(); ++i) v.probes[i] = 0.01f * static_cast<float>(i);
+  v.offsets.assign(6 * 3, 0.0f);
+  v.offsets[3 * 4 + 0] = 0.45f;   // probe 4: 0.45 m along x
+  v.offsets[3 * 4 + 1] = -0.125f;
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(v, bytes);
+  ProbeVolume back;
+  std::string error;
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_EQ(back.offsets, v.offsets);  // floats, bit for bit
+  for (size_t len = 0; len < bytes.size(); ++len) EXPECT_FALSE(parseProbeVolume(bytes.data(), len, back, error)) << len;
+
+  // A version 1 file, as written before offsets existed (no offset count): read, no offsets.
+  ProbeVolume old = v;
+  old.offsets.clear();
+  serializeProbeVolume(old, bytes);
+  bytes.erase(bytes.end() - 8, bytes.end() - 4);  // the zero offset count
+  bytes[4] = 1;
+  bytes.resize(bytes.size() - 4);
+  const uint32_t crc = crc32c(bytes.data(), bytes.size());
+  for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(crc >> (8 * i)));
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_TRUE(back.offsets.empty());
+  EXPECT_EQ(back.probes, v.probes);
+
+  // Offsets beyond half a cell, NaN, or on an axis of one probe are refused under a valid checksum.
+  const auto refusedWith = [&](size_t at, float value, const std::string& why) {
+    ProbeVolume bad = v;
+    bad.offsets[at] = value;
+    serializeProbeVolume(bad, bytes);
+    EXPECT_FALSE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << at;
+    EXPECT_NE(error.find(why), std::string::npos) << error;
+  };
+  refusedWith(3 * 2, 0.51f, "more than half its cell");
+  refusedWith(3 * 2 + 1, std::nanf(""), "non-finite");
+  refusedWith(3 * 5 + 2, 0.01f, "more than half its cell (0");  // z has one probe
 }
 
 }  // namespace

@@ -8,13 +8,14 @@
 
 #include "byte_io.h"
 #include "probecast/codec/crc32c.h"
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {
 namespace {
 
 constexpr uint8_t kMagic[4] = {'P', 'C', 'P', 'V'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2 adds the offsets; 1 is still read
 constexpr size_t kHeaderBytes = 4 + 4 + 12 + 24 + 8;
 
 void putF32(std::vector<uint8_t>& out, float v) {
@@ -42,13 +43,17 @@ void serializeProbeVolume(const ProbeVolume& v, std::vector<uint8_t>& out) {
   putU32(out, v.samplesPerProbe);
   for (float f : v.probes) putF32(out, f);
   out.insert(out.end(), v.active.begin(), v.active.end());
+  putU32(out, static_cast<uint32_t>(v.offsets.size()));
+  for (float f : v.offsets) putF32(out, f);
   putU32(out, crc32c(out.data(), out.size()));
 }
 
 bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::string& error) {
   if (size < kHeaderBytes + 4) return error = "truncated probe file header", false;
   if (std::memcmp(data, kMagic, 4) != 0) return error = "not a probecast probe file (bad magic)", false;
-  if (getU32(data + 4) != kVersion) return error = "unsupported probe file version " + std::to_string(getU32(data + 4)), false;
+  const uint32_t version = getU32(data + 4);
+  if (version != 1 && version != kVersion)
+    return error = "unsupported probe file version " + std::to_string(version) + " (this build reads 1 and 2)", false;
   ProbeVolume out;
   uint64_t count = 1;
   for (int a = 0; a < 3; ++a) {
@@ -64,7 +69,18 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
   }
   out.updates = getU32(data + 44);
   out.samplesPerProbe = getU32(data + 48);
-  const uint64_t expected = kHeaderBytes + count * 27 * 4 + count + 4;
+  // Version 2: u32 number of offset floats (0 or 3 per probe), then the floats.
+  const uint64_t samplesEnd = kHeaderBytes + count * 27 * 4 + count;
+  uint64_t offsetFloats = 0;
+  if (version >= 2) {
+    if (size < samplesEnd + 4 + 4) return error = "probe file truncated before its offsets", false;
+    offsetFloats = getU32(data + samplesEnd);
+    if (offsetFloats != 0 && offsetFloats != count * 3)
+      return error = "probe file holds " + std::to_string(offsetFloats) + " offset floats for " +
+                     std::to_string(count) + " probes (3 each, or none)",
+             false;
+  }
+  const uint64_t expected = samplesEnd + (version >= 2 ? 4 + offsetFloats * 4 : 0) + 4;
   if (size != expected)
     return error = "probe file is " + std::to_string(size) + " bytes, expected " + std::to_string(expected), false;
   if (crc32c(data, size - 4) != getU32(data + size - 4)) return error = "probe file checksum mismatch", false;
@@ -77,6 +93,9 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
   out.active.assign(p + count * 27 * 4, p + count * 27 * 4 + count);
   for (uint8_t a : out.active)
     if (a > 1) return error = "active mask holds a value other than 0 or 1", false;
+  out.offsets.resize(offsetFloats);
+  for (size_t i = 0; i < out.offsets.size(); ++i) out.offsets[i] = getF32(data + samplesEnd + 4 + 4 * i);
+  if (!checkProbeOffsets(out.grid, out.offsets, error)) return false;
   v = std::move(out);
   return true;
 }

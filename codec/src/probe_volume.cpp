@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {
@@ -69,7 +70,7 @@ bool checkProbeVolume(const ProbeVolume& v, std::string& error) {
   for (size_t i = 0; i < v.noise.size(); ++i)
     if (!(std::isfinite(v.noise[i]) && v.noise[i] >= 0.0f))
       return error = "probe volume: noise of probe " + std::to_string(i) + " is not a finite value >= 0", false;
-  return true;
+  return checkProbeOffsets(v.grid, v.offsets, error);
 }
 
 ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel) {

@@ -11,6 +11,8 @@
 #include "probe_trace.rgen.h"
 #include "gpu_scene.h"
 #include "probe_history.h"
+#include "probe_relocation.h"
+#include "probecast/codec/probe_offsets.h"
 #include "vk_raytracing.h"
 
 namespace probecast::renderer {
@@ -98,6 +100,7 @@ struct ProbeUpdater::Impl {
   UpdaterOptions options;
   uint32_t samples = 0;
   std::vector<uint32_t> activeList;
+  ClassifyStats classifyStats;
   std::vector<ProbeHistory> history;  // per probe: blend count and noise statistics
   size_t geometryVertices = 0, geometryTriangles = 0;
   std::vector<glm::vec3> geometryPositions;
@@ -114,6 +117,8 @@ struct ProbeUpdater::Impl {
     for (size_t i = 0; i < list.size(); ++i) {
       float p[3];
       volume.grid.position(list[i], p);
+      if (!volume.offsets.empty())
+        for (int a = 0; a < 3; ++a) p[a] += volume.offsets[static_cast<size_t>(list[i]) * 3 + a];
       float key;
       std::memcpy(&key, &list[i], sizeof key);  // the grid index as bits: the shader's RNG stream
       data[i] = {p[0], p[1], p[2], key};
@@ -139,21 +144,76 @@ struct ProbeUpdater::Impl {
     runRayTracingPass(*d, pass, in, &push, kLanes, count);
   }
 
+  // What the lanes of the i-th probe of the last classify dispatch saw, over `n` rays.
+  ClassifyHits classifyHits(size_t i, uint32_t n) const {
+    const float* part = static_cast<const float*>(partials.mapped);
+    ClassifyHits h;
+    h.backDistance = h.frontDistance = static_cast<float>(PT_CLASSIFY_FAR);
+    float back = 0.0f;
+    for (uint32_t lane = 0; lane < kLanes; ++lane) {
+      const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
+      back += src[27];
+      if (src[PT_CLASSIFY_BACK] < h.backDistance) {
+        h.backDistance = src[PT_CLASSIFY_BACK];
+        h.backDirection = glm::vec3(src[PT_CLASSIFY_BACK + 1], src[PT_CLASSIFY_BACK + 2], src[PT_CLASSIFY_BACK + 3]);
+      }
+      if (src[PT_CLASSIFY_FRONT] < h.frontDistance) {
+        h.frontDistance = src[PT_CLASSIFY_FRONT];
+        h.frontDirection = glm::vec3(src[PT_CLASSIFY_FRONT + 1], src[PT_CLASSIFY_FRONT + 2], src[PT_CLASSIFY_FRONT + 3]);
+      }
+    }
+    h.backFraction = back / static_cast<float>(n);
+    return h;
+  }
+
+  // Classify rays at every probe, then (relocating) again at the probes that moved, until every
+  // probe is settled or stuck or the rounds are spent; inside geometry at the end = inactive.
   void classify() {
-    std::vector<uint32_t> all(volume.count());
-    std::iota(all.begin(), all.end(), 0u);
+    const auto t0 = std::chrono::steady_clock::now();
+    classifyStats = ClassifyStats{};
+    std::vector<uint32_t> pending(volume.count());
+    std::iota(pending.begin(), pending.end(), 0u);
     std::vector<uint8_t>& active = volume.active;
     std::fill(active.begin(), active.end(), 1);
-    if (options.classify) {
-      uploadProbeList(all);
-      const uint32_t n = roundUpLanes(options.classifySamples);
-      dispatch(volume.count(), n, classifyDirections, PT_MODE_CLASSIFY, identity());
-      const float* part = static_cast<const float*>(partials.mapped);
-      for (uint32_t p = 0; p < volume.count(); ++p) {
-        float back = 0.0f;
-        for (uint32_t lane = 0; lane < kLanes; ++lane) back += part[(p * kLanes + lane) * PT_PARTIAL_FLOATS + 27];
-        active[p] = back / static_cast<float>(n) > options.backFaceThreshold ? 0 : 1;
+    volume.offsets.clear();
+    const bool relocating = options.classify && options.relocate;
+    RelocationRule rule;
+    rule.backFaceThreshold = options.backFaceThreshold;
+    float smallest = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+      const float cell = probeCellSize(volume.grid, a);
+      rule.maxShift[a] = std::clamp(options.relocateMaxShift, 0.0f, 0.5f) * cell;
+      if (cell > 0.0f) smallest = smallest > 0.0f ? std::min(smallest, cell) : cell;
+    }
+    rule.clearance = std::max(0.0f, options.relocateClearance) * smallest;
+    if (relocating) volume.offsets.assign(static_cast<size_t>(volume.count()) * 3, 0.0f);
+    const uint32_t n = roundUpLanes(options.classifySamples);
+    for (uint32_t round = 0; options.classify && !pending.empty(); ++round) {
+      uploadProbeList(pending);
+      dispatch(static_cast<uint32_t>(pending.size()), n, classifyDirections, PT_MODE_CLASSIFY, identity());
+      ++classifyStats.rounds;
+      const bool last = !relocating || round >= options.relocateRounds;
+      std::vector<uint32_t> moved;
+      for (size_t i = 0; i < pending.size(); ++i) {
+        const uint32_t p = pending[i];
+        const ClassifyHits hits = classifyHits(i, n);
+        const bool inside = hits.backFraction > options.backFaceThreshold;
+        if (round == 0) classifyStats.insideAtGrid += inside ? 1u : 0u;
+        float* o = relocating ? &volume.offsets[static_cast<size_t>(p) * 3] : nullptr;
+        glm::vec3 offset = o ? glm::vec3(o[0], o[1], o[2]) : glm::vec3(0.0f);
+        if (!last && relocationStep(hits, rule, offset) == RelocationStep::Moved) {
+          std::vector<float> snapped = {offset.x, offset.y, offset.z};
+          snapProbeOffsets(volume.grid, snapped);  // trace where viewers will put it
+          if (!std::equal(snapped.begin(), snapped.end(), o)) {
+            std::copy(snapped.begin(), snapped.end(), o);
+            moved.push_back(p);
+            continue;
+          }
+        }
+        active[p] = inside ? 0 : 1;
+        if (inside && o) std::fill_n(o, 3, 0.0f);  // no position in the allowed box is outside: off, unmoved
       }
+      pending = std::move(moved);
     }
     activeList.clear();
     for (uint32_t p = 0; p < volume.count(); ++p) {
@@ -166,6 +226,25 @@ struct ProbeUpdater::Impl {
       if (!volume.noise.empty()) volume.noise[p] = 0.0f;
     }
     uploadProbeList(activeList);
+    summarizeClassification(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+
+  void summarizeClassification(double milliseconds) {
+    ClassifyStats& c = classifyStats;
+    c.milliseconds = milliseconds;
+    double sum = 0.0;
+    for (uint32_t p = 0; p < volume.count(); ++p) {
+      c.inactive += volume.active[p] == 0 ? 1u : 0u;
+      if (volume.offsets.empty()) continue;
+      const float* o = &volume.offsets[static_cast<size_t>(p) * 3];
+      if (o[0] == 0.0f && o[1] == 0.0f && o[2] == 0.0f) continue;
+      ++c.moved;
+      sum += std::sqrt(static_cast<double>(o[0]) * o[0] + static_cast<double>(o[1]) * o[1] + static_cast<double>(o[2]) * o[2]);
+      for (int a = 0; a < 3; ++a)
+        c.maxOffsetCells = std::max(c.maxOffsetCells, std::fabs(o[a]) / static_cast<double>(probeCellSize(volume.grid, a)));
+    }
+    c.meanOffsetMetres = c.moved ? sum / c.moved : 0.0;
+    if (c.moved == 0) volume.offsets.clear();  // nothing moved: every probe at its grid position, no bytes to send
   }
 
   void setGeometry(const scene::Scene& s) {
@@ -275,6 +354,7 @@ uint32_t ProbeUpdater::probeCount() const { return impl_->volume.count(); }
 uint32_t ProbeUpdater::updates() const { return impl_->volume.updates; }
 const ProbeVolume& ProbeUpdater::volume() const { return impl_->volume; }
 const ProbeGrid& ProbeUpdater::grid() const { return impl_->volume.grid; }
+const ClassifyStats& ProbeUpdater::classifyStats() const { return impl_->classifyStats; }
 
 uint64_t ProbeUpdater::deviceBytes() const {
   const Impl& s = *impl_;

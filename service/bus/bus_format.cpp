@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "probecast/codec/crc32c.h"
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/record.h"
 
 namespace probecast::bus {
@@ -53,11 +54,12 @@ void writeVolume(const Volume& v, std::vector<uint8_t>& out) {
   put(out, kFormatVersion);
   put(out, static_cast<uint8_t>(v.layout.repr));
   put(out, v.layout.brickDim);
-  put(out, uint8_t{0});
+  put(out, static_cast<uint8_t>(v.offsets.empty() && !v.hasOffsets ? 0 : 1));
   for (uint16_t n : v.layout.grid) put(out, n);
   put(out, uint16_t{0});
   for (float f : v.bounds.min) put(out, f);
   for (float f : v.bounds.max) put(out, f);
+  put(out, v.offsets.empty() ? v.offsetsCrc : offsetsChecksum(v.offsets));
 }
 
 bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
@@ -68,7 +70,12 @@ bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
     return why = "codec format version " + std::to_string(p[16]) + ", this build reads " +
                  std::to_string(kFormatVersion), false;
   if (!isValidRepresentation(p[17])) return why = "unknown representation " + std::to_string(p[17]), false;
-  if (p[19] != 0 || get<uint16_t>(p + 26) != 0) return why = "reserved volume bytes are not 0", false;
+  if (p[19] > 1) return why = "volume offsets flag " + std::to_string(p[19]) + " is neither 0 nor 1", false;
+  if (get<uint16_t>(p + 26) != 0) return why = "reserved volume bytes are not 0", false;
+  v.hasOffsets = p[19] == 1;
+  v.offsetsCrc = get<uint32_t>(p + 52);
+  v.offsets.clear();
+  if (!v.hasOffsets && v.offsetsCrc != 0) return why = "a volume without offsets announces an offsets checksum", false;
   v.layout.repr = static_cast<Representation>(p[17]);
   v.layout.brickDim = p[18];
   for (int a = 0; a < 3; ++a) v.layout.grid[a] = get<uint16_t>(p + 20 + 2 * a);
@@ -103,11 +110,33 @@ bool checkSection(const StreamLayout& layout, std::span<const uint8_t> bytes, co
   return true;
 }
 
+// The offsets that follow a volume message's fixed part: as many as the volume announces, valid,
+// with the announced checksum.
+bool readOffsets(const uint8_t* p, size_t bytes, Volume& v, std::string& why) {
+  const uint64_t probes = static_cast<uint64_t>(v.layout.grid[0]) * v.layout.grid[1] * v.layout.grid[2];
+  const uint64_t expected = v.hasOffsets ? probes * kOffsetBytesPerProbe : 0;
+  if (bytes != expected)
+    return why = "volume message has " + std::to_string(bytes) + " offset bytes, its volume " +
+                 std::to_string(expected), false;
+  if (!v.hasOffsets) return true;
+  const auto* q = reinterpret_cast<const int8_t*>(p);
+  std::vector<float> metres;
+  if (!dequantizeProbeOffsets(gridOf(v.layout, v.bounds), q, bytes, metres, why)) return false;
+  v.offsets.assign(q, q + bytes);
+  if (offsetsChecksum(v.offsets) != v.offsetsCrc) return why = "volume offsets do not match their checksum", false;
+  return true;
+}
+
 }  // namespace
+
+uint32_t offsetsChecksum(const std::vector<int8_t>& offsets) {
+  return offsets.empty() ? 0 : crc32c(reinterpret_cast<const uint8_t*>(offsets.data()), offsets.size());
+}
 
 void writeVolumeMessage(const Volume& volume, uint16_t flags, std::vector<uint8_t>& out) {
   writeHeader(Kind::Volume, flags, out);
   writeVolume(volume, out);
+  put(out, volume.offsets.data(), volume.offsets.size());
   finish(out);
 }
 
@@ -148,12 +177,12 @@ bool readMessage(const uint8_t* data, size_t size, Message& out, std::string& wh
 
   const uint8_t* p = data + kHeaderSize;
   const size_t fixed = out.kind == Kind::Volume ? kVolumeSize : kVolumeSize + kBrickFixedSize;
-  if (body < fixed || (out.kind == Kind::Volume && body != kVolumeSize))
+  if (body < fixed)
     return why = "body of " + std::to_string(body) + " bytes, a " +
-                 (out.kind == Kind::Volume ? "volume message has " : "brick message has at least ") +
+                 (out.kind == Kind::Volume ? "volume message has " : "brick message has ") + "at least " +
                  std::to_string(fixed), false;
   if (!readVolume(p, out.volume, why)) return false;
-  if (out.kind == Kind::Volume) return true;
+  if (out.kind == Kind::Volume) return readOffsets(p + kVolumeSize, body - kVolumeSize, out.volume, why);
 
   p += kVolumeSize;
   Brick& b = out.brick;

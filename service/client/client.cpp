@@ -25,6 +25,7 @@ struct ProbeClient::Impl {
   std::unique_ptr<StreamDecoder> decoder;
   StreamLayout layout;
   GridBounds bounds;
+  std::vector<float> offsets;  // the description's probe offsets, metres
   uint64_t epoch = 0;
   uint64_t newestServerTimeUs = 0;
   std::vector<uint32_t> latencies;  // ring of the most recent 4096
@@ -68,9 +69,10 @@ struct ProbeClient::Impl {
   bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
     StreamLayout l;
     GridBounds b;
+    std::vector<float> o;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
-    if (!volumeFromWire(v, l, b, why)) {
+    if (!volumeFromWire(v, l, b, o, why)) {
       stats.lastError = "bad volume description: " + why;
       return false;
     }
@@ -82,6 +84,7 @@ struct ProbeClient::Impl {
     }
     layout = l;
     bounds = b;
+    offsets = std::move(o);
     epoch = v.stream_epoch();
     stats.connected = true;
     stats.connects += 1;
@@ -268,6 +271,7 @@ bool ProbeClient::snapshot(VolumeSnapshot& out) const {
   if (!impl_->decoder) return false;
   out.layout = impl_->layout;
   impl_->decoder->copyVolume(impl_->bounds, out.volume);
+  out.volume.offsets = impl_->offsets;
   out.framesApplied = impl_->stats.framesApplied;
   out.newestServerTimeUs = impl_->newestServerTimeUs;
   return true;

@@ -21,6 +21,7 @@ struct BusPublisher::Impl {
   bool stopping = false, needStream = true, resync = false, purge = true, busy = false;
   std::string failure;  // an acknowledgement that came back refused, from the library's thread
   PublisherStats stats;
+  uint64_t volumeEpochSent = 0;  // the producer's epoch of the last volume message the bus acknowledged
   std::unique_ptr<NatsLink> link;
   std::thread worker;
 
@@ -66,6 +67,9 @@ struct BusPublisher::Impl {
   bool publish(const std::map<uint32_t, BrickVersionBytes>& batch, bool withVolume, PublisherStats& sent,
                std::string& why) {
     bus::Volume volume = hub.volume();
+    // A new epoch (the probe offsets changed) needs its description out before its bricks: the
+    // brick messages carry only the offsets' checksum.
+    withVolume = withVolume || volume.epoch != volumeEpochSent;
     std::vector<uint8_t> message;
     jsPubOptions po;
     jsPubOptions_Init(&po);
@@ -102,6 +106,7 @@ struct BusPublisher::Impl {
       failure.clear();
       return false;
     }
+    if (withVolume) volumeEpochSent = volume.epoch;
     return true;
   }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "brick_source.h"
+#include "probecast/codec/probe_offsets.h"
 
 namespace probecast::service {
 namespace {
@@ -19,9 +20,11 @@ uint64_t randomEpoch() {
   return (static_cast<uint64_t>(rd()) << 32 | rd()) | 1u;  // never 0 ("no epoch")
 }
 
-bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBounds& bounds) {
+bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBounds& bounds, bool hasOffsets,
+                uint32_t offsetsCrc) {
   const StreamLayout& l = a.layout;
-  bool same = l.repr == layout.repr && l.brickDim == layout.brickDim;
+  bool same = l.repr == layout.repr && l.brickDim == layout.brickDim && a.hasOffsets == hasOffsets &&
+              a.offsetsCrc == offsetsCrc;
   for (int i = 0; i < 3; ++i)
     same = same && l.grid[i] == layout.grid[i] && a.bounds.min[i] == bounds.min[i] && a.bounds.max[i] == bounds.max[i];
   return same;
@@ -41,6 +44,8 @@ bus::Brick busBrick(const BrickVersionBytes& v) {
 }
 
 ProbeHub::ProbeHub(const HubConfig& config) : config_(config), epoch_(randomEpoch()) {
+  hasOffsets_ = !config.offsets.empty();
+  offsetsCrc_ = bus::offsetsChecksum(config.offsets);
   auto source = std::make_unique<EncoderBricks>(config.layout, config.encoder);
   encoder_ = source.get();
   source_ = std::move(source);
@@ -52,7 +57,7 @@ ProbeHub::~ProbeHub() = default;
 
 bool ProbeHub::ready() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return source_ != nullptr;
+  return source_ != nullptr && (!hasOffsets_ || !config_.offsets.empty());
 }
 
 StreamLayout ProbeHub::layout() const {
@@ -77,7 +82,31 @@ bus::Volume ProbeHub::volume() const {
   v.publishedUs = publishedUs_;
   v.layout = config_.layout;
   v.bounds = config_.bounds;
+  v.offsets = config_.offsets;
+  v.hasOffsets = hasOffsets_;
+  v.offsetsCrc = offsetsCrc_;
   return v;
+}
+
+void ProbeHub::setProbeOffsets(const std::vector<float>& offsets) {
+  std::vector<std::function<void()>> wakes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    encoderSource("setProbeOffsets");
+    const ProbeGrid grid = gridOf(config_.layout, config_.bounds);
+    std::string error;
+    if (!checkProbeOffsets(grid, offsets, error)) throw std::invalid_argument(error);
+    std::vector<int8_t> q = quantizeProbeOffsets(grid, offsets);
+    if (q == config_.offsets) return;
+    config_.offsets = std::move(q);
+    hasOffsets_ = !config_.offsets.empty();
+    offsetsCrc_ = bus::offsetsChecksum(config_.offsets);
+    if (frame_ > 0 || !subscribers_.empty()) {  // what viewers were told no longer holds
+      epoch_ = randomEpoch();
+      endStreams(wakes);
+    }
+  }
+  for (auto& w : wakes) w();
 }
 
 EncoderBricks& ProbeHub::encoderSource(const char* what) const {
@@ -99,6 +128,7 @@ void ProbeHub::publish(const ProbeVolume& volume) {
   for (int a = 0; a < 3; ++a)
     if (volume.grid.dims[a] != config_.layout.grid[a])
       throw std::invalid_argument("published volume's grid differs from the hub's");
+  setProbeOffsets(volume.offsets);
   publish(volume.probes.data(), volume.active.data(), volume.noise.empty() ? nullptr : volume.noise.data());
 }
 
@@ -168,12 +198,19 @@ std::vector<BrickVersionBytes> ProbeHub::currentBricks() {
 void ProbeHub::startEpoch(const bus::Volume& volume, std::vector<std::function<void()>>& wakes) {
   config_.layout = volume.layout;
   config_.bounds = volume.bounds;
+  config_.offsets = volume.offsets;  // none yet when a brick message opens the epoch: the volume message brings them
+  hasOffsets_ = volume.hasOffsets;
+  offsetsCrc_ = volume.offsetsCrc;
   epoch_ = volume.epoch;
   auto source = std::make_unique<BusBricks>(volume.layout);
   bus_ = source.get();
   source_ = std::move(source);
   frame_ = 0;
   publishedUs_ = 0;
+  endStreams(wakes);
+}
+
+void ProbeHub::endStreams(std::vector<std::function<void()>>& wakes) {
   for (auto& [id, s] : subscribers_) {  // what they hold is of another epoch: their streams end
     s.ended = true;
     s.waiting = false;
@@ -190,9 +227,12 @@ ProbeHub::Received ProbeHub::receive(const bus::Message& m, bool wake, std::stri
     if (!source_ || m.volume.epoch != epoch_) {
       startEpoch(m.volume, wakes);
       result = Received::NewEpoch;
-    } else if (!sameVolume(m.volume, config_.layout, config_.bounds)) {
+    } else if (!sameVolume(m.volume, config_.layout, config_.bounds, hasOffsets_, offsetsCrc_)) {
       why = "a message of stream epoch " + std::to_string(epoch_) + " describes another volume than the epoch's";
       return Received::Refused;
+    } else if (m.kind == bus::Kind::Volume && config_.offsets.empty() && !m.volume.offsets.empty()) {
+      config_.offsets = m.volume.offsets;  // the offsets the epoch's brick messages announced (checksum checked)
+      result = Received::Applied;
     }
     if (m.kind == bus::Kind::Brick) {
       const BusBricks::Accepted a = bus_->accept(m.brick, why);
@@ -420,6 +460,9 @@ ProbeVolume ProbeHub::reconstruction() const {
   std::lock_guard<std::mutex> lock(mutex_);
   ProbeVolume v;
   if (source_) source_->copyVolume(config_.bounds, v);
+  std::string why;
+  if (source_ && !dequantizeProbeOffsets(v.grid, config_.offsets.data(), config_.offsets.size(), v.offsets, why))
+    v.offsets.clear();  // never: offsets are checked when they arrive
   return v;
 }
 

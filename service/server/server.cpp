@@ -268,7 +268,7 @@ class SubscribeReactor : public RawReactor {
     id_ = id;
     out_.Clear();
     const bus::Volume v = hub_.volume();
-    volumeToWire(v.layout, v.bounds, v.epoch, *out_.mutable_volume());
+    volumeToWire(v.layout, v.bounds, v.epoch, v.offsets, *out_.mutable_volume());
     startWriteLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }
@@ -331,7 +331,7 @@ class Service final : public RawSubscribeService {
       return reactor;
     }
     const bus::Volume v = hub_.volume();
-    volumeToWire(v.layout, v.bounds, v.epoch, *response);
+    volumeToWire(v.layout, v.bounds, v.epoch, v.offsets, *response);
     reactor->Finish(grpc::Status::OK);
     return reactor;
   }

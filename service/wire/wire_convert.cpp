@@ -2,13 +2,16 @@
 
 #include <cmath>
 
+#include "probecast/codec/probe_offsets.h"
+
 namespace probecast::service {
 
 const char* const kShConvention =
     "real SH L0-L2 without the Condon-Shortley phase, index l(l+1)+m, 27 floats per probe coefficient-major "
     "(RGB per coefficient), incident radiance";
 
-void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t epoch, v1::VolumeDescription& out) {
+void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t epoch,
+                  const std::vector<int8_t>& offsets, v1::VolumeDescription& out) {
   out.set_protocol_version(kProtocolVersion);
   out.set_codec_format_version(kFormatVersion);
   out.set_grid_x(layout.grid[0]);
@@ -24,9 +27,11 @@ void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t
   }
   out.set_sh_convention(kShConvention);
   out.set_stream_epoch(epoch);
+  out.set_probe_offsets(reinterpret_cast<const char*>(offsets.data()), offsets.size());
 }
 
-bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds, std::string& why) {
+bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds,
+                    std::vector<float>& offsets, std::string& why) {
   if (in.protocol_version() != kProtocolVersion)
     return why = "server speaks protocol version " + std::to_string(in.protocol_version()) + ", not " +
                  std::to_string(kProtocolVersion), false;
@@ -59,6 +64,9 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
     bounds.max[a] = in.bounds_max(a);
     if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a])) return why = "volume bounds not finite", false;
   }
+  const std::string& q = in.probe_offsets();
+  if (!dequantizeProbeOffsets(gridOf(l, bounds), reinterpret_cast<const int8_t*>(q.data()), q.size(), offsets, why))
+    return false;
   layout = l;
   return true;
 }

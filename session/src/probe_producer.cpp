@@ -38,6 +38,7 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
                                const scene::Scene& first, const ProbeGrid& grid,
                                const renderer::UpdaterOptions& options, const Animation& animation) {
   updater_ = std::make_unique<renderer::ProbeUpdater>(context, first, grid, options);
+  hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
   sceneSpec_ = sceneSpec;
   animation_ = animation;
   t_ = animation.start;

@@ -54,6 +54,9 @@ struct ProbeVolume {
   // orthonormal SH coefficient's estimator has the same variance). Empty when unknown; 0 for
   // inactive probes. A stream encoder with a noise scale does not re-send changes within it.
   std::vector<float> noise;
+  // Relocation: per probe, 3 floats (x, y, z) in metres added to grid.position(i), the position the
+  // probe is traced at and interpolated from; empty = every probe at its grid position.
+  std::vector<float> offsets;
 
   uint32_t count() const { return grid.count(); }
 };
@@ -63,8 +66,9 @@ ProbeVolume makeProbeVolume(const ProbeGrid& grid);
 
 // Checks what every consumer relies on: 1 to kMaxGridDim probes per axis and at most kMaxProbes,
 // finite bounds with max > min along every axis of two or more probes, 27 floats and one active
-// byte (0 or 1) per probe, every coefficient finite, and `noise` empty or one finite value >= 0 per
-// probe. False with the reason in `error`.
+// byte (0 or 1) per probe, every coefficient finite, `noise` empty or one finite value >= 0 per
+// probe, and `offsets` empty or 3 finite floats per probe, each within half a cell on its axis
+// (probeCellSize; 0 along an axis of one probe). False with the reason in `error`.
 bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back

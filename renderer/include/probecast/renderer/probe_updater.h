@@ -9,7 +9,8 @@
 // k standard errors of the difference, and restarts from the new estimate (n = 1) when one does not
 // (a light or an object moved); a short moving average catches changes smaller than one update's
 // noise within a few updates. Probes whose rays see back faces too often are inside geometry: they
-// are inactive, get no rays and stay zero. Output is the codec's ProbeVolume (probe_volume.h): 27
+// move out of it when they can (UpdaterOptions::relocate, ProbeVolume::offsets), else they are
+// inactive, get no rays and stay zero. Output is the codec's ProbeVolume (probe_volume.h): 27
 // floats per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
 #pragma once
 
@@ -39,7 +40,16 @@ struct UpdaterOptions {
   uint32_t seed = 1;
   bool classify = true;            // mark probes inside geometry inactive
   uint32_t classifySamples = 64;
-  float backFaceThreshold = 0.25f; // inactive above this back-face hit ratio (RTXGI's rule)
+  float backFaceThreshold = 0.25f; // inside geometry above this back-face hit ratio (RTXGI's rule)
+  // Relocation (with classify): a probe inside geometry moves through the nearest back face its
+  // classify rays see, one nearer than relocateClearance to a front face moves away from it, in up
+  // to relocateRounds rounds of classify rays, each probe within relocateMaxShift of its cell per
+  // axis. Only a probe still inside after that is inactive. Offsets are snapped to what viewers
+  // reconstruct from the wire (probe_offsets.h), and probes are traced there.
+  bool relocate = true;
+  float relocateClearance = 0.2f;  // fraction of the smallest cell
+  float relocateMaxShift = 0.45f;  // fraction of the cell on each axis
+  uint32_t relocateRounds = 4;
   // Distant light: misses return it and next-event estimation importance-samples it (MIS with
   // the BSDF); none: misses are black. Probes see it directly, like any distant light.
   std::shared_ptr<const Environment> environment;
@@ -54,6 +64,17 @@ struct UpdateStats {
   uint32_t activeProbes = 0;
   uint64_t droppedSamples = 0;  // non-finite path samples replaced by 0 (a defect if ever nonzero)
   uint32_t restartedProbes = 0; // probes whose history was rejected this update
+};
+
+// The last classification (at construction and after each geometry change).
+struct ClassifyStats {
+  double milliseconds = 0.0;     // every classify round, rays and reduction
+  uint32_t rounds = 0;           // classify dispatches
+  uint32_t insideAtGrid = 0;     // probes inside geometry at their grid positions (inactive without relocation)
+  uint32_t inactive = 0;         // probes left inactive
+  uint32_t moved = 0;            // active probes with a nonzero offset
+  double meanOffsetMetres = 0.0; // mean |offset| of the moved probes
+  double maxOffsetCells = 0.0;   // largest |offset component| / cell
 };
 
 class ProbeUpdater {
@@ -74,6 +95,7 @@ class ProbeUpdater {
   // The probes as traced so far (float samples; `updates` and `samplesPerProbe` filled in).
   const ProbeVolume& volume() const;
   const ProbeGrid& grid() const;
+  const ClassifyStats& classifyStats() const;
   // Device memory this updater holds (buffers and acceleration structures), bytes: it grows with
   // the probe count, not with probes × samples.
   uint64_t deviceBytes() const;

@@ -4,17 +4,22 @@
 // so the fuzz build links it).
 //
 // Every brick message is self-contained: it carries the volume it belongs to (epoch, layout,
-// bounds) and both sections of the new version, its keyframe and its delta from the version
-// before. A store that keeps only the newest message per brick therefore holds everything a
-// late joiner needs, and a holder one version behind still gets the small delta.
+// bounds, and a checksum of the probe offsets) and both sections of the new version, its keyframe
+// and its delta from the version before. A store that keeps only the newest message per brick
+// therefore holds everything a late joiner needs but the offsets themselves (3 bytes per probe),
+// which travel once, in the volume message; a holder one version behind still gets the small delta.
 //
 // Message = header (16 bytes) + body, little-endian:
-//   header: magic "PCBM" | u8 busVersion (1) | u8 kind (1 volume, 2 brick) | u16 flags
+//   header: magic "PCBM" | u8 busVersion (2) | u8 kind (1 volume, 2 brick) | u16 flags
 //           | u32 bodyBytes | u32 CRC-32C of the preceding 12 bytes and the body
 //   volume: u64 epoch (nonzero) | u64 publishedUs | u8 codecFormatVersion (stream.h kFormatVersion)
-//           | u8 representation | u8 brickDim | u8 reserved (0) | u16 nx, ny, nz | u16 reserved (0)
-//           | f32 boundsMin[3] | f32 boundsMax[3]                                     (52 bytes)
-//           The whole body of a volume message; the first part of a brick message's body.
+//           | u8 representation | u8 brickDim | u8 hasOffsets (0 or 1) | u16 nx, ny, nz
+//           | u16 reserved (0) | f32 boundsMin[3] | f32 boundsMax[3]
+//           | u32 offsetsCrc (CRC-32C of the offset bytes; 0 without offsets)         (56 bytes)
+//           The first part of both messages' bodies. A volume message's body is this, then, with
+//           hasOffsets, the offsets: 3 bytes per probe as in probe_offsets.h (int8 steps of 1/256
+//           cell, |q| <= 127, 0 along an axis of one probe).
+// Version 1 (no offsets, a 52-byte volume) is refused: producers and edges are upgraded together.
 //   brick:  u32 brick | u32 version (>= 1) | u32 producerFrame | f32 change (finite, >= 0)
 //           | u32 keyframeBytes | u32 deltaBytes | keyframe section | delta section  (24 bytes + sections)
 //           Sections exactly as in a codec frame (stream.h); the delta may be absent (0 bytes).
@@ -34,9 +39,9 @@
 
 namespace probecast::bus {
 
-constexpr uint8_t kBusVersion = 1;
+constexpr uint8_t kBusVersion = 2;
 constexpr size_t kHeaderSize = 16;
-constexpr size_t kVolumeSize = 52;
+constexpr size_t kVolumeSize = 56;
 constexpr size_t kBrickFixedSize = 24;
 constexpr uint16_t kEndOfBatch = 1;
 // A brick's relative change above this is nonsense from a broken producer, not lighting.
@@ -49,7 +54,18 @@ struct Volume {
   uint64_t publishedUs = 0;
   StreamLayout layout;
   GridBounds bounds;
+  // Probe offsets (probe_offsets.h), 3 per probe or none. A parsed brick message leaves them empty
+  // and says only whether the volume has some and their checksum; a parsed volume message fills
+  // them (checked against both). Writers announce the offsets when there are some, else what
+  // hasOffsets and offsetsCrc say (so a parsed brick message is written back as it was); a volume
+  // message is written with the offsets it announces, so it needs them.
+  std::vector<int8_t> offsets;
+  bool hasOffsets = false;
+  uint32_t offsetsCrc = 0;
 };
+
+// Checksum of offsets as a volume announces them (0 for none).
+uint32_t offsetsChecksum(const std::vector<int8_t>& offsets);
 
 struct Brick {
   uint32_t brick = 0;

@@ -37,7 +37,8 @@ struct ClientConfig {
 };
 
 struct VolumeSnapshot {
-  ProbeVolume volume;           // the last good volume (decodedFrom: the stream's representation)
+  ProbeVolume volume;           // the last good volume (decodedFrom: the stream's representation;
+                                // offsets: the description's probe offsets)
   StreamLayout layout;          // the stream's grid, brick edge and representation
   uint32_t framesApplied = 0;
   uint64_t newestServerTimeUs = 0;

@@ -34,6 +34,8 @@ struct HubConfig {
   EncoderOptions encoder;
   PriorityParams priority;
   double burstSeconds = 1.0;  // a subscriber's budget bucket holds this many seconds of bytes
+  // Probe offsets as descriptions carry them (probe_offsets.h: 3 bytes per probe); empty = none.
+  std::vector<int8_t> offsets;
 };
 
 // The hub of a probe grid streamed as `repr` in bricks of brickDim³ probes, dropping changes of
@@ -95,15 +97,22 @@ class ProbeHub {
   StreamLayout layout() const;
   GridBounds bounds() const;
   uint64_t epoch() const;
-  // Layout, bounds and epoch read together (an edge's change with the producer's epoch).
+  // Layout, bounds, epoch and offsets read together (an edge's change with the producer's epoch).
+  // An edge is not ready() while its epoch announces offsets that have not arrived yet.
   bus::Volume volume() const;
+  // A producer's probe offsets (ProbeVolume::offsets, metres, checkProbeOffsets's rules against
+  // the hub's grid; std::invalid_argument otherwise), quantised as the wire carries them. A change
+  // once the hub has published or has subscribers starts a new epoch: every stream ends, and
+  // clients subscribe again and get the new description.
+  void setProbeOffsets(const std::vector<float>& offsets);
 
   // A new lighting frame (27 floats per probe, sh.h layout; active mask or null; per-probe noise
   // or null, see EncoderOptions::noiseScale). Each changed brick gets a new version, encoded once.
   // Wakes subscribers that wait for data. Producer hubs only (std::logic_error on an edge's).
   void publish(const float* probes, const uint8_t* active, const float* noise = nullptr);
-  // The same for a volume (its noise too, when it has one), which must pass checkProbeVolume and
-  // have the hub's grid size (std::invalid_argument otherwise, nothing published).
+  // The same for a volume (its noise too, when it has one, and its offsets: setProbeOffsets), which
+  // must pass checkProbeVolume and have the hub's grid size (std::invalid_argument otherwise,
+  // nothing published).
   void publish(const ProbeVolume& volume);
   // Every brick version publish() makes, keyframe and delta, is handed to `output` (called on the
   // publishing thread, outside the hub's lock). Producer hubs only.
@@ -140,7 +149,8 @@ class ProbeHub {
   bool acknowledge(uint64_t id, uint32_t sequence, std::string& why);
 
   // The volume every subscriber converges to (the encoder's reconstruction, or on an edge the
-  // decoded bus versions; zh3h hallucinated per probe), for tests and tools.
+  // decoded bus versions; zh3h hallucinated per probe; offsets as subscribers reconstruct them),
+  // for tests and tools.
   ProbeVolume reconstruction() const;
 
  private:
@@ -169,10 +179,13 @@ class ProbeHub {
   BrickVersionBytes versionBytes(uint32_t brick);
   EncoderBricks& encoderSource(const char* what) const;
   void startEpoch(const bus::Volume& volume, std::vector<std::function<void()>>& wakes);
+  void endStreams(std::vector<std::function<void()>>& wakes);
 
   HubConfig config_;
   uint64_t epoch_ = 0;
   bool fromBus_ = false;
+  bool hasOffsets_ = false;   // what the epoch announces (config_.offsets may still be on its way to an edge)
+  uint32_t offsetsCrc_ = 0;
   mutable std::mutex mutex_;
   std::unique_ptr<BrickSource> source_;
   EncoderBricks* encoder_ = nullptr;  // source_ of a producer's hub
