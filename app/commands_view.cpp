@@ -27,6 +27,7 @@ struct ViewOptions {
   uint32_t updates = 4;
   float exposure = 1.0f;
   bool exr = false;
+  bool visibility = true;
 };
 
 struct Rendered {
@@ -126,6 +127,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--passes", o->passes, "per-view (one pass per view) or multiview (chunks of views per pass)")
       ->check(CLI::IsMember({"per-view", "multiview"}));
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
+  addVisibilityOption(cmd, o->visibility);
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
     renderer::ViewSetSpec spec;
@@ -139,6 +141,7 @@ void addViewCommand(CLI::App& app) {
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
+    ro.visibility = o->visibility;
     ro.environment = environment;
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);

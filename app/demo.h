@@ -37,6 +37,7 @@ struct DemoOptions {
   uint32_t referenceSpp = 256;
   uint64_t lightFieldBudget = 6 * 1024;  // bytes/s: the display sits on a thin link
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
+  bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
 };
 
 struct DemoViewer {

@@ -54,6 +54,9 @@ struct ProbeVolume {
   // orthonormal SH coefficient's estimator has the same variance). Empty when unknown; 0 for
   // inactive probes. A stream encoder with a noise scale does not re-send changes within it.
   std::vector<float> noise;
+  // Relocation: per probe, 3 floats (x, y, z) in metres added to grid.position(i), the position the
+  // probe is traced at and interpolated from; empty = every probe at its grid position.
+  std::vector<float> offsets;
 
   uint32_t count() const { return grid.count(); }
 };
