@@ -82,6 +82,10 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
     volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
   renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
   raster.setProbes(volume);
+  if (raster.visibilityActive())
+    fmt::print("view: probe visibility for {} probes made in {:.1f} ms (depth cubes) + {:.1f} ms (moments), {} bytes per probe\n",
+               volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityMomentsMs,
+               renderer::RasterRenderer::visibilityBytesPerProbe());
   Rendered r;
   r.images = raster.renderViews(views);
   r.viewsMs = raster.timings().viewsMs;

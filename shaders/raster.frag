@@ -1,7 +1,8 @@
 #version 460
 // Raster client shading: surface emission + direct light from punctual lights (shadow maps, 3×3
 // PCF) + diffuse indirect albedo/π · E(n) and split-sum glossy indirect from the probe volume
-// (trilinear in 3D textures), linear radiance out. Cut-away points (alphaMode Mask) are discarded;
+// (8 probes weighted by visibility from per-probe distance moments, or hardware trilinear in the 3D
+// textures with visibility off), linear radiance out. Cut-away points (alphaMode Mask) are discarded;
 // transmissive surfaces (scene.h's rule) are drawn after the opaque ones in two blended passes:
 // RS_PASS_TRANSMIT multiplies what lies behind by T = τ·base, RS_PASS_REFLECT adds emission +
 // (1 − τ)·(direct + indirect). One layer is exact; several are order-independent but approximate
@@ -72,7 +73,7 @@ vec2 probeMomentsToward(uint index, vec3 dir) {
 // its cell, each weighted by trilinear × backface × Chebyshev visibility (DDGI's weights): the
 // point, moved off the surface along ng and wo by a fraction of the probe spacing, is visible from
 // a probe with probability at least σ²/(σ² + (r − μ)²) when farther than the mean distance μ of
-// what the probe sees that way. Inactive probes weigh 0. Where every weight vanishes, the filled
+// what the probe sees that way. Inactive probes weigh 0; where all 8 are inactive, the filled
 // trilinear volume answers (probeCoefficients).
 bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
   for (int i = 0; i < 28; ++i) c[i] = 0.0;
@@ -85,6 +86,7 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
   vec3 alpha = clamp(g - vec3(base), vec3(0.0), vec3(1.0));
   vec3 q = p + (0.2 * ng + 0.8 * wo) * (0.75 * 0.3 * pc.volumeMax.w);
   float total = 0.0;
+  int activeProbes = 0;
   for (int k = 0; k < 8; ++k) {
     ivec3 off = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
     vec3 t3 = mix(1.0 - alpha, alpha, vec3(off));
@@ -92,6 +94,7 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
     ivec3 idx = min(base + off, last);
     vec4 tail = texelFetch(probeVolume[RS_PROBE_TEXTURES - 1], idx, 0);
     if (trilinear <= 0.0 || tail.w < 0.5) continue;  // tail.w: 1 active, kInactiveWeight inactive
+    ++activeProbes;
     uint index = uint(idx.x + int(dims.x) * (idx.y + int(dims.y) * idx.z));
     vec3 probe = probePositions[index].xyz;
     vec3 toProbe = probe - p;
@@ -119,8 +122,11 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
     }
     total += w;
   }
-  if (total < 1e-6) return probeCoefficients(p, c);
-  for (int i = 0; i < 27; ++i) c[i] /= total;
+  if (activeProbes == 0) return probeCoefficients(p, c);
+  // Every active probe hidden (the outer face of a wall, probes all inside): no probe sees the
+  // point, so none lights it; weights this small would only rank the hidden probes.
+  float scale = total > 1e-10 ? 1.0 / total : 0.0;
+  for (int i = 0; i < 27; ++i) c[i] *= scale;
   return true;
 }
 

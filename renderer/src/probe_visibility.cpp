@@ -20,6 +20,9 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr uint32_t kCube = kVisibilityCubeSize;
+// The lobes are summed over the cube reduced 2× per side (sums of r and r² over 2×2 texels keep
+// both moments; only the weight inside a block is taken as constant): a quarter of the taps.
+constexpr uint32_t kLobeCube = kCube / 2;
 constexpr uint32_t kBatchColumns = 16;  // probes per row of the depth atlas (six faces each)
 constexpr uint32_t kBatchRows = 16;     // rows of probes per depth atlas: 256 probes per pass
 constexpr uint32_t kBatch = kBatchColumns * kBatchRows;
@@ -52,9 +55,9 @@ const CubeTexels& cubeTexels() {
     const std::vector<glm::mat4> faces = cubeFaceViews(100.0f);
     for (const glm::mat4& vp : faces) {
       const glm::mat4 inv = glm::inverse(vp);
-      for (uint32_t y = 0; y < kCube; ++y)
-        for (uint32_t x = 0; x < kCube; ++x) {
-          const float u = texelCentre(x, kCube), v = texelCentre(y, kCube);
+      for (uint32_t y = 0; y < kLobeCube; ++y)
+        for (uint32_t x = 0; x < kLobeCube; ++x) {
+          const float u = texelCentre(x, kLobeCube), v = texelCentre(y, kLobeCube);
           const glm::vec4 p = inv * glm::vec4(u, v, 0.5f, 1.0f);
           t.dir.push_back(glm::normalize(glm::vec3(p) / p.w));
           t.solidAngle.push_back(std::pow(1.0f + u * u + v * v, -1.5f));
@@ -232,15 +235,27 @@ glm::vec3 octDecode(glm::vec2 e) {
 void octahedralMoments(const float* cubeDistances, uint32_t size, float* tile) {
   if (size != kCube) throw std::invalid_argument("depth cubes are " + std::to_string(kCube) + " texels per side");
   const std::vector<std::vector<LobeTap>>& taps = lobeTaps();
+  float r1[6 * kLobeCube * kLobeCube], r2[6 * kLobeCube * kLobeCube];
+  for (uint32_t f = 0; f < 6; ++f)
+    for (uint32_t y = 0; y < kLobeCube; ++y)
+      for (uint32_t x = 0; x < kLobeCube; ++x) {
+        float sum = 0.0f, square = 0.0f;
+        for (uint32_t k = 0; k < 4; ++k) {
+          const float r = cubeDistances[(f * kCube + 2 * y + k / 2) * kCube + 2 * x + k % 2];
+          sum += r;
+          square += r * r;
+        }
+        r1[(f * kLobeCube + y) * kLobeCube + x] = 0.25f * sum;
+        r2[(f * kLobeCube + y) * kLobeCube + x] = 0.25f * square;
+      }
   for (size_t t = 0; t < taps.size(); ++t) {
-    double mean = 0.0, square = 0.0;
+    float mean = 0.0f, square = 0.0f;
     for (const LobeTap& tap : taps[t]) {
-      const double r = cubeDistances[tap.cube];
-      mean += tap.weight * r;
-      square += tap.weight * r * r;
+      mean += tap.weight * r1[tap.cube];
+      square += tap.weight * r2[tap.cube];
     }
-    tile[t * 2] = static_cast<float>(mean);
-    tile[t * 2 + 1] = static_cast<float>(square);
+    tile[t * 2] = mean;
+    tile[t * 2 + 1] = square;
   }
 }
 
