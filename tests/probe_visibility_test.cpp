@@ -68,7 +68,7 @@ TEST(ProbeVisibility, MeanDistanceInAClosedBoxMatchesTheWallsPerDirection) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
-TEST(ProbeVisibility, OffsetsOfTheWrongSizeOrNotFiniteAreRefused) {
+TEST(ProbeVisibility, OffsetsOfTheWrongSizeNotFiniteOrAbsurdAreRefused) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("closed-box");
   RasterRenderer raster(context, s, 8, 8);
@@ -77,6 +77,8 @@ TEST(ProbeVisibility, OffsetsOfTheWrongSizeOrNotFiniteAreRefused) {
   EXPECT_THROW(raster.setProbes(v), std::invalid_argument);
   v.offsets.assign(24, 0.0f);
   v.offsets[7] = std::nanf("");
+  EXPECT_THROW(raster.setProbes(v), std::invalid_argument);
+  v.offsets[7] = 1e30f;  // finite, but a light-year off its cell
   EXPECT_THROW(raster.setProbes(v), std::invalid_argument);
   v.offsets[7] = 0.1f;
   EXPECT_NO_THROW(raster.setProbes(v));

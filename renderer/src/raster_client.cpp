@@ -73,9 +73,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Where each probe was traced: its grid position plus its offset (ProbeVolume::offsets), xyz per
-// probe. Throws std::invalid_argument for offsets that are neither empty nor 3 finite floats per probe.
+// probe. Throws std::invalid_argument for offsets that are neither empty nor 3 finite floats per
+// probe, or that move a probe farther than the grid's size (+ 1 m): relocation stays inside a cell.
 std::vector<float> probePositions(const ProbeVolume& v) {
   const size_t count = v.count();
+  float reach = 1.0f;
+  for (int a = 0; a < 3; ++a) reach = std::max(reach, v.grid.bounds.max[a] - v.grid.bounds.min[a] + 1.0f);
   if (!v.offsets.empty() && v.offsets.size() != count * 3)
     throw std::invalid_argument("probe offsets: " + std::to_string(v.offsets.size()) + " floats for " +
                                 std::to_string(count) + " probes (want 3 per probe or none)");
@@ -85,7 +88,9 @@ std::vector<float> probePositions(const ProbeVolume& v) {
     if (v.offsets.empty()) continue;
     for (int c = 0; c < 3; ++c) {
       const float o = v.offsets[i * 3 + c];
-      if (!std::isfinite(o)) throw std::invalid_argument("probe offsets: probe " + std::to_string(i) + " is not finite");
+      if (!std::isfinite(o) || std::abs(o) > reach)
+        throw std::invalid_argument("probe offsets: probe " + std::to_string(i) + " moves " + std::to_string(o) +
+                                    " m, not a finite offset within the grid");
       out[i * 3 + c] += o;
     }
   }
