@@ -150,6 +150,7 @@ void addBenchRaster(CLI::App* bench) {
   raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
       ->check(CLI::Range(16, 8192));
   addShadowCascadesOption(raster, ro->bench.raster.shadowCascades);
+  addVisibilityOption(raster, ro->bench.raster.visibility);
   addJsonOption(raster, ro->json);
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
   raster->callback([=] {

@@ -26,6 +26,7 @@ void addDemoCommand(CLI::App& app) {
   demo->add_option("--settle-updates", o->settleUpdates, "updates with the light frozen before the comparison")
       ->check(CLI::Range(1, 10000));
   addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
+  addVisibilityOption(demo, o->visibility);
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
   o->environment.add(demo);
   demo->callback([o] {

@@ -27,6 +27,7 @@ struct ViewOptions {
   uint32_t updates = 4;
   float exposure = 1.0f;
   bool exr = false;
+  bool visibility = true;
 };
 
 struct Rendered {
@@ -81,6 +82,10 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
     volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
   renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
   raster.setProbes(volume);
+  if (raster.visibilityActive())
+    fmt::print("view: probe visibility for {} probes made in {:.1f} ms (depth cubes) + {:.1f} ms (moments), {} bytes per probe\n",
+               volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityMomentsMs,
+               renderer::RasterRenderer::visibilityBytesPerProbe());
   Rendered r;
   r.images = raster.renderViews(views);
   r.viewsMs = raster.timings().viewsMs;
@@ -128,6 +133,7 @@ void addViewCommand(CLI::App& app) {
       ->check(CLI::IsMember({"per-view", "multiview"}));
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
   addShadowCascadesOption(cmd, o->shadowCascades);
+  addVisibilityOption(cmd, o->visibility);
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
     renderer::ViewSetSpec spec;
@@ -142,6 +148,7 @@ void addViewCommand(CLI::App& app) {
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
     ro.shadowCascades = o->shadowCascades;
+    ro.visibility = o->visibility;
     ro.environment = environment;
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);

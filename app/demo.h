@@ -39,6 +39,7 @@ struct DemoOptions {
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
   EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
   std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
+  bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
 };
 
 struct DemoViewer {

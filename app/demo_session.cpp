@@ -79,6 +79,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
     session::ViewerConfig vc;
     vc.width = v.width;
     vc.height = v.height;
+    vc.raster.visibility = o.visibility;
     vc.client.address = server.listen;
     vc.client.token = server.token;
     vc.client.name = v.name;

@@ -125,6 +125,15 @@ inline CLI::Option* addSizeOption(CLI::App* cmd, std::vector<uint32_t>& size, co
   return cmd->add_option("--size", size, what)->delimiter('x')->expected(2)->check(CLI::Range(static_cast<int>(min), static_cast<int>(max)));
 }
 
+// --visibility on|off: probe visibility in the raster client (RasterOptions::visibility).
+inline CLI::Option* addVisibilityOption(CLI::App* cmd, bool& visibility) {
+  return cmd
+      ->add_option_function<std::string>(
+          "--visibility", [&visibility](const std::string& v) { visibility = v == "on"; },
+          "raster client: weigh probes by visibility from depth moments (on) or plain trilinear (off)")
+      ->check(CLI::IsMember({"on", "off"}));
+}
+
 // --json FILE, required by every benchmark.
 inline CLI::Option* addJsonOption(CLI::App* cmd, std::string& json) {
   return cmd->add_option("--json", json, "write the results as JSON here")->required();

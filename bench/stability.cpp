@@ -253,7 +253,10 @@ WallLeak measureWallLeak(renderer::VulkanContext& context) {
   for (uint8_t a : on.active) r.inactiveProbes += a == 0;
   r.raySavings = static_cast<double>(r.inactiveProbes) / r.probes;
   const uint32_t w = 48, h = 32;
-  renderer::RasterRenderer raster(context, s, w, h);
+  // Classification alone: visibility (on by default) also keeps probes inside the wall out.
+  renderer::RasterOptions plain;
+  plain.visibility = false;
+  renderer::RasterRenderer raster(context, s, w, h, plain);
   const renderer::CameraView cam = renderer::CameraView::fromScene(s);
   const auto mean = [](const renderer::Image& img) {
     double sum = 0;

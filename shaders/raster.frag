@@ -1,7 +1,8 @@
 #version 460
 // Raster client shading: surface emission + direct light from punctual lights (shadow maps, 3×3
 // PCF) + diffuse indirect albedo/π · E(n) and split-sum glossy indirect from the probe volume
-// (trilinear in 3D textures), linear radiance out. Cut-away points (alphaMode Mask) are discarded;
+// (8 probes weighted by visibility from per-probe distance moments, or hardware trilinear in the 3D
+// textures with visibility off), linear radiance out. Cut-away points (alphaMode Mask) are discarded;
 // transmissive surfaces (scene.h's rule) are drawn after the opaque ones in two blended passes:
 // RS_PASS_TRANSMIT multiplies what lies behind by T = τ·base, RS_PASS_REFLECT adds emission +
 // (1 − τ)·(direct + indirect). One layer is exact; several are order-independent but approximate
@@ -28,6 +29,8 @@ layout(std430, binding = RS_BINDING_SHADOW_LIGHTS) readonly buffer ShadowLights 
 layout(std430, binding = RS_BINDING_SHADOW_LAYERS) readonly buffer ShadowLayers { RsShadowLayer shadowLayers[]; };
 layout(binding = RS_BINDING_SHADOW_MAP) uniform sampler2DArrayShadow shadowMap;
 layout(binding = RS_BINDING_SHADOW_TRANSMIT) uniform sampler2DArray shadowTransmit;
+layout(std430, binding = RS_BINDING_PROBE_POSITIONS) readonly buffer ProbePositions { vec4 probePositions[]; };
+layout(binding = RS_BINDING_PROBE_MOMENTS) uniform sampler2D probeMoments;
 
 #include "material.glsl"
 
@@ -49,6 +52,82 @@ bool probeCoefficients(vec3 p, out float c[28]) {
   float weight = c[27];
   if (weight > 0.0)
     for (int i = 0; i < 27; ++i) c[i] /= weight;
+  return true;
+}
+
+// Octahedral map of unit directions to [-1, 1]² (probe_visibility.cpp's octEncode).
+vec2 octEncode(vec3 v) {
+  vec2 e = v.xy / (abs(v.x) + abs(v.y) + abs(v.z));
+  if (v.z < 0.0) e = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);
+  return e;
+}
+
+// (E[r], E[r²]) of probe `index` toward `dir`, bilinear inside its tile (the border repeats the
+// texels across the octahedron's edges).
+vec2 probeMomentsToward(uint index, vec3 dir) {
+  uvec2 tile = uvec2(index % RS_VIS_TILES_PER_ROW, index / RS_VIS_TILES_PER_ROW) * uint(RS_VIS_TILE);
+  vec2 texel = vec2(tile) + 1.0 + (octEncode(dir) * 0.5 + 0.5) * float(RS_VIS_OCT);
+  return texture(probeMoments, texel / vec2(textureSize(probeMoments, 0))).xy;
+}
+
+// The 27 SH coefficients at p (geometric normal ng, towards the viewer wo) from the 8 probes of
+// its cell, each weighted by trilinear × backface × Chebyshev visibility (DDGI's weights): the
+// point, moved off the surface along ng and wo by a fraction of the probe spacing, is visible from
+// a probe with probability at least σ²/(σ² + (r − μ)²) when farther than the mean distance μ of
+// what the probe sees that way. Inactive probes weigh 0; where all 8 are inactive, the filled
+// trilinear volume answers (probeCoefficients).
+bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
+  for (int i = 0; i < 28; ++i) c[i] = 0.0;
+  if (pc.volumeMin.w == 0.0) return false;
+  vec3 dims = pc.volumeDims.xyz;
+  ivec3 last = ivec3(dims) - 1;
+  vec3 extent = max(pc.volumeMax.xyz - pc.volumeMin.xyz, vec3(1e-6));
+  vec3 g = clamp((p - pc.volumeMin.xyz) / extent * (dims - 1.0), vec3(0.0), dims - 1.0);
+  ivec3 base = ivec3(min(floor(g), max(dims - 2.0, vec3(0.0))));
+  vec3 alpha = clamp(g - vec3(base), vec3(0.0), vec3(1.0));
+  vec3 q = p + (0.2 * ng + 0.8 * wo) * (0.75 * 0.3 * pc.volumeMax.w);
+  float total = 0.0;
+  int activeProbes = 0;
+  for (int k = 0; k < 8; ++k) {
+    ivec3 off = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    vec3 t3 = mix(1.0 - alpha, alpha, vec3(off));
+    float trilinear = t3.x * t3.y * t3.z;
+    ivec3 idx = min(base + off, last);
+    vec4 tail = texelFetch(probeVolume[RS_PROBE_TEXTURES - 1], idx, 0);
+    if (trilinear <= 0.0 || tail.w < 0.5) continue;  // tail.w: 1 active, kInactiveWeight inactive
+    ++activeProbes;
+    uint index = uint(idx.x + int(dims.x) * (idx.y + int(dims.y) * idx.z));
+    vec3 probe = probePositions[index].xyz;
+    vec3 toProbe = probe - p;
+    float len = length(toProbe);
+    float facing = len > 1e-6 ? (dot(toProbe / len, ng) + 1.0) * 0.5 : 1.0;
+    float w = facing * facing + 0.2;
+    vec3 fromProbe = q - probe;
+    float r = length(fromProbe);
+    vec2 m = probeMomentsToward(index, r > 1e-6 ? fromProbe / r : ng);
+    if (r > m.x) {
+      float variance = abs(m.y - m.x * m.x);
+      float d = r - m.x;
+      float chebyshev = variance / (variance + d * d);
+      w *= chebyshev * chebyshev * chebyshev;
+    }
+    if (w < 0.2) w *= w * w / (0.2 * 0.2);  // crush small weights: a mostly hidden probe adds nothing
+    w *= trilinear;
+    if (w <= 0.0) continue;
+    for (int t = 0; t < RS_PROBE_TEXTURES; ++t) {
+      vec4 v = t == RS_PROBE_TEXTURES - 1 ? tail : texelFetch(probeVolume[t], idx, 0);
+      c[4 * t] += w * v.x / tail.w;
+      c[4 * t + 1] += w * v.y / tail.w;
+      c[4 * t + 2] += w * v.z / tail.w;
+      c[4 * t + 3] += w * v.w / tail.w;
+    }
+    total += w;
+  }
+  if (activeProbes == 0) return probeCoefficients(p, c);
+  // Every active probe hidden (the outer face of a wall, probes all inside): no probe sees the
+  // point, so none lights it; weights this small would only rank the hidden probes.
+  float scale = total > 1e-10 ? 1.0 / total : 0.0;
+  for (int i = 0; i < 27; ++i) c[i] *= scale;
   return true;
 }
 
@@ -213,7 +292,7 @@ void main() {
   }
   float c[28];
   vec3 indirect = vec3(0.0);
-  if (probeCoefficients(worldPosition, c)) {
+  if (pc.visibility != 0u ? probeCoefficientsVisible(worldPosition, ngf, wo, c) : probeCoefficients(worldPosition, c)) {
     if (pc.volumeDims.w != 0.0) hallucinateZh3(c);
     float roughness = m.emissionRoughness.a;
     vec3 f0 = mix(vec3(0.04), base, metallic);

@@ -18,8 +18,17 @@
 #define RS_BINDING_SHADOW_MAP 10       // sampler2DArrayShadow: depth of every shadow layer
 #define RS_BINDING_SHADOW_TRANSMIT 11  // sampler2DArray: per shadow layer, rgb = transmittance of the
                                        // transmissive casters before the opaque depth, a = the nearest one's depth
-#define RS_BINDING_COUNT 12
 #define RS_TRANSMIT_CLEAR_DEPTH 65504.0  // a of a texel no transmissive caster covers (largest half float)
+#define RS_BINDING_PROBE_POSITIONS 12  // vec4[] per probe: xyz where it was traced (grid + offset), metres
+#define RS_BINDING_PROBE_MOMENTS 13    // sampler2D RG32F atlas of per-probe distance moments (below)
+#define RS_BINDING_COUNT 14
+
+// Probe visibility (probe_visibility.h): per probe an RS_VIS_OCT² octahedral map of (E[r], E[r²]),
+// r the distance from the probe to the nearest surface, with a one-texel border so that bilinear
+// filtering never reads a neighbour's tile; tiles laid out RS_VIS_TILES_PER_ROW to a row.
+#define RS_VIS_OCT 16
+#define RS_VIS_TILE (RS_VIS_OCT + 2)
+#define RS_VIS_TILES_PER_ROW 256
 
 #define RS_PASS_OPAQUE 0u              // opaque and cut-out triangles, depth written
 #define RS_PASS_TRANSMIT 1u            // transmissive triangles: colour × T (blend: dst · src)
@@ -55,7 +64,7 @@ struct RsShadowLayer {
 
 struct RsPushConstants {
   vec4 volumeMin;      // xyz position of probe (0,0,0); w = 1 if a probe volume is bound
-  vec4 volumeMax;      // xyz position of the last probe
+  vec4 volumeMax;      // xyz position of the last probe; w = smallest probe spacing (metres), for biases
   vec4 volumeDims;     // xyz probes per axis (as floats); w = 1: zh3PerPixel (L1 only, hallucinate ZH3 per pixel)
   vec4 lobeBand1;      // GGX zonal lobe fit of band 1: p1, p2, q1, q2 (glossy_sh.h)
   vec4 lobeBand2;      // band 2
@@ -64,7 +73,7 @@ struct RsPushConstants {
   uint shadowMapSize;  // texels per side of each shadow layer
   uint primitiveBase;  // scene triangle index of the draw's first triangle (+ gl_PrimitiveID)
   uint pass;           // RS_PASS_*
-  uint pad0;
+  uint visibility;     // 1: interpolate 8 probes weighted by visibility; 0: hardware trilinear
   uint pad1;
   uint pad2;
 };

@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gpu_scene.h"
+#include "probe_visibility.h"
 #include "probecast/codec/priority.h"
 #include "probecast/renderer/glossy_sh.h"
 #include "raster.frag.h"
@@ -70,6 +71,32 @@ void fillInactiveProbes(ProbeVolume& v) {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+
+// Where each probe was traced: its grid position plus its offset (ProbeVolume::offsets), xyz per
+// probe. Throws std::invalid_argument for offsets that are neither empty nor 3 finite floats per
+// probe, or that move a probe farther than the grid's size (+ 1 m): relocation stays inside a cell.
+std::vector<float> probePositions(const ProbeVolume& v) {
+  const size_t count = v.count();
+  float reach = 1.0f;
+  for (int a = 0; a < 3; ++a) reach = std::max(reach, v.grid.bounds.max[a] - v.grid.bounds.min[a] + 1.0f);
+  if (!v.offsets.empty() && v.offsets.size() != count * 3)
+    throw std::invalid_argument("probe offsets: " + std::to_string(v.offsets.size()) + " floats for " +
+                                std::to_string(count) + " probes (want 3 per probe or none)");
+  std::vector<float> out(count * 3);
+  for (size_t i = 0; i < count; ++i) {
+    v.grid.position(static_cast<uint32_t>(i), &out[i * 3]);
+    if (v.offsets.empty()) continue;
+    for (int c = 0; c < 3; ++c) {
+      const float o = v.offsets[i * 3 + c];
+      if (!std::isfinite(o) || std::abs(o) > reach)
+        throw std::invalid_argument("probe offsets: probe " + std::to_string(i) + " moves " + std::to_string(o) +
+                                    " m, not a finite offset within the grid");
+      out[i * 3 + c] += o;
+    }
+  }
+  return out;
+}
+
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 VkDescriptorSetLayoutBinding layoutBinding(uint32_t binding, VkDescriptorType type, uint32_t count,
@@ -117,6 +144,7 @@ struct RasterRenderer::Impl {
   GpuImage probeTextures[RS_PROBE_TEXTURES];
   GpuImage envBrdf;
   ShadowMaps shadows;
+  ProbeVisibility visibility;
   VkSampler sampler = VK_NULL_HANDLE, shadowSampler = VK_NULL_HANDLE;
   Buffer readback, views;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
@@ -152,14 +180,16 @@ struct RasterRenderer::Impl {
   bool hasBackground() const { return options.environment && !options.environment->empty(); }
 
   void writeDescriptors() {
-    const Buffer* buffers[8] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
-                                &views, &shadows.lights, &shadows.layers};
-    const uint32_t bindings[8] = {RS_BINDING_TRIANGLE_MATERIAL, RS_BINDING_MATERIALS, RS_BINDING_LIGHTS,
-                                  RS_BINDING_TEXELS, RS_BINDING_TEXTURES, RS_BINDING_VIEWS,
-                                  RS_BINDING_SHADOW_LIGHTS, RS_BINDING_SHADOW_LAYERS};
-    VkDescriptorBufferInfo infos[8];
-    VkWriteDescriptorSet writes[12];
-    for (uint32_t b = 0; b < 8; ++b) {
+    constexpr uint32_t kBuffers = 9;
+    const Buffer* buffers[kBuffers] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
+                                       &views, &shadows.lights, &shadows.layers, &visibility.positions};
+    const uint32_t bindings[kBuffers] = {RS_BINDING_TRIANGLE_MATERIAL, RS_BINDING_MATERIALS, RS_BINDING_LIGHTS,
+                                         RS_BINDING_TEXELS, RS_BINDING_TEXTURES, RS_BINDING_VIEWS,
+                                         RS_BINDING_SHADOW_LIGHTS, RS_BINDING_SHADOW_LAYERS,
+                                         RS_BINDING_PROBE_POSITIONS};
+    VkDescriptorBufferInfo infos[kBuffers];
+    VkWriteDescriptorSet writes[kBuffers + 5];
+    for (uint32_t b = 0; b < kBuffers; ++b) {
       infos[b] = {buffers[b]->buffer, 0, VK_WHOLE_SIZE};
       writes[b] = bufferWrite(set, bindings[b], &infos[b]);
     }
@@ -168,12 +198,14 @@ struct RasterRenderer::Impl {
       images[t] = {sampler, probeTextures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo envInfo{sampler, envBrdf.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo shadowInfo{shadowSampler, shadows.depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    writes[8] = imageWrite(set, RS_BINDING_PROBES, images, RS_PROBE_TEXTURES);
-    writes[9] = imageWrite(set, RS_BINDING_ENV_BRDF, &envInfo, 1);
-    writes[10] = imageWrite(set, RS_BINDING_SHADOW_MAP, &shadowInfo, 1);
+    const VkDescriptorImageInfo momentsInfo{sampler, visibility.moments.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo transmitInfo{sampler, shadows.transmit.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    writes[11] = imageWrite(set, RS_BINDING_SHADOW_TRANSMIT, &transmitInfo, 1);
-    vkUpdateDescriptorSets(d->device, 12, writes, 0, nullptr);
+    writes[kBuffers] = imageWrite(set, RS_BINDING_PROBES, images, RS_PROBE_TEXTURES);
+    writes[kBuffers + 1] = imageWrite(set, RS_BINDING_ENV_BRDF, &envInfo, 1);
+    writes[kBuffers + 2] = imageWrite(set, RS_BINDING_SHADOW_MAP, &shadowInfo, 1);
+    writes[kBuffers + 3] = imageWrite(set, RS_BINDING_PROBE_MOMENTS, &momentsInfo, 1);
+    writes[kBuffers + 4] = imageWrite(set, RS_BINDING_SHADOW_TRANSMIT, &transmitInfo, 1);
+    vkUpdateDescriptorSets(d->device, kBuffers + 5, writes, 0, nullptr);
   }
 
   // Coefficients premultiplied by a weight, the weight in the last texel's w: after trilinear
@@ -408,7 +440,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
       layoutBinding(RS_BINDING_SHADOW_LIGHTS, kSsbo, 1, kFrag),
       layoutBinding(RS_BINDING_SHADOW_LAYERS, kSsbo, 1, kFrag),
       layoutBinding(RS_BINDING_SHADOW_MAP, kImage, 1, kFrag),
-      layoutBinding(RS_BINDING_SHADOW_TRANSMIT, kImage, 1, kFrag)};
+      layoutBinding(RS_BINDING_SHADOW_TRANSMIT, kImage, 1, kFrag),
+      layoutBinding(RS_BINDING_PROBE_POSITIONS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_PROBE_MOMENTS, kImage, 1, kFrag)};
   VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   lci.bindingCount = RS_BINDING_COUNT;
   lci.pBindings = bindings;
@@ -417,8 +451,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
                                   sizeof(shaders::RsPushConstants));
   s.pipelineFor(0, RS_PASS_OPAQUE);
   createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, options.shadowCascades, s.setLayout, s.shadows);
+  createProbeVisibility(d, s.setLayout, s.visibility);
 
-  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 8}, {kImage, RS_PROBE_TEXTURES + 3}};
+  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 9}, {kImage, RS_PROBE_TEXTURES + 4}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
   // The environment BRDF table, computed at start-up (glossy_sh.h), and the lobe fit.
   {
@@ -461,6 +496,7 @@ RasterRenderer::~RasterRenderer() {
   for (GpuImage* img : {&s.envBrdf, &s.color, &s.depth}) destroyImage(d, *img);
   for (Buffer* b : {&s.readback, &s.views}) destroyBuffer(d, *b);
   destroyShadowMaps(d, s.shadows);
+  destroyProbeVisibility(d, s.visibility);
   destroyGpuScene(d, s.gpu);
   for (VkSampler sampler : {s.sampler, s.shadowSampler})
     if (sampler) vkDestroySampler(d.device, sampler, nullptr);
@@ -473,11 +509,32 @@ RasterRenderer::~RasterRenderer() {
 void RasterRenderer::setProbes(const ProbeVolume& volume) {
   std::string error;
   if (!checkProbeVolume(volume, error)) throw std::invalid_argument(error);
-  impl_->uploadVolume(volume);
+  const std::vector<float> positions = probePositions(volume);
+  Impl& s = *impl_;
+  const bool visible = s.options.visibility && volume.count() <= kMaxVisibilityProbes;
+  if (visible) {
+    // An open direction reads as far as anything in the scene or the grid can be.
+    glm::vec3 lo = glm::min(s.sceneMin, glm::vec3(volume.grid.bounds.min[0], volume.grid.bounds.min[1], volume.grid.bounds.min[2]));
+    glm::vec3 hi = glm::max(s.sceneMax, glm::vec3(volume.grid.bounds.max[0], volume.grid.bounds.max[1], volume.grid.bounds.max[2]));
+    const float farDistance = std::max(2.0f * glm::length(hi - lo), 1.0f);
+    if (buildProbeVisibility(*s.d, s.gpu, positions, farDistance, s.visibility)) {
+      s.timings.visibilityRenderMs = s.visibility.renderMs;
+      s.timings.visibilityMomentsMs = s.visibility.momentsMs;
+      s.writeDescriptors();
+    }
+  }
+  s.uploadVolume(volume);
   const GridBounds& b = volume.grid.bounds;
   const uint32_t* n = volume.grid.dims;
-  impl_->push.volumeMin = {b.min[0], b.min[1], b.min[2], 1.0f};
-  impl_->push.volumeMax = {b.max[0], b.max[1], b.max[2], 0.0f};
+  float spacing = 0.0f;
+  for (int a = 0; a < 3; ++a)
+    if (n[a] > 1) {
+      const float step = (b.max[a] - b.min[a]) / static_cast<float>(n[a] - 1);
+      spacing = spacing > 0.0f ? std::min(spacing, step) : step;
+    }
+  s.push.visibility = visible ? 1u : 0u;
+  s.push.volumeMin = {b.min[0], b.min[1], b.min[2], 1.0f};
+  s.push.volumeMax = {b.max[0], b.max[1], b.max[2], spacing > 0.0f ? spacing : 1.0f};
   impl_->push.volumeDims = {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2]),
                             volume.zh3PerPixel ? 1.0f : 0.0f};
 }
@@ -525,6 +582,14 @@ Image RasterRenderer::render(const glm::mat4& viewProj, const glm::vec3& eye) {
 glm::mat4 RasterRenderer::viewProjection(const CameraView& c) const {
   const float aspect = static_cast<float>(impl_->width) / static_cast<float>(impl_->height);
   return vulkanPerspective(c.yfov, aspect, 0.01f, 200.0f) * glm::lookAtRH(c.position, c.position + c.forward, c.up);
+}
+
+bool RasterRenderer::visibilityActive() const { return impl_->push.visibility != 0u; }
+uint32_t RasterRenderer::visibilityBytesPerProbe() { return kVisibilityBytesPerProbe; }
+uint32_t RasterRenderer::visibilityMaxProbes() { return kMaxVisibilityProbes; }
+uint32_t RasterRenderer::visibilityMapTexels() { return RS_VIS_OCT; }
+glm::vec2 RasterRenderer::probeMoments(uint32_t probe, const glm::vec3& dir) const {
+  return probeMomentsAt(impl_->visibility, probe, dir);
 }
 
 uint32_t RasterRenderer::chunkSize() const { return impl_->chunk; }

@@ -1,8 +1,11 @@
 // The raster client: renders views of a scene with direct light from its punctual lights (shadow
 // maps with PCF), surface emission, diffuse indirect light albedo/π · E(n) and split-sum glossy
-// indirect light from a probe volume (SH in 3D textures, hardware trilinear filtering weighted by
-// probe activity, so probes inside walls never darken their active neighbours; inactive probes are
-// also filled from active neighbours for places no active probe reaches). Offscreen, dynamic
+// indirect light from a probe volume (SH in 3D textures). With visibility on, each point blends the
+// 8 probes of its cell weighted by trilinear × backface × Chebyshev visibility from per-probe
+// distance moments that the client makes from its own geometry (probe_visibility.h), so probes
+// behind walls or inside boxes do not light it; off, hardware trilinear filtering weighted by probe
+// activity (probes inside walls never darken their active neighbours; inactive probes are also
+// filled from active neighbours for places no active probe reaches). Offscreen, dynamic
 // rendering, linear radiance out. A view set renders with its shadow maps drawn once, in chunks
 // of views: one pass per view, or one multiview pass per chunk. Pixels no surface covers show the
 // environment (black without one).
@@ -40,11 +43,16 @@ struct RasterOptions {
   // Drawn as background where no surface covers a pixel (linear radiance like the rest, so the
   // same exposure and tone map apply); its light reaches surfaces through the probes only.
   std::shared_ptr<const Environment> environment;
+  // Probe visibility (depth moments per probe, made by setProbes when the probe positions change);
+  // off: hardware trilinear over active probes, as before visibility existed.
+  bool visibility = true;
 };
 
 struct RasterTimings {
   double shadowMs = 0.0;  // last shadow-map pass
   double viewsMs = 0.0;   // last renderViews, shadows excluded, readback included
+  double visibilityRenderMs = 0.0;   // last visibility build: depth cubes drawn and read back
+  double visibilityMomentsMs = 0.0;  // last visibility build: moments on the CPU and their upload
 };
 
 // Replaces inactive probes by the mean of their active neighbours, growing outwards until every
@@ -62,8 +70,20 @@ class RasterRenderer {
   // Uploads a volume (checkProbeVolume's rules) into 3D textures kept across updates (re-created
   // only when the grid's size changes). zh3PerPixel: the shader hallucinates ZH3 after
   // interpolating; zh3 is expected expanded to SH3 already (as the codec decodes it).
-  // Throws std::invalid_argument (and keeps the previous volume) for a volume that fails the check.
+  // Throws std::invalid_argument (and keeps the previous volume) for a volume that fails the check,
+  // or whose offsets are neither empty nor 3 finite floats per probe. With visibility on, the
+  // moments are made again when the probe positions (grid + offsets) differ from the last ones;
+  // a volume of more than visibilityMaxProbes() probes is drawn without visibility.
   void setProbes(const ProbeVolume& volume);
+  // Whether the current volume is drawn with visibility.
+  bool visibilityActive() const;
+  // Client memory per probe for visibility (moments tile and position), bytes; and the most probes.
+  static uint32_t visibilityBytesPerProbe();
+  static uint32_t visibilityMaxProbes();
+  // Texels per side of each probe's octahedral moment map (without its border).
+  static uint32_t visibilityMapTexels();
+  // The host copy of a probe's moments (E[r], E[r²]) toward `dir`, metres (nearest texel).
+  glm::vec2 probeMoments(uint32_t probe, const glm::vec3& dir) const;
   // The same geometry with new lights or materials (an animated scene); shadows are redrawn.
   void setShading(const scene::Scene& scene);
   // Renders a view set; images in the order of `views`.

@@ -1,0 +1,345 @@
+#include "probe_visibility.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "probecast/renderer/view_sets.h"
+#include "shadow.vert.h"
+#include "vk_pipeline.h"
+
+namespace probecast::renderer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr uint32_t kCube = kVisibilityCubeSize;
+// The lobes are summed over the cube reduced 2× per side (sums of r and r² over 2×2 texels keep
+// both moments; only the weight inside a block is taken as constant): a quarter of the taps.
+constexpr uint32_t kLobeCube = kCube / 2;
+constexpr uint32_t kBatchColumns = 16;  // probes per row of the depth atlas (six faces each)
+constexpr uint32_t kBatchRows = 16;     // rows of probes per depth atlas: 256 probes per pass
+constexpr uint32_t kBatch = kBatchColumns * kBatchRows;
+constexpr uint32_t kAtlasW = kBatchColumns * 6 * kCube, kAtlasH = kBatchRows * kCube;
+constexpr float kNear = 0.005f;  // metres: a surface nearer than this to a probe is not seen
+
+// The six 90° faces seen from the origin (+x −x +y −y +z −z), world → Vulkan clip.
+std::vector<glm::mat4> cubeFaceViews(float farDistance) {
+  static const glm::vec3 kDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const glm::vec3 kUp[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
+  const glm::mat4 proj = vulkanPerspective(glm::radians(90.0f), 1.0f, kNear, farDistance);
+  std::vector<glm::mat4> faces;
+  for (int f = 0; f < 6; ++f) faces.push_back(proj * glm::lookAtRH(glm::vec3(0.0f), kDir[f], kUp[f]));
+  return faces;
+}
+
+// Centre of texel i of a face or an octahedral interior, in [-1, 1].
+float texelCentre(uint32_t i, uint32_t n) { return (static_cast<float>(i) + 0.5f) / static_cast<float>(n) * 2.0f - 1.0f; }
+
+// The direction of every cube texel (face-major, then row, then column) and its solid angle
+// (∝ (1 + u² + v²)^(-3/2) for face coordinates u, v).
+struct CubeTexels {
+  std::vector<glm::vec3> dir;
+  std::vector<float> solidAngle;
+};
+
+const CubeTexels& cubeTexels() {
+  static const CubeTexels texels = [] {
+    CubeTexels t;
+    const std::vector<glm::mat4> faces = cubeFaceViews(100.0f);
+    for (const glm::mat4& vp : faces) {
+      const glm::mat4 inv = glm::inverse(vp);
+      for (uint32_t y = 0; y < kLobeCube; ++y)
+        for (uint32_t x = 0; x < kLobeCube; ++x) {
+          const float u = texelCentre(x, kLobeCube), v = texelCentre(y, kLobeCube);
+          const glm::vec4 p = inv * glm::vec4(u, v, 0.5f, 1.0f);
+          t.dir.push_back(glm::normalize(glm::vec3(p) / p.w));
+          t.solidAngle.push_back(std::pow(1.0f + u * u + v * v, -1.5f));
+        }
+    }
+    return t;
+  }();
+  return texels;
+}
+
+// For every texel of a tile (borders folded back across the octahedron's edges, so they repeat
+// the texel they stand for), the cube texels of its lobe and their normalised weights.
+struct LobeTap {
+  uint32_t cube;
+  float weight;
+};
+
+const std::vector<std::vector<LobeTap>>& lobeTaps() {
+  static const std::vector<std::vector<LobeTap>> taps = [] {
+    const CubeTexels& cube = cubeTexels();
+    std::vector<std::vector<LobeTap>> all(RS_VIS_TILE * RS_VIS_TILE);
+    for (uint32_t ty = 0; ty < RS_VIS_TILE; ++ty)
+      for (uint32_t tx = 0; tx < RS_VIS_TILE; ++tx) {
+        glm::vec2 e((static_cast<float>(tx) - 0.5f) / RS_VIS_OCT * 2.0f - 1.0f,
+                    (static_cast<float>(ty) - 0.5f) / RS_VIS_OCT * 2.0f - 1.0f);
+        // Across an edge of the square, (1 + ε, v) is the same point as (1 − ε, −v).
+        if (std::abs(e.x) > 1.0f) e = {std::copysign(2.0f, e.x) - e.x, -e.y};
+        if (std::abs(e.y) > 1.0f) e = {-e.x, std::copysign(2.0f, e.y) - e.y};
+        const glm::vec3 d = octDecode(e);
+        std::vector<LobeTap>& list = all[ty * RS_VIS_TILE + tx];
+        double sum = 0.0;
+        for (uint32_t s = 0; s < cube.dir.size(); ++s) {
+          const float c = glm::dot(d, cube.dir[s]);
+          if (c <= 0.0f) continue;
+          const float w = std::pow(c, kVisibilityLobePower) * cube.solidAngle[s];
+          if (w < 1e-4f) continue;
+          list.push_back({s, w});
+          sum += w;
+        }
+        for (LobeTap& t : list) t.weight = static_cast<float>(t.weight / sum);
+      }
+    return all;
+  }();
+  return taps;
+}
+
+void destroyOwned(VulkanDevice& d, ProbeVisibility& vis) {
+  destroyImage(d, vis.moments);
+  destroyBuffer(d, vis.positions);
+}
+
+// Uploads an atlas of `width` × `height` RG texels and the positions, replacing the old ones once
+// both are made.
+void uploadMoments(VulkanDevice& d, std::vector<float> atlas, uint32_t width, uint32_t height,
+                   const std::vector<float>& positions, ProbeVisibility& vis) {
+  const size_t count = positions.size() / 3;
+  std::vector<float> xyzw(std::max<size_t>(count, 1) * 4, 0.0f);
+  for (size_t p = 0; p < count; ++p)
+    for (int c = 0; c < 3; ++c) xyzw[p * 4 + c] = positions[p * 3 + c];
+  GpuImage image;
+  Buffer pos, staging;
+  try {
+    pos = createBufferWithData(d, xyzw.data(), xyzw.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    staging = createBufferWithData(d, atlas.data(), atlas.size() * sizeof(float), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    image = createImage(d, VK_FORMAT_R32G32_SFLOAT, {width, height, 1},
+                        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+    submitAndWait(d, [&](VkCommandBuffer cmd) {
+      transitionImage(cmd, image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageExtent = {width, height, 1};
+      vkCmdCopyBufferToImage(cmd, staging.buffer, image.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+      transitionImage(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    });
+  } catch (...) {
+    destroyImage(d, image);
+    destroyBuffer(d, pos);
+    destroyBuffer(d, staging);
+    throw;
+  }
+  destroyBuffer(d, staging);
+  destroyOwned(d, vis);
+  vis.moments = image;
+  vis.positions = pos;
+  vis.atlas = std::move(atlas);
+  vis.atlasWidth = width;
+  vis.atlasHeight = height;
+}
+
+// Draws the depth cubes of probes [first, first + n) into `depth` (kAtlasW × kAtlasH) and reads
+// the distances back into `distances` (6 kCube² per probe, cubeTexels' order).
+void drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, const std::vector<float>& positions, size_t first,
+                    uint32_t n, const std::vector<glm::mat4>& faces, float farDistance, GpuImage& depth,
+                    Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances) {
+  const uint32_t triangles = gpu.accel.opaqueTriangles;
+  submitAndWait(d, [&](VkCommandBuffer cmd) {
+    transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+    const VkRenderingAttachmentInfo depthInfo =
+        clearedAttachment(depth.view, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {kAtlasW, kAtlasH}};
+    ri.layerCount = 1;
+    ri.pDepthAttachment = &depthInfo;
+    vkCmdBeginRendering(cmd, &ri);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vis.pipeline);
+    const VkBuffer streams[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
+    const VkDeviceSize offsets[3] = {0, 0, 0};
+    vkCmdBindVertexBuffers(cmd, 0, 3, streams, offsets);
+    vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
+    for (uint32_t k = 0; k < n && triangles > 0; ++k) {
+      const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
+      const glm::mat4 move = glm::translate(glm::mat4(1.0f), -probe);
+      for (uint32_t f = 0; f < 6; ++f) {
+        const auto x = static_cast<int32_t>(((k % kBatchColumns) * 6 + f) * kCube);
+        const auto y = static_cast<int32_t>((k / kBatchColumns) * kCube);
+        const VkViewport viewport{static_cast<float>(x), static_cast<float>(y), kCube, kCube, 0.0f, 1.0f};
+        const VkRect2D scissor{{x, y}, {kCube, kCube}};
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        shaders::RsShadowPush push{};
+        const glm::mat4 vp = faces[f] * move;
+        std::memcpy(&push.viewProj, &vp[0][0], sizeof push.viewProj);
+        vkCmdPushConstants(cmd, vis.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
+        vkCmdDrawIndexed(cmd, 3 * triangles, 1, 0, 0, 0);
+      }
+    }
+    vkCmdEndRendering(cmd);
+    transitionImage(cmd, depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    region.imageExtent = {kAtlasW, kAtlasH, 1};
+    vkCmdCopyImageToBuffer(cmd, depth.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                         nullptr);
+  });
+  // Depth → distance: unproject through the face's inverse (the probe at the origin).
+  std::vector<glm::mat4> inverse;
+  for (const glm::mat4& f : faces) inverse.push_back(glm::inverse(f));
+  const float* z = static_cast<const float*>(readback.mapped);
+  distances.resize(static_cast<size_t>(n) * 6 * kCube * kCube);
+  for (uint32_t k = 0; k < n; ++k)
+    for (uint32_t f = 0; f < 6; ++f)
+      for (uint32_t ty = 0; ty < kCube; ++ty)
+        for (uint32_t tx = 0; tx < kCube; ++tx) {
+          const uint32_t ax = ((k % kBatchColumns) * 6 + f) * kCube + tx, ay = (k / kBatchColumns) * kCube + ty;
+          const float depthValue = z[static_cast<size_t>(ay) * kAtlasW + ax];
+          float r = farDistance;
+          if (depthValue < 1.0f) {
+            const glm::vec4 p = inverse[f] * glm::vec4(texelCentre(tx, kCube), texelCentre(ty, kCube), depthValue, 1.0f);
+            r = glm::length(glm::vec3(p) / p.w);
+          }
+          distances[((static_cast<size_t>(k) * 6 + f) * kCube + ty) * kCube + tx] = r;
+        }
+}
+
+}  // namespace
+
+glm::vec2 octEncode(const glm::vec3& v) {
+  glm::vec2 e = glm::vec2(v.x, v.y) / (std::abs(v.x) + std::abs(v.y) + std::abs(v.z));
+  if (v.z < 0.0f)
+    e = glm::vec2((1.0f - std::abs(e.y)) * (e.x >= 0.0f ? 1.0f : -1.0f), (1.0f - std::abs(e.x)) * (e.y >= 0.0f ? 1.0f : -1.0f));
+  return e;
+}
+
+glm::vec3 octDecode(glm::vec2 e) {
+  glm::vec3 v(e.x, e.y, 1.0f - std::abs(e.x) - std::abs(e.y));
+  if (v.z < 0.0f)
+    v = glm::vec3((1.0f - std::abs(e.y)) * (e.x >= 0.0f ? 1.0f : -1.0f), (1.0f - std::abs(e.x)) * (e.y >= 0.0f ? 1.0f : -1.0f), v.z);
+  return glm::normalize(v);
+}
+
+void octahedralMoments(const float* cubeDistances, uint32_t size, float* tile) {
+  if (size != kCube) throw std::invalid_argument("depth cubes are " + std::to_string(kCube) + " texels per side");
+  const std::vector<std::vector<LobeTap>>& taps = lobeTaps();
+  float r1[6 * kLobeCube * kLobeCube], r2[6 * kLobeCube * kLobeCube];
+  for (uint32_t f = 0; f < 6; ++f)
+    for (uint32_t y = 0; y < kLobeCube; ++y)
+      for (uint32_t x = 0; x < kLobeCube; ++x) {
+        float sum = 0.0f, square = 0.0f;
+        for (uint32_t k = 0; k < 4; ++k) {
+          const float r = cubeDistances[(f * kCube + 2 * y + k / 2) * kCube + 2 * x + k % 2];
+          sum += r;
+          square += r * r;
+        }
+        r1[(f * kLobeCube + y) * kLobeCube + x] = 0.25f * sum;
+        r2[(f * kLobeCube + y) * kLobeCube + x] = 0.25f * square;
+      }
+  for (size_t t = 0; t < taps.size(); ++t) {
+    float mean = 0.0f, square = 0.0f;
+    for (const LobeTap& tap : taps[t]) {
+      mean += tap.weight * r1[tap.cube];
+      square += tap.weight * r2[tap.cube];
+    }
+    tile[t * 2] = mean;
+    tile[t * 2 + 1] = square;
+  }
+}
+
+glm::vec2 probeMomentsAt(const ProbeVisibility& vis, uint32_t probe, const glm::vec3& dir) {
+  const glm::vec2 e = octEncode(glm::normalize(dir));
+  const auto ix = std::min<uint32_t>(RS_VIS_OCT - 1, static_cast<uint32_t>((e.x * 0.5f + 0.5f) * RS_VIS_OCT));
+  const auto iy = std::min<uint32_t>(RS_VIS_OCT - 1, static_cast<uint32_t>((e.y * 0.5f + 0.5f) * RS_VIS_OCT));
+  const uint32_t x = (probe % RS_VIS_TILES_PER_ROW) * RS_VIS_TILE + 1 + ix;
+  const uint32_t y = (probe / RS_VIS_TILES_PER_ROW) * RS_VIS_TILE + 1 + iy;
+  const size_t i = (static_cast<size_t>(y) * vis.atlasWidth + x) * 2;
+  if (i + 1 >= vis.atlas.size()) return glm::vec2(0.0f);
+  return {vis.atlas[i], vis.atlas[i + 1]};
+}
+
+void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, ProbeVisibility& out) {
+  out.layout = createPipelineLayout(d, materials, VK_SHADER_STAGE_VERTEX_BIT, sizeof(shaders::RsShadowPush));
+  GraphicsPipelineDesc desc;
+  desc.vertexCode = kShadowVert;
+  desc.vertexBytes = sizeof kShadowVert;
+  desc.layout = out.layout;
+  out.pipeline = createGraphicsPipeline(d, desc);
+  // One tile of a probe that sees nothing: E[r] large, zero variance — every point visible.
+  std::vector<float> atlas(RS_VIS_TILE * RS_VIS_TILE * 2);
+  for (size_t t = 0; t < atlas.size(); t += 2) {
+    atlas[t] = 1e6f;
+    atlas[t + 1] = 1e12f;
+  }
+  uploadMoments(d, std::move(atlas), RS_VIS_TILE, RS_VIS_TILE, {0.0f, 0.0f, 0.0f}, out);
+}
+
+bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, const std::vector<float>& positions,
+                          float farDistance, ProbeVisibility& vis) {
+  if (positions == vis.builtFor) return false;
+  const size_t count = positions.size() / 3;
+  if (count == 0 || count > kMaxVisibilityProbes)
+    throw std::invalid_argument("probe visibility takes 1.." + std::to_string(kMaxVisibilityProbes) + " probes, not " +
+                                std::to_string(count));
+  const auto t0 = Clock::now();
+  const std::vector<glm::mat4> faces = cubeFaceViews(farDistance);
+  const auto columns = static_cast<uint32_t>(std::min<size_t>(count, RS_VIS_TILES_PER_ROW));
+  const auto rows = static_cast<uint32_t>((count + RS_VIS_TILES_PER_ROW - 1) / RS_VIS_TILES_PER_ROW);
+  const uint32_t width = columns * RS_VIS_TILE, height = rows * RS_VIS_TILE;
+  std::vector<float> atlas(static_cast<size_t>(width) * height * 2, 0.0f);
+  GpuImage depth = createImage(d, VK_FORMAT_D32_SFLOAT, {kAtlasW, kAtlasH, 1},
+                               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  Buffer readback;
+  double momentsMs = 0.0;
+  try {
+    readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
+                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    std::vector<float> distances, tile(RS_VIS_TILE * RS_VIS_TILE * 2);
+    for (size_t first = 0; first < count; first += kBatch) {
+      const auto n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
+      drawDepthCubes(d, gpu, positions, first, n, faces, farDistance, depth, readback, vis, distances);
+      const auto m0 = Clock::now();
+      for (uint32_t k = 0; k < n; ++k) {
+        octahedralMoments(distances.data() + static_cast<size_t>(k) * 6 * kCube * kCube, kCube, tile.data());
+        const size_t p = first + k;
+        const size_t x0 = (p % RS_VIS_TILES_PER_ROW) * RS_VIS_TILE, y0 = (p / RS_VIS_TILES_PER_ROW) * RS_VIS_TILE;
+        for (uint32_t ty = 0; ty < RS_VIS_TILE; ++ty)
+          std::copy_n(tile.data() + ty * RS_VIS_TILE * 2, RS_VIS_TILE * 2, atlas.data() + ((y0 + ty) * width + x0) * 2);
+      }
+      momentsMs += msSince(m0);
+    }
+  } catch (...) {
+    destroyImage(d, depth);
+    destroyBuffer(d, readback);
+    throw;
+  }
+  destroyImage(d, depth);
+  destroyBuffer(d, readback);
+  const auto u0 = Clock::now();
+  uploadMoments(d, std::move(atlas), width, height, positions, vis);
+  vis.momentsMs = momentsMs + msSince(u0);
+  vis.renderMs = msSince(t0) - vis.momentsMs;
+  vis.builtFor = positions;
+  return true;
+}
+
+void destroyProbeVisibility(VulkanDevice& d, ProbeVisibility& vis) {
+  destroyOwned(d, vis);
+  if (vis.pipeline) vkDestroyPipeline(d.device, vis.pipeline, nullptr);
+  if (vis.layout) vkDestroyPipelineLayout(d.device, vis.layout, nullptr);
+  vis = ProbeVisibility{};
+}
+
+}  // namespace probecast::renderer

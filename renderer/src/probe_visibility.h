@@ -1,0 +1,59 @@
+// Probe visibility for the raster client, made from the client's own geometry (no ray tracing, no
+// wire bytes): a low-resolution depth cube is rasterised from every probe position (six 90° faces,
+// all probes of a batch in one depth atlas, one render pass), read back, and turned on the CPU into
+// an octahedral map of distance moments (E[r], E[r²]) per probe, each texel the mean over a
+// cosine-power lobe around its direction (as DDGI filters its depth). raster.frag weighs each of
+// the 8 probes around a point by a Chebyshev bound on the probability that the point is visible
+// from the probe. Made again only when the probe positions change (a new grid, new offsets).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gpu_scene.h"
+#include "raster_shared.h"
+#include "vk_resources.h"
+
+namespace probecast::renderer {
+
+constexpr uint32_t kVisibilityCubeSize = 32;       // texels per side of each depth-cube face
+constexpr uint32_t kMaxVisibilityProbes = 1u << 16;  // larger volumes are drawn without visibility
+constexpr float kVisibilityLobePower = 50.0f;        // cos^k lobe of each moment texel (DDGI's depth sharpness)
+// Client memory per probe: the atlas tile, two 32-bit floats per texel, plus its position (vec4).
+constexpr uint32_t kVisibilityBytesPerProbe = RS_VIS_TILE * RS_VIS_TILE * 8 + 16;
+
+struct ProbeVisibility {
+  GpuImage moments;                // RG32F atlas (raster_shared.h's layout), sampled by raster.frag
+  Buffer positions;                // vec4 per probe: the moved position, metres
+  std::vector<float> atlas;        // host copy of `moments`, 2 floats per texel
+  uint32_t atlasWidth = 0, atlasHeight = 0;
+  std::vector<float> builtFor;     // xyz per probe of the last build (skips unchanged positions)
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;  // depth only, no bias
+  double renderMs = 0.0, momentsMs = 0.0;  // last build: depth cubes drawn and read back; moments + upload
+};
+
+// `materials`: the raster client's set layout (the depth pass binds none of it, the layout is shared).
+// Starts with one probe at the origin and an empty map (every direction open), so descriptors are valid.
+void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, ProbeVisibility& out);
+// Rasterises depth cubes of the opaque triangles of `gpu` from `positions` (xyz per probe) and
+// rebuilds the moments; `farDistance` is what an open direction reads. Returns false (and does
+// nothing) when the positions equal those of the last build. Throws std::invalid_argument for more
+// than kMaxVisibilityProbes probes. New images replace the old only once made.
+bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, const std::vector<float>& positions,
+                          float farDistance, ProbeVisibility& vis);
+void destroyProbeVisibility(VulkanDevice& d, ProbeVisibility& vis);
+
+// The moments of one probe from its depth cube (6 faces of `size`² distances, face order +x −x +y
+// −y +z −z as `cubeFaceViews`): RS_VIS_TILE² texels × 2 floats into `tile`, borders included.
+void octahedralMoments(const float* cubeDistances, uint32_t size, float* tile);
+// (E[r], E[r²]) of `probe` toward `dir` from the host copy, at the nearest texel.
+glm::vec2 probeMomentsAt(const ProbeVisibility& vis, uint32_t probe, const glm::vec3& dir);
+
+// Octahedral mapping of unit directions to [-1, 1]² and back (the same formulas as raster.frag).
+glm::vec2 octEncode(const glm::vec3& dir);
+glm::vec3 octDecode(glm::vec2 e);
+
+}  // namespace probecast::renderer

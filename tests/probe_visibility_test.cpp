@@ -1,0 +1,207 @@
+// Probe visibility in the raster client: distance moments made from the client's own geometry,
+// and the leaks they stop (light through a thin wall, a box face darkened by probes inside it).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "probecast/renderer/probe_updater.h"
+#include "probecast/renderer/raster_client.h"
+#include "vulkan_test_support.h"
+
+namespace probecast::renderer {
+namespace {
+
+// The centre of texel (i, j) of an octahedral map of n² texels, as a unit direction (the map of
+// raster.frag / probe_visibility.cpp: (x, y) / (|x| + |y| + |z|), folded for z < 0).
+glm::vec3 octTexelDirection(int i, int j, int n) {
+  const glm::vec2 e((static_cast<float>(i) + 0.5f) / static_cast<float>(n) * 2.0f - 1.0f,
+                    (static_cast<float>(j) + 0.5f) / static_cast<float>(n) * 2.0f - 1.0f);
+  glm::vec3 v(e.x, e.y, 1.0f - std::abs(e.x) - std::abs(e.y));
+  if (v.z < 0.0f)
+    v = {(1.0f - std::abs(e.y)) * (e.x >= 0.0f ? 1.0f : -1.0f), (1.0f - std::abs(e.x)) * (e.y >= 0.0f ? 1.0f : -1.0f), v.z};
+  return glm::normalize(v);
+}
+
+// Distance from `p` inside the box [-1, 1]³ to its walls along the unit direction `d`.
+float distanceToBoxWalls(const glm::vec3& p, const glm::vec3& d) {
+  float t = 1e30f;
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(d[a]) > 1e-6f) t = std::min(t, ((d[a] > 0.0f ? 1.0f : -1.0f) - p[a]) / d[a]);
+  return t;
+}
+
+TEST(ProbeVisibility, MeanDistanceInAClosedBoxMatchesTheWallsPerDirection) {
+  // One probe in builtin:closed-box (inner walls at ±1 m): E[r] toward each texel centre is the
+  // distance to the walls that way, averaged over the texel's cos^50 lobe (a few % above the
+  // central value on a flat wall, where 1/cos grows off-axis; below it near edges and corners,
+  // where the distance peaks). 10 % everywhere, 3 % along the six axes. Then the same probe moved
+  // by an offset of (0.5, 0, 0): the cube is drawn from where the probe is, not its grid point.
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("closed-box");
+  RasterRenderer raster(context, s, 16, 16);
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{1, 1, 1}, {{-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}}});  // at the origin
+  for (const glm::vec3 probe : {glm::vec3(0.0f), glm::vec3(0.5f, 0.0f, 0.0f)}) {
+    v.offsets = {probe.x, probe.y, probe.z};
+    raster.setProbes(v);
+    ASSERT_TRUE(raster.visibilityActive());
+    const auto n = static_cast<int>(RasterRenderer::visibilityMapTexels());
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const glm::vec3 d = octTexelDirection(i, j, n);
+        const glm::vec2 m = raster.probeMoments(0, d);
+        const float expected = distanceToBoxWalls(probe, d);
+        EXPECT_NEAR(m.x, expected, 0.1f * expected) << "probe " << probe.x << " texel " << i << "," << j;
+        EXPECT_GE(m.y, m.x * m.x * 0.999f);  // E[r²] ≥ E[r]²
+      }
+    const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (const glm::vec3& a : axes) {
+      // The nearest texel's centre is up to half a texel off the axis: compare with the wall there.
+      const float m = raster.probeMoments(0, a).x, expected = distanceToBoxWalls(probe, a);
+      EXPECT_NEAR(m, expected, 0.03f * expected + 0.03f) << a.x << "," << a.y << "," << a.z;
+    }
+  }
+  EXPECT_LT(raster.probeMoments(0, {1, 0, 0}).x, 0.6f);   // 0.5 m to the +x wall from x = 0.5
+  EXPECT_GT(raster.probeMoments(0, {-1, 0, 0}).x, 1.4f);  // 1.5 m to the −x wall
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+TEST(ProbeVisibility, OffsetsOfTheWrongSizeNotFiniteOrAbsurdAreRefused) {
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("closed-box");
+  RasterRenderer raster(context, s, 8, 8);
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{2, 2, 2}, {{-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}}});
+  v.offsets.assign(5, 0.0f);
+  EXPECT_THROW(raster.setProbes(v), std::invalid_argument);
+  v.offsets.assign(24, 0.0f);
+  v.offsets[7] = std::nanf("");
+  EXPECT_THROW(raster.setProbes(v), std::invalid_argument);
+  v.offsets[7] = 1e30f;  // finite, but a light-year off its cell
+  EXPECT_THROW(raster.setProbes(v), std::invalid_argument);
+  v.offsets[7] = 0.1f;
+  EXPECT_NO_THROW(raster.setProbes(v));
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+// `measure` of a raster client of scene `s` with visibility off, then on.
+template <class Measure>
+std::array<double, 2> offAndOn(VulkanContext& context, const scene::Scene& s, uint32_t width, uint32_t height,
+                               Measure measure) {
+  std::array<double, 2> out{};
+  for (int on = 0; on < 2; ++on) {
+    RasterOptions ro;
+    ro.visibility = on != 0;
+    RasterRenderer raster(context, s, width, height, ro);
+    out[static_cast<size_t>(on)] = measure(raster);
+  }
+  return out;
+}
+
+// Mean luminance of an image.
+double imageMean(const Image& img) {
+  double sum = 0.0;
+  size_t count = 0;
+  for (uint32_t y = 0; y < img.height; ++y)
+    for (uint32_t x = 0; x < img.width; ++x) {
+      const float* px = &img.rgb[(static_cast<size_t>(y) * img.width + x) * 3];
+      sum += 0.2126 * px[0] + 0.7152 * px[1] + 0.0722 * px[2];
+      ++count;
+    }
+  return sum / static_cast<double>(count);
+}
+
+TEST(ProbeVisibility, ThinWallDarkSideFloorStaysDark) {
+  // builtin:thin-wall: the light is in the +x room and the 0.2 m wall at x = 0 closes the −x room
+  // off, so its floor gets no light at all (the traced probes there are black). Mirror-image
+  // views of the floor by the wall from each room: without visibility the probes of the lit room
+  // light the dark floor through the wall (the cells across it blend both sides); with it, the
+  // dark floor is ≤ 1 % of the lit one.
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("thin-wall");
+  UpdaterOptions uo;
+  uo.samplesPerProbe = 64;
+  ProbeUpdater updater(context, s, sceneGrid(s, {8, 4, 4}), uo);
+  updater.update();
+  updater.update();
+  const ProbeVolume volume = updater.volume();
+  // Straight down from 1 m onto the floor x in [-0.6, -0.1] (the wall's foot at the image's edge).
+  CameraView dark, lit;
+  dark.position = {-0.35f, 1.0f, 0.0f};
+  dark.forward = {0.0f, -1.0f, 0.0f};
+  dark.up = {1.0f, 0.0f, 0.0f};
+  dark.yfov = 0.5f;
+  lit = dark;
+  lit.position.x = -dark.position.x;
+  lit.up.x = -dark.up.x;
+  const std::array<double, 2> ratio = offAndOn(context, s, 48, 32, [&](RasterRenderer& raster) {
+    raster.setProbes(volume);
+    const double darkFloor = imageMean(raster.render(raster.viewProjection(dark), dark.position));
+    const double litFloor = imageMean(raster.render(raster.viewProjection(lit), lit.position));
+    EXPECT_GT(litFloor, 0.0);
+    return darkFloor / litFloor;
+  });
+  std::printf("thin-wall dark floor / lit floor: visibility off %.4f, on %.4f\n", ratio[0], ratio[1]);
+  EXPECT_LE(ratio[1], 0.01);
+  EXPECT_GT(ratio[0], 0.02);  // the leak visibility removes
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+TEST(ProbeVisibility, BoxFaceIsNotDarkenedByProbesInsideTheBox) {
+  // A box of half-size 0.6 m floating in constant light L from every direction, probes 0.5 m
+  // apart; the 27 probes inside it hold nothing but are active (as if classification missed
+  // them). The face towards the camera at z = 0.6 sits between the inside layer z = 0.5
+  // (trilinear weight 0.8) and the outside layer z = 1.0: without visibility it shows about 20 %
+  // of its light; with visibility it matches a volume that is L everywhere within 5 % (what is
+  // left comes from inside probes 0.1 m from the face seeing it at a grazing angle).
+  VulkanContext context(test::validatedContext());
+  scene::Scene s;
+  scene::Material white;
+  white.baseColor = glm::vec3(0.8f);
+  s.materials.push_back(white);
+  scene::addBox(s, {0.0f, 0.0f, 0.0f}, {0.6f, 0.6f, 0.6f}, 0.0f, 0);
+  scene::finalizeScene(s);
+  const ProbeGrid grid{{7, 7, 7}, {{-1.5f, -1.5f, -1.5f}, {1.5f, 1.5f, 1.5f}}};
+  ProbeVolume full = makeProbeVolume(grid);
+  for (uint32_t p = 0; p < grid.count(); ++p) full.probes[p * 27] = full.probes[p * 27 + 1] = full.probes[p * 27 + 2] = 3.5449077f;
+  ProbeVolume hollow = full;
+  int inside = 0;
+  for (uint32_t p = 0; p < grid.count(); ++p) {
+    float pos[3];
+    grid.position(p, pos);
+    if (std::abs(pos[0]) < 0.6f && std::abs(pos[1]) < 0.6f && std::abs(pos[2]) < 0.6f) {
+      for (int c = 0; c < 27; ++c) hollow.probes[p * 27 + c] = 0.0f;
+      ++inside;
+    }
+  }
+  ASSERT_EQ(inside, 27);
+  CameraView cam;
+  cam.position = {0.0f, 0.0f, 3.0f};
+  cam.forward = {0.0f, 0.0f, -1.0f};
+  cam.yfov = 0.4f;  // the face fills the centre of the image
+  // Mean of the central 50 % of the image: all of it the face at z = 0.6.
+  const auto faceMean = [](const Image& img) {
+    double sum = 0.0;
+    size_t count = 0;
+    for (uint32_t y = img.height / 4; y < img.height * 3 / 4; ++y)
+      for (uint32_t x = img.width / 4; x < img.width * 3 / 4; ++x) {
+        sum += img.rgb[(static_cast<size_t>(y) * img.width + x) * 3 + 1];
+        ++count;
+      }
+    return sum / static_cast<double>(count);
+  };
+  const std::array<double, 2> ratio = offAndOn(context, s, 32, 32, [&](RasterRenderer& raster) {
+    raster.setProbes(full);
+    const double expected = faceMean(raster.render(raster.viewProjection(cam), cam.position));
+    raster.setProbes(hollow);
+    return faceMean(raster.render(raster.viewProjection(cam), cam.position)) / expected;
+  });
+  std::printf("box face with hollow probes / full: visibility off %.4f, on %.4f\n", ratio[0], ratio[1]);
+  EXPECT_NEAR(ratio[1], 1.0, 0.05);
+  EXPECT_LT(ratio[0], 0.5);  // the darkening visibility removes
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+}  // namespace
+}  // namespace probecast::renderer
