@@ -16,7 +16,14 @@
 #define RS_BINDING_SHADOW_LIGHTS 8     // RsShadowLight[], one per light
 #define RS_BINDING_SHADOW_LAYERS 9     // RsShadowLayer[], one per shadow-map layer
 #define RS_BINDING_SHADOW_MAP 10       // sampler2DArrayShadow: depth of every shadow layer
-#define RS_BINDING_COUNT 11
+#define RS_BINDING_AREA_LIGHTS 11       // RsAreaLight[]: client area lights (scene/area_lights.h)
+#define RS_BINDING_AREA_CORNERS 12      // vec4[]: 3 corners per area-light triangle, xyz world
+#define RS_BINDING_AREA_SHADOW_LAYERS 13 // RsShadowLayer[], one per area-light shadow layer
+#define RS_BINDING_AREA_SHADOW_MAP 14   // sampler2DArrayShadow: depth from every area light
+#define RS_BINDING_AREA_SHADOW_DEPTH 15 // sampler2DArray: the same depths, raw (PCSS blocker search)
+#define RS_BINDING_COUNT 16
+
+#define RS_AREA_UNSHADOWED 0xffffffffu // RsAreaLight.shadowLayer: no layer left for it
 
 #define RS_PASS_OPAQUE 0u              // opaque and cut-out triangles, depth written
 #define RS_PASS_TRANSMIT 1u            // transmissive triangles: colour × T (blend: dst · src)
@@ -58,9 +65,23 @@ struct RsPushConstants {
   uint shadowMapSize;  // texels per side of each shadow layer
   uint primitiveBase;  // scene triangle index of the draw's first triangle (+ gl_PrimitiveID)
   uint pass;           // RS_PASS_*
-  uint pad0;
-  uint pad1;
+  uint areaLightCount; // client area lights (RS_BINDING_AREA_LIGHTS)
+  uint areaShadowMapSize;  // texels per side of each area-light shadow layer
   uint pad2;
+};
+
+struct RsAreaLight {
+  vec4 radiance;       // rgb emitted radiance (constant over the light)
+  vec4 centroidSize;   // xyz centroid (its shadow map's eye), w = light size √area (PCSS)
+  vec4 axisTanHalf;    // xyz unit axis of its shadow map (the light's normal), w = tan(fov / 2)
+  uint firstCorner;    // in RS_BINDING_AREA_CORNERS
+  uint triangleCount;
+  uint shadowLayer;    // layer of the area shadow map, RS_AREA_UNSHADOWED when none
+  uint pad;
+  float znear;         // the shadow layer's depth range along the axis
+  float zfar;
+  float pad1;
+  float pad2;
 };
 
 // Shadow-map passes: one layer's view-projection, and the draw's first triangle.
@@ -77,6 +98,7 @@ static_assert(sizeof(RsPushConstants) == 112);
 static_assert(sizeof(RsShadowPush) == 80);
 static_assert(sizeof(RsView) == 80);
 static_assert(sizeof(RsShadowLight) == 16);
+static_assert(sizeof(RsAreaLight) == 80);
 }  // namespace probecast::shaders
 #endif
 

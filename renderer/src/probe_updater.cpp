@@ -168,8 +168,13 @@ struct ProbeUpdater::Impl {
     uploadProbeList(activeList);
   }
 
+  // After every upload of materials: the emitters the raster client lights (area_lights.h).
+  void markClientLit(const scene::Scene& s) {
+    markClientLitMaterials(scene::extractAreaLights(s, options.areaLights).clientLitMaterial, gpu);
+  }
   void setGeometry(const scene::Scene& s) {
     uploadGpuScene(*d, s, gpu);
+    markClientLit(s);
     geometryPositions = s.positions;
     geometryIndices = s.indices;
   }
@@ -214,6 +219,7 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
     s.classify();
   } else {
     uploadGpuShading(*s.d, scene, s.gpu);
+    s.markClientLit(scene);
   }
 }
 

@@ -77,6 +77,10 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
     records.push_back(r);
   }
   if (records.empty()) records.push_back({RS_SHADOW_NONE, 0, 0.0f, 0.0f});
+  uploadShadowPlan(d, records, maps);
+}
+
+void uploadShadowPlan(VulkanDevice& d, const std::vector<shaders::RsShadowLight>& records, ShadowMaps& maps) {
   destroyBuffer(d, maps.lights);
   destroyBuffer(d, maps.layers);
   maps.lights =

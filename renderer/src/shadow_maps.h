@@ -13,6 +13,7 @@
 
 #include "gpu_scene.h"
 #include "probecast/scene/scene.h"
+#include "raster_shared.h"
 #include "vk_resources.h"
 
 namespace probecast::renderer {
@@ -36,6 +37,9 @@ void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, VkDesc
                       ShadowMaps& out);
 // Plans the layers for the scene's lights (bounds from the scene); drawn at the next draw call.
 void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps);
+// Uploads a plan made in maps.matrices (and one record per light) and sizes the depth array for it;
+// the layers are drawn at the next drawShadowMaps.
+void uploadShadowPlan(VulkanDevice& d, const std::vector<shaders::RsShadowLight>& records, ShadowMaps& maps);
 // Draws every planned layer of `gpu`'s triangles if the plan changed since the last draw;
 // `materials` is a set of the layout given at creation.
 void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, VkDescriptorSet materials,
