@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <stdexcept>
 #include <tuple>
 
 namespace probecast::scene {
@@ -71,6 +72,8 @@ AreaLight makeLight(const Scene& s, uint32_t material, const std::vector<uint32_
 }  // namespace
 
 AreaLightSet extractAreaLights(const Scene& s, const AreaLightOptions& o) {
+  if (!(o.minPowerFraction >= 0.0f && o.minPowerFraction <= 1.0f))  // NaN too
+    throw std::invalid_argument("area lights: the minimum power share must be in [0, 1]");
   AreaLightSet out;
   out.clientLitMaterial.assign(s.materials.size(), 0);
   // Power per material, and the triangles of each untextured emissive material.

@@ -42,6 +42,7 @@ struct AreaLightSet {
 };
 
 // The decision above. Empty (no light, every flag 0) when disabled or when nothing qualifies.
+// Throws std::invalid_argument for a minimum share outside [0, 1] (NaN included).
 AreaLightSet extractAreaLights(const Scene& scene, const AreaLightOptions& options);
 
 }  // namespace probecast::scene
