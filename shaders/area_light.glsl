@@ -85,6 +85,7 @@ float areaShadow(RsAreaLight l, vec3 p, vec3 n, vec3 ngf) {
 // normal ngf on the viewer's side), shadowed.
 vec3 areaLightsDirect(vec3 p, vec3 n, vec3 ngf, vec3 wo, vec3 base, float metallic, float alpha, float roughness) {
   vec3 sum = vec3(0.0);
+  if (pc.areaLightCount == 0u) return sum;  // the table lookup below is not free
   float nv = clamp(dot(n, wo), 0.0, 1.0);
   vec3 r = reflect(-wo, n);
   vec3 f0 = mix(vec3(0.04), base, metallic);
