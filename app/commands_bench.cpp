@@ -138,6 +138,7 @@ void addBenchRaster(CLI::App* bench) {
     std::string json, chart;
     std::vector<uint32_t> size{320, 200};
     bench::RasterBenchOptions bench;
+    AreaLightCli areaLights;
   };
   auto ro = std::make_shared<RasterOptions>();
   rt->add(raster);
@@ -151,12 +152,14 @@ void addBenchRaster(CLI::App* bench) {
       ->check(CLI::Range(16, 8192));
   addShadowCascadesOption(raster, ro->bench.raster.shadowCascades);
   addVisibilityOption(raster, ro->bench.raster.visibility);
+  ro->areaLights.add(raster);
   addJsonOption(raster, ro->json);
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
   raster->callback([=] {
     ro->bench.scene = rt->scene.load();
     ro->bench.grid = rt->grid.resolve(ro->bench.scene);
     ro->bench.updater = rt->updater(rt->scene.environment.load());  // the reference and background too
+    ro->bench.updater.areaLights = ro->bench.raster.areaLights = ro->areaLights.options();
     ro->bench.context = rt->gpu.context();
     ro->bench.width = ro->size[0];
     ro->bench.height = ro->size[1];

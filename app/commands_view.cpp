@@ -22,6 +22,7 @@ struct ViewOptions {
   std::string probes = "live", views = "lf:5x5", out = "out/view";
   std::string repr = "float", passes = "per-view", toneMap = "filmic";
   uint32_t shadowMap = 1024, shadowCascades = 4;
+  AreaLightCli areaLights;
   double waitSeconds = 3.0;
   std::vector<uint32_t> size{320, 200};
   uint32_t updates = 4;
@@ -66,7 +67,9 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
                      const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
   ProbeVolume volume;
   if (o.probes == "live") {
-    renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), o.tracing.updater(ro.environment));
+    renderer::UpdaterOptions uo = o.tracing.updater(ro.environment);
+    uo.areaLights = ro.areaLights;  // the probes leave out exactly what this viewer lights
+    renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), uo);
     Progress progress("view", /*bar=*/false);
     for (uint32_t u = 0; u < o.updates; ++u) {
       updater.update();
@@ -134,6 +137,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
   addShadowCascadesOption(cmd, o->shadowCascades);
   addVisibilityOption(cmd, o->visibility);
+  o->areaLights.add(cmd);
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
     renderer::ViewSetSpec spec;
@@ -150,6 +154,10 @@ void addViewCommand(CLI::App& app) {
     ro.shadowCascades = o->shadowCascades;
     ro.visibility = o->visibility;
     ro.environment = environment;
+    ro.areaLights = o->areaLights.options();
+    if (ro.areaLights.enabled && (o->probes != "live" || !o->connection.connect.empty()))
+      throw std::runtime_error("--area-lights on needs --probes live: probes from a file or a server hold the "
+                               "emitters' direct light already, and it would be counted twice");
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);
     writeViews(*o, r, views, spec);

@@ -15,6 +15,7 @@
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
+#include "probecast/scene/area_lights.h"
 #include "probecast/scene/scene.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/scene_loading.h"
@@ -179,6 +180,27 @@ struct TracerOptions {
     o.rejectSigmas = rejectSigmas;
     o.indirectClamp = clamp;
     o.relocate = relocate;
+    return o;
+  }
+};
+
+// --area-lights on|off: emitters the viewer shades itself (scene/area_lights.h), left out of the
+// probes it traces for itself. Off by default: probes from a file or a server hold every emitter.
+struct AreaLightCli {
+  std::string mode = "off";
+  float minFraction = 0.05f;
+  void add(CLI::App* cmd) {
+    cmd->add_option("--area-lights", mode,
+                    "on: emissive surfaces become area lights the raster client shades with soft shadows, and the "
+                    "probes traced here leave their direct light out")
+        ->check(CLI::IsMember({"on", "off"}));
+    cmd->add_option("--area-light-min", minFraction, "smallest share of the scene's emitted power an area light has")
+        ->check(CLI::Range(0.0f, 1.0f));
+  }
+  scene::AreaLightOptions options() const {
+    scene::AreaLightOptions o;
+    o.enabled = mode == "on";
+    o.minPowerFraction = minFraction;
     return o;
   }
 };

@@ -88,6 +88,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["reference_spp"] = o.referenceSpp;
   json["shadow_map_size"] = o.raster.shadowMapSize;
   json["shadow_cascades"] = o.raster.shadowCascades;
+  json["area_lights"] = o.raster.areaLights.enabled;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
   std::string table =
       fmt::format("raster bench: {} at {}x{} on {}\n", o.scene.name, o.width, o.height, context.deviceName());
@@ -172,11 +173,14 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
       speedSeries[static_cast<size_t>(way)].points.push_back({static_cast<double>(views.size()), perViewMs[way], ""});
     }
     row["shadow_ms"] = raster.timings().shadowMs;
+    row["area_shadow_ms"] = raster.timings().areaShadowMs;
     json["view_sets"].push_back(row);
     table += fmt::format("{:<8} {:>6} {:>16.2f} {:>16.2f}\n", name, views.size(), perViewMs[0], perViewMs[1]);
     say(fmt::format("raster bench: {} done", name));
   }
   table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
+  table += fmt::format("shadow maps: punctual {:.2f} ms, {} client area lights {:.2f} ms (drawn once per plan)\n",
+                       raster.timings().shadowMs, raster.areaLights().lights.size(), raster.timings().areaShadowMs);
 
   table += timeVolumeUpdates(raster, o, json);
   json["validation_messages"] = context.validationMessages();

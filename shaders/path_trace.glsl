@@ -8,7 +8,7 @@
 // (Blend, KHR_materials_transmission; the rule in scene.h) attenuate visibility rays by T = τ·base
 // and let a path through with probability τ. The including raygen declares the bindings
 // (scene_bindings.glsl) and defines PATH_LIGHT_COUNT, PATH_MAX_BOUNCES, PATH_INDIRECT_CLAMP,
-// PATH_EMITTER_COUNT and PATH_EMITTER_POWER.
+// PATH_EMITTER_COUNT, PATH_EMITTER_POWER and PATH_SKIP_CLIENT_LIT.
 #include "material.glsl"
 
 layout(location = 0) rayPayloadEXT HitPayload hit;
@@ -283,6 +283,12 @@ vec3 clampIndirect(vec3 c, uint bounce) {
   return lum > PATH_INDIRECT_CLAMP ? c * (PATH_INDIRECT_CLAMP / lum) : c;
 }
 
+// What a probe holds (README): a probe ray that meets a client-lit emitter on its first segment
+// (crossings of transmissive surfaces included) gets none of its emission; the viewer adds that
+// light itself. Later segments, and next-event estimation toward it, keep it. The reference camera
+// defines PATH_SKIP_CLIENT_LIT 0 and sees every emitter.
+bool clientLitFirstHit(PtMaterial m) { return PATH_SKIP_CLIENT_LIT != 0 && m.textures.w != 0; }
+
 vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
   float lastBsdfPdf = 0.0;  // pdf of the BSDF sample that started this segment (0: not sampled)
@@ -313,7 +319,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     vec4 uvs = vertexTexcoords(i0) * bary.x + vertexTexcoords(i1) * bary.y + vertexTexcoords(i2) * bary.z;
     vec3 leFactor = m.emissionRoughness.rgb;
     vec3 le = materialEmission(m, uvs);
-    if (hit.backFace == 0u && anyLight(le)) {
+    if (hit.backFace == 0u && anyLight(le) && !(bounce == 0u && clientLitFirstHit(m))) {
       // Emission found by BSDF sampling, weighted against emitter sampling (not on the first
       // segment: probe and camera rays are not BSDF samples).
       float weight = 1.0;

@@ -68,7 +68,8 @@ struct mat4 {
 struct PtMaterial {
   vec4 baseColorMetallic;   // rgb base colour, a metallic
   vec4 emissionRoughness;   // rgb emitted radiance, a roughness
-  ivec4 textures;           // x base colour texture, y emissive texture (-1 = none), z PT_ALPHA_*
+  ivec4 textures;           // x base colour texture, y emissive texture (-1 = none), z PT_ALPHA_*,
+                            // w 1: a client area light (the probe tracer's first segment skips its emission)
   vec4 alpha;               // x alpha (baseColorFactor.a), y alpha cutoff (Mask), z transmission factor
   // KHR_texture_transform: uv' = (row0.xyz · (u, v, 1), row1.xyz · (u, v, 1)) of TEXCOORD_<row0.w>.
   vec4 baseTransform0;

@@ -1,6 +1,7 @@
 #version 460
 // Raster client shading: surface emission + direct light from punctual lights (shadow maps, 3×3
-// PCF) + diffuse indirect albedo/π · E(n) and split-sum glossy indirect from the probe volume
+// PCF) and from client area lights (area_light.glsl) + diffuse indirect albedo/π · E(n) and
+// split-sum glossy indirect from the probe volume
 // (8 probes weighted by visibility from per-probe distance moments, or hardware trilinear in the 3D
 // textures with visibility off), linear radiance out. Cut-away points (alphaMode Mask) are discarded;
 // transmissive surfaces (scene.h's rule) are drawn after the opaque ones in two blended passes:
@@ -33,6 +34,7 @@ layout(std430, binding = RS_BINDING_PROBE_POSITIONS) readonly buffer ProbePositi
 layout(binding = RS_BINDING_PROBE_MOMENTS) uniform sampler2D probeMoments;
 
 #include "material.glsl"
+#include "area_light.glsl"
 
 // The probe volume's 27 SH coefficients at p (trilinear over active probes).
 bool probeCoefficients(vec3 p, out float c[28]) {
@@ -290,6 +292,7 @@ void main() {
     float cosine = dot(n, wi);
     if (cosine > 0.0 && dot(ngf, wi) > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e * shadowVisibility(i, worldPosition, n);
   }
+  direct += areaLightsDirect(worldPosition, n, ngf, wo, base, metallic, alpha, m.emissionRoughness.a);
   float c[28];
   vec3 indirect = vec3(0.0);
   if (pc.visibility != 0u ? probeCoefficientsVisible(worldPosition, ngf, wo, c) : probeCoefficients(worldPosition, c)) {

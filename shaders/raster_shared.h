@@ -21,7 +21,6 @@
 #define RS_TRANSMIT_CLEAR_DEPTH 65504.0  // a of a texel no transmissive caster covers (largest half float)
 #define RS_BINDING_PROBE_POSITIONS 12  // vec4[] per probe: xyz where it was traced (grid + offset), metres
 #define RS_BINDING_PROBE_MOMENTS 13    // sampler2D RG32F atlas of per-probe distance moments (below)
-#define RS_BINDING_COUNT 14
 
 // Probe visibility (probe_visibility.h): per probe an RS_VIS_OCT² octahedral map of (E[r], E[r²]),
 // r the distance from the probe to the nearest surface, with a one-texel border so that bilinear
@@ -29,6 +28,15 @@
 #define RS_VIS_OCT 16
 #define RS_VIS_TILE (RS_VIS_OCT + 2)
 #define RS_VIS_TILES_PER_ROW 256
+
+#define RS_BINDING_AREA_LIGHTS 14       // RsAreaLight[]: client area lights (scene/area_lights.h)
+#define RS_BINDING_AREA_CORNERS 15      // vec4[]: 3 corners per area-light triangle, xyz world
+#define RS_BINDING_AREA_SHADOW_LAYERS 16 // RsShadowLayer[], one per area-light shadow layer
+#define RS_BINDING_AREA_SHADOW_MAP 17   // sampler2DArrayShadow: depth from every area light
+#define RS_BINDING_AREA_SHADOW_DEPTH 18 // sampler2DArray: the same depths, raw (PCSS blocker search)
+#define RS_BINDING_COUNT 19
+
+#define RS_AREA_UNSHADOWED 0xffffffffu // RsAreaLight.shadowLayer: no layer left for it
 
 #define RS_PASS_OPAQUE 0u              // opaque and cut-out triangles, depth written
 #define RS_PASS_TRANSMIT 1u            // transmissive triangles: colour × T (blend: dst · src)
@@ -74,8 +82,22 @@ struct RsPushConstants {
   uint primitiveBase;  // scene triangle index of the draw's first triangle (+ gl_PrimitiveID)
   uint pass;           // RS_PASS_*
   uint visibility;     // 1: interpolate 8 probes weighted by visibility; 0: hardware trilinear
-  uint pad1;
-  uint pad2;
+  uint areaLightCount; // client area lights (RS_BINDING_AREA_LIGHTS)
+  uint areaShadowMapSize;  // texels per side of each area-light shadow layer
+};
+
+struct RsAreaLight {
+  vec4 radiance;       // rgb emitted radiance (constant over the light)
+  vec4 centroidSize;   // xyz centroid (its shadow map's eye), w = light size √area (PCSS)
+  vec4 axisTanHalf;    // xyz unit axis of its shadow map (the light's normal), w = tan(fov / 2)
+  uint firstCorner;    // in RS_BINDING_AREA_CORNERS
+  uint triangleCount;
+  uint shadowLayer;    // layer of the area shadow map, RS_AREA_UNSHADOWED when none
+  uint pad;
+  float znear;         // the shadow layer's depth range along the axis
+  float zfar;
+  float pad1;
+  float pad2;
 };
 
 // Shadow-map passes: one layer's view-projection, and the draw's first triangle.
@@ -93,6 +115,7 @@ static_assert(sizeof(RsShadowPush) == 80);
 static_assert(sizeof(RsView) == 80);
 static_assert(sizeof(RsShadowLight) == 16);
 static_assert(sizeof(RsShadowLayer) == 80);
+static_assert(sizeof(RsAreaLight) == 80);
 }  // namespace probecast::shaders
 #endif
 

@@ -68,6 +68,12 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   }
 }
 
+void markClientLitMaterials(const std::vector<uint8_t>& clientLit, GpuScene& g) {
+  auto* mats = static_cast<shaders::PtMaterial*>(g.materials.mapped);
+  const size_t count = g.materials.size / sizeof(shaders::PtMaterial);
+  for (size_t m = 0; m < count; ++m) mats[m].textures.w = m < clientLit.size() && clientLit[m] ? 1 : 0;
+}
+
 void uploadGpuEnvironment(VulkanDevice& d, const Environment* env, bool sampling, GpuScene& g) {
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   destroyBuffer(d, g.environment);

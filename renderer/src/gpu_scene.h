@@ -29,6 +29,10 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& scene, GpuScene& out)
 // The environment the ray-tracing passes see (none when `env` is null or empty); `sampling`:
 // next-event estimation importance-samples it. uploadGpuScene starts with none.
 void uploadGpuEnvironment(VulkanDevice& d, const Environment* env, bool sampling, GpuScene& out);
+// Flags the materials whose emission the raster client lights itself (one byte per material, as
+// scene::AreaLightSet::clientLitMaterial; missing entries count as 0): the probe tracer's first
+// segment skips their emission. Only the probe updater calls it; the reference camera sees all.
+void markClientLitMaterials(const std::vector<uint8_t>& clientLit, GpuScene& g);
 void destroyGpuScene(VulkanDevice& d, GpuScene& g);
 
 }  // namespace probecast::renderer

@@ -247,8 +247,13 @@ struct ProbeUpdater::Impl {
     if (c.moved == 0) volume.offsets.clear();  // nothing moved: every probe at its grid position, no bytes to send
   }
 
+  // After every upload of materials: the emitters the raster client lights (area_lights.h).
+  void markClientLit(const scene::Scene& s) {
+    markClientLitMaterials(scene::extractAreaLights(s, options.areaLights).clientLitMaterial, gpu);
+  }
   void setGeometry(const scene::Scene& s) {
     uploadGpuScene(*d, s, gpu);
+    markClientLit(s);
     geometryPositions = s.positions;
     geometryIndices = s.indices;
   }
@@ -293,6 +298,7 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
     s.classify();
   } else {
     uploadGpuShading(*s.d, scene, s.gpu);
+    s.markClientLit(scene);
   }
 }
 

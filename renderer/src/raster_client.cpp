@@ -15,6 +15,7 @@
 #include "probecast/renderer/glossy_sh.h"
 #include "raster.frag.h"
 #include "raster.vert.h"
+#include "area_light_shadows.h"
 #include "raster_shared.h"
 #include "shadow_maps.h"
 #include "vk_pipeline.h"
@@ -145,7 +146,10 @@ struct RasterRenderer::Impl {
   GpuImage envBrdf;
   ShadowMaps shadows;
   ProbeVisibility visibility;
-  VkSampler sampler = VK_NULL_HANDLE, shadowSampler = VK_NULL_HANDLE;
+  ShadowMaps areaShadows;  // one layer per client area light
+  scene::AreaLightSet areaSet;
+  AreaLightBuffers areaBuffers;
+  VkSampler sampler = VK_NULL_HANDLE, shadowSampler = VK_NULL_HANDLE, depthSampler = VK_NULL_HANDLE;
   Buffer readback, views;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
@@ -177,18 +181,27 @@ struct RasterRenderer::Impl {
         for (int c = 0; c < 3; ++c) px[c] = L[c];
       }
   }
+  // The client area lights of `scene` (the rule of area_lights.h), uploaded with their shadow plan.
+  void planAreaLights(const scene::Scene& scene) {
+    areaSet = scene::extractAreaLights(scene, options.areaLights);
+    renderer::planAreaLights(*d, scene, areaSet, areaShadows, areaBuffers);
+    push.areaLightCount = areaBuffers.count;
+  }
   bool hasBackground() const { return options.environment && !options.environment->empty(); }
 
   void writeDescriptors() {
-    constexpr uint32_t kBuffers = 9;
-    const Buffer* buffers[kBuffers] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels, &gpu.textures,
-                                       &views, &shadows.lights, &shadows.layers, &visibility.positions};
+    constexpr uint32_t kBuffers = 12;
+    const Buffer* buffers[kBuffers] = {&gpu.triangleMaterial, &gpu.materials, &gpu.lights, &gpu.texels,
+                                       &gpu.textures, &views, &shadows.lights, &shadows.layers,
+                                       &visibility.positions, &areaBuffers.lights, &areaBuffers.corners,
+                                       &areaShadows.layers};
     const uint32_t bindings[kBuffers] = {RS_BINDING_TRIANGLE_MATERIAL, RS_BINDING_MATERIALS, RS_BINDING_LIGHTS,
                                          RS_BINDING_TEXELS, RS_BINDING_TEXTURES, RS_BINDING_VIEWS,
                                          RS_BINDING_SHADOW_LIGHTS, RS_BINDING_SHADOW_LAYERS,
-                                         RS_BINDING_PROBE_POSITIONS};
+                                         RS_BINDING_PROBE_POSITIONS, RS_BINDING_AREA_LIGHTS, RS_BINDING_AREA_CORNERS,
+                                         RS_BINDING_AREA_SHADOW_LAYERS};
     VkDescriptorBufferInfo infos[kBuffers];
-    VkWriteDescriptorSet writes[kBuffers + 5];
+    VkWriteDescriptorSet writes[kBuffers + 7];
     for (uint32_t b = 0; b < kBuffers; ++b) {
       infos[b] = {buffers[b]->buffer, 0, VK_WHOLE_SIZE};
       writes[b] = bufferWrite(set, bindings[b], &infos[b]);
@@ -200,12 +213,18 @@ struct RasterRenderer::Impl {
     const VkDescriptorImageInfo shadowInfo{shadowSampler, shadows.depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo momentsInfo{sampler, visibility.moments.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo transmitInfo{sampler, shadows.transmit.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo areaInfo{shadowSampler, areaShadows.depth.view,
+                                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo areaDepthInfo{depthSampler, areaShadows.depth.view,
+                                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     writes[kBuffers] = imageWrite(set, RS_BINDING_PROBES, images, RS_PROBE_TEXTURES);
     writes[kBuffers + 1] = imageWrite(set, RS_BINDING_ENV_BRDF, &envInfo, 1);
     writes[kBuffers + 2] = imageWrite(set, RS_BINDING_SHADOW_MAP, &shadowInfo, 1);
     writes[kBuffers + 3] = imageWrite(set, RS_BINDING_PROBE_MOMENTS, &momentsInfo, 1);
     writes[kBuffers + 4] = imageWrite(set, RS_BINDING_SHADOW_TRANSMIT, &transmitInfo, 1);
-    vkUpdateDescriptorSets(d->device, kBuffers + 5, writes, 0, nullptr);
+    writes[kBuffers + 5] = imageWrite(set, RS_BINDING_AREA_SHADOW_MAP, &areaInfo, 1);
+    writes[kBuffers + 6] = imageWrite(set, RS_BINDING_AREA_SHADOW_DEPTH, &areaDepthInfo, 1);
+    vkUpdateDescriptorSets(d->device, kBuffers + 7, writes, 0, nullptr);
   }
 
   // Coefficients premultiplied by a weight, the weight in the last texel's w: after trilinear
@@ -425,6 +444,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   sci.compareEnable = VK_TRUE;  // hardware 2×2 depth comparison: lit where ref ≤ stored
   sci.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
   VK_CHECK(vkCreateSampler(d.device, &sci, nullptr, &s.shadowSampler));
+  sci.compareEnable = VK_FALSE;  // raw depths for the area lights' blocker search
+  sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
+  VK_CHECK(vkCreateSampler(d.device, &sci, nullptr, &s.depthSampler));
 
   constexpr VkShaderStageFlags kFrag = VK_SHADER_STAGE_FRAGMENT_BIT;
   constexpr VkDescriptorType kSsbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kImage = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -442,7 +464,12 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
       layoutBinding(RS_BINDING_SHADOW_MAP, kImage, 1, kFrag),
       layoutBinding(RS_BINDING_SHADOW_TRANSMIT, kImage, 1, kFrag),
       layoutBinding(RS_BINDING_PROBE_POSITIONS, kSsbo, 1, kFrag),
-      layoutBinding(RS_BINDING_PROBE_MOMENTS, kImage, 1, kFrag)};
+      layoutBinding(RS_BINDING_PROBE_MOMENTS, kImage, 1, kFrag),
+      layoutBinding(RS_BINDING_AREA_LIGHTS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_AREA_CORNERS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_AREA_SHADOW_LAYERS, kSsbo, 1, kFrag),
+      layoutBinding(RS_BINDING_AREA_SHADOW_MAP, kImage, 1, kFrag),
+      layoutBinding(RS_BINDING_AREA_SHADOW_DEPTH, kImage, 1, kFrag)};
   VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   lci.bindingCount = RS_BINDING_COUNT;
   lci.pBindings = bindings;
@@ -451,9 +478,10 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
                                   sizeof(shaders::RsPushConstants));
   s.pipelineFor(0, RS_PASS_OPAQUE);
   createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, options.shadowCascades, s.setLayout, s.shadows);
+  createShadowMaps(d, options.areaShadowMapSize, options.maxShadowLayers, 1, s.setLayout, s.areaShadows);
   createProbeVisibility(d, s.setLayout, s.visibility);
 
-  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 9}, {kImage, RS_PROBE_TEXTURES + 4}};
+  const VkDescriptorPoolSize sizes[2] = {{kSsbo, 12}, {kImage, RS_PROBE_TEXTURES + 6}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
   // The environment BRDF table, computed at start-up (glossy_sh.h), and the lobe fit.
   {
@@ -479,7 +507,9 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
                         static_cast<float>(fit.band2[2]), static_cast<float>(fit.band2[3])};
   }
   planShadowMaps(d, scene, s.shadows);
+  s.planAreaLights(scene);
   s.push.shadowMapSize = options.shadowMapSize;
+  s.push.areaShadowMapSize = options.areaShadowMapSize;
   s.push.lightCount = s.gpu.lightCount;
   // No volume yet: a 1³ black one keeps every descriptor valid (and writes them all).
   ProbeGrid one;
@@ -497,8 +527,10 @@ RasterRenderer::~RasterRenderer() {
   for (Buffer* b : {&s.readback, &s.views}) destroyBuffer(d, *b);
   destroyShadowMaps(d, s.shadows);
   destroyProbeVisibility(d, s.visibility);
+  destroyShadowMaps(d, s.areaShadows);
+  destroyAreaLights(d, s.areaBuffers);
   destroyGpuScene(d, s.gpu);
-  for (VkSampler sampler : {s.sampler, s.shadowSampler})
+  for (VkSampler sampler : {s.sampler, s.shadowSampler, s.depthSampler})
     if (sampler) vkDestroySampler(d.device, sampler, nullptr);
   if (s.pool) vkDestroyDescriptorPool(d.device, s.pool, nullptr);
   for (auto& [mask, pipeline] : s.pipelines) vkDestroyPipeline(d.device, pipeline, nullptr);
@@ -547,6 +579,7 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   uploadGpuShading(*s.d, scene, s.gpu);
   s.push.lightCount = s.gpu.lightCount;
   planShadowMaps(*s.d, scene, s.shadows);
+  s.planAreaLights(scene);
   s.writeDescriptors();
 }
 
@@ -558,6 +591,8 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   fitShadowCascades(views, s.shadows);
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;
+  drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.areaShadows);
+  s.timings.areaShadowMs = s.areaShadows.lastDrawMs;
   const auto t0 = Clock::now();
   auto* dst = static_cast<shaders::RsView*>(s.views.mapped);
   s.inverseViewProj.resize(views.size());
@@ -594,5 +629,6 @@ glm::vec2 RasterRenderer::probeMoments(uint32_t probe, const glm::vec3& dir) con
 
 uint32_t RasterRenderer::chunkSize() const { return impl_->chunk; }
 const RasterTimings& RasterRenderer::timings() const { return impl_->timings; }
+const scene::AreaLightSet& RasterRenderer::areaLights() const { return impl_->areaSet; }
 
 }  // namespace probecast::renderer

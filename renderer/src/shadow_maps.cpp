@@ -171,8 +171,12 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
     records.push_back(r);
   }
   if (records.empty()) records.push_back({RS_SHADOW_NONE, 0, 0.0f, 1u});
-  maps.texels.assign(maps.matrices.size(), glm::vec4(0.0f));
+  uploadShadowPlan(d, records, maps.transmissiveFirst < scene.triangleCount(), maps);
+}
 
+void uploadShadowPlan(VulkanDevice& d, const std::vector<shaders::RsShadowLight>& records, bool transmissive,
+                      ShadowMaps& maps) {
+  maps.texels.assign(maps.matrices.size(), glm::vec4(0.0f));
   for (const shaders::RsShadowLight& r : records)
     if (r.kind == RS_SHADOW_ORTHO)
       for (uint32_t k = 0; k < r.cascades; ++k) maps.texels[r.firstLayer + k].x = r.texelScale;
@@ -194,7 +198,7 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
       transitionImage(cmd, maps.depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     });
   }
-  createTransmitLayers(d, layers, maps.transmissiveFirst < scene.triangleCount(), maps);
+  createTransmitLayers(d, layers, transmissive, maps);
   maps.layerDirty.assign(maps.matrices.size(), 1);
 }
 

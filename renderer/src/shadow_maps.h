@@ -19,6 +19,7 @@
 #include "gpu_scene.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/scene/scene.h"
+#include "raster_shared.h"
 #include "vk_resources.h"
 
 namespace probecast::renderer {
@@ -58,6 +59,10 @@ void planShadowMaps(VulkanDevice& d, const scene::Scene& scene, ShadowMaps& maps
 // Fits the cascades of every directional light to the view set (a no-op for the same views as the
 // last fit, or with 1 cascade): only the refitted layers are drawn again.
 void fitShadowCascades(const std::vector<ViewInfo>& views, ShadowMaps& maps);
+// Uploads a plan made in maps.matrices (and one record per light) and sizes the depth array (and,
+// with transmissive casters, the colour layers) for it; the layers are drawn at the next drawShadowMaps.
+void uploadShadowPlan(VulkanDevice& d, const std::vector<shaders::RsShadowLight>& records, bool transmissive,
+                      ShadowMaps& maps);
 // Draws every planned layer of `gpu`'s triangles if the plan changed since the last draw;
 // `materials` is a set of the layout given at creation.
 void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, VkDescriptorSet materials,

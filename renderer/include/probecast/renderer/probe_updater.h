@@ -22,6 +22,7 @@
 #include "probecast/codec/probe_volume.h"
 #include "probecast/renderer/environment.h"
 #include "probecast/renderer/vulkan_context.h"
+#include "probecast/scene/area_lights.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::renderer {
@@ -54,6 +55,9 @@ struct UpdaterOptions {
   // the BSDF); none: misses are black. Probes see it directly, like any distant light.
   std::shared_ptr<const Environment> environment;
   bool environmentSampling = true;  // false: reach the environment by BSDF sampling only
+  // Emitters the raster client lights itself (the same options as RasterOptions::areaLights):
+  // probe rays see none of their emission directly; light bounced from them stays in.
+  scene::AreaLightOptions areaLights;
 };
 
 struct UpdateStats {

@@ -22,6 +22,7 @@
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/renderer/vulkan_context.h"
+#include "probecast/scene/area_lights.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::renderer {
@@ -40,6 +41,10 @@ struct RasterOptions {
   // fitted to slices of each view set's depth range (the union of its views' frusta), finest first.
   uint32_t shadowCascades = 4;
   ViewPasses passes = ViewPasses::PerView;
+  // Emitters shaded per pixel as area lights with soft shadows (area_lights.h). Give the probe
+  // updater the same options (UpdaterOptions::areaLights), so the probes leave that light out.
+  scene::AreaLightOptions areaLights;
+  uint32_t areaShadowMapSize = 512;  // texels per side of each area light's shadow layer
   // Drawn as background where no surface covers a pixel (linear radiance like the rest, so the
   // same exposure and tone map apply); its light reaches surfaces through the probes only.
   std::shared_ptr<const Environment> environment;
@@ -50,6 +55,7 @@ struct RasterOptions {
 
 struct RasterTimings {
   double shadowMs = 0.0;  // last shadow-map pass
+  double areaShadowMs = 0.0;  // last area-light shadow-map pass
   double viewsMs = 0.0;   // last renderViews, shadows excluded, readback included
   double visibilityRenderMs = 0.0;   // last visibility build: depth cubes drawn and read back
   double visibilityMomentsMs = 0.0;  // last visibility build: moments on the CPU and their upload
@@ -93,6 +99,8 @@ class RasterRenderer {
   // Views per chunk (multiview: the device's limit, at most 8).
   uint32_t chunkSize() const;
   const RasterTimings& timings() const;
+  // The client area lights in use (empty when RasterOptions::areaLights is off).
+  const scene::AreaLightSet& areaLights() const;
   // A perspective view-projection for a camera (Vulkan conventions) at the target's aspect.
   glm::mat4 viewProjection(const CameraView& camera) const;
 
