@@ -1,4 +1,4 @@
-// `probecast bench codec|update|raster|pipeline|environment|stability|stream|edge|adaptive`.
+// `probecast bench codec|update|raster|scene|pipeline|environment|stability|stream|edge|adaptive`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -15,6 +15,7 @@
 #include "scene_options.h"
 #include "pipeline_bench.h"
 #include "raster_bench.h"
+#include "scene_bench.h"
 #include "stability.h"
 #include "stream_bench.h"
 #include "update_bench.h"
@@ -169,6 +170,50 @@ void addBenchRaster(CLI::App* bench) {
       writeTextFile(views, r.svgViews);
       fmt::print("wrote {}\n", views);
     }
+  });
+}
+
+// `probecast bench scene`: the seeds' table for one scene against cached references.
+void addBenchScene(CLI::App* bench) {
+  CLI::App* cmd = bench->add_subcommand(
+      "scene", "one scene: update ms, raster ms per view, PSNR/SSIM per representation against a cached reference");
+  auto st = std::make_shared<TracingOptions>();
+  struct SceneCli {
+    std::string json, chart;
+    std::vector<uint32_t> size{160, 100};
+    bench::SceneBenchOptions bench;
+  };
+  auto so = std::make_shared<SceneCli>();
+  st->add(cmd);
+  cmd->add_option("--views", so->bench.views, "mono, stereo or lf:NxM");
+  addSizeOption(cmd, so->size, "size of each view WxH", 8, 4096);
+  cmd->add_option("--updates", so->bench.updates, "probe updates (each timed)")->check(CLI::Range(1, 10000));
+  cmd->add_option("--repeats", so->bench.repeats, "timed renders of the view set per representation (median)")
+      ->check(CLI::Range(1, 1000));
+  addReferenceSppOption(cmd, so->bench.referenceSpp, 1u << 20, "samples per pixel of each reference (two halves)");
+  cmd->add_option("--reference-bounces", so->bench.referenceBounces, "surface interactions per reference path")
+      ->check(CLI::Range(1, 16));
+  cmd->add_option("--reference-seed", so->bench.referenceSeed, "seed of the first half-reference");
+  cmd->add_option("--reference-cache", so->bench.referenceCache,
+                  "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
+  cmd->add_option("--images", so->bench.imagesDir, "write PNGs of the reference and every representation here");
+  cmd->add_option("--shadow-map", so->bench.raster.shadowMapSize, "shadow map texels per side")->check(CLI::Range(16, 8192));
+  addJsonOption(cmd, so->json);
+  cmd->add_option("--chart", so->chart, "write an SVG chart of PSNR against ms per view here");
+  cmd->callback([=] {
+    bench::SceneBenchOptions& o = so->bench;
+    o.width = so->size[0];
+    o.height = so->size[1];
+    bench::checkSceneBenchOptions(o);  // before loading a large scene
+    o.scene = st->scene.load();
+    o.t = st->scene.t;
+    o.grid = st->grid.resolve(o.scene);
+    o.updater = st->updater(st->scene.environment.load());
+    o.context = st->gpu.context();
+    o.command = commandLine();
+    o.progress = progressLine;
+    const bench::SceneBenchResult r = bench::runSceneBench(o);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
   });
 }
 
@@ -369,6 +414,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchCodec(bench);
   addBenchUpdate(bench);
   addBenchRaster(bench);
+  addBenchScene(bench);
   addBenchPipeline(bench);
   addBenchEnvironment(bench);
   addBenchStability(bench);
