@@ -148,6 +148,8 @@ void addBenchRaster(CLI::App* bench) {
   raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));
   raster->add_option("--repeats", ro->bench.repeats, "timed renders per case (median)")->check(CLI::Range(1, 1000));
   addReferenceSppOption(raster, ro->bench.referenceSpp, 1u << 20);
+  raster->add_option("--reference-cache", ro->bench.referenceCache,
+                     "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
   raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
       ->check(CLI::Range(16, 8192));
   addJsonOption(raster, ro->json);
@@ -197,6 +199,7 @@ void addBenchScene(CLI::App* bench) {
   cmd->add_option("--reference-cache", so->bench.referenceCache,
                   "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
   cmd->add_option("--images", so->bench.imagesDir, "write PNGs of the reference and every representation here");
+  cmd->add_option("--exposure", so->bench.exposure, "scale applied to the PNGs only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_option("--shadow-map", so->bench.raster.shadowMapSize, "shadow map texels per side")->check(CLI::Range(16, 8192));
   addJsonOption(cmd, so->json);
   cmd->add_option("--chart", so->chart, "write an SVG chart of PSNR against ms per view here");

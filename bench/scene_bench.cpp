@@ -29,9 +29,9 @@ nlohmann::json dbJson(double db) { return std::isfinite(db) ? nlohmann::json(db)
 // and minutes on a fast GPU; past it the request is surely a typo.
 constexpr double kMaxReferenceSamples = 1e11;
 
-void writePng(const std::string& path, const renderer::Image& image) {
+void writePng(const std::string& path, const renderer::Image& image, float exposure) {
   std::string error;
-  if (!imaging::writePngPreview(path, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), 1.0f,
+  if (!imaging::writePngPreview(path, image.rgb, static_cast<int>(image.width), static_cast<int>(image.height), exposure,
                                 error))
     throw std::runtime_error(error);
 }
@@ -112,7 +112,7 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
   if (!o.imagesDir.empty()) {
     std::filesystem::create_directories(o.imagesDir);
     for (size_t v = 0; v < views.size(); ++v)
-      writePng(fmt::format("{}/reference_v{:02}.png", o.imagesDir, v), refs[v].mean);
+      writePng(fmt::format("{}/reference_v{:02}.png", o.imagesDir, v), refs[v].mean, o.exposure);
   }
 
   nlohmann::json json;
@@ -198,7 +198,15 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
                          {"psnr_vs_float_db", dbJson(c.vsFloat.psnrDb)},
                          {"ssim_vs_float", c.vsFloat.ssim},
                          {"floor_psnr_db", dbJson(refs[v].floor.psnrDb)}});
-      if (!o.imagesDir.empty()) writePng(fmt::format("{}/{}_v{:02}.png", o.imagesDir, run.name, v), images[v]);
+      if (!o.imagesDir.empty()) {
+        writePng(fmt::format("{}/{}_v{:02}.png", o.imagesDir, run.name, v), images[v], o.exposure);
+        // Luminance difference after gamma against the reference, 0.1 shown as full red.
+        std::string diffError;
+        if (!imaging::writeDifferencePng(fmt::format("{}/{}_v{:02}_difference.png", o.imagesDir, run.name, v),
+                                         images[v].rgb, refs[v].mean.rgb, static_cast<int>(o.width),
+                                         static_cast<int>(o.height), 0.1, diffError))
+          throw std::runtime_error(diffError);
+      }
     }
     json["representations"].push_back({{"representation", run.name},
                                        {"record_bytes", run.viaCodec ? recordSize(run.repr) : kProbeFloats * 4},

@@ -30,6 +30,7 @@ struct SceneBenchOptions {
   uint32_t referenceSeed = 1;
   std::string referenceCache;        // empty: defaultReferenceCacheDir()
   std::string imagesDir;             // empty: no PNGs
+  float exposure = 1.0f;             // scale of the PNGs only (filmic tone map)
   std::string command;
   std::function<void(const std::string&)> progress;
 };
