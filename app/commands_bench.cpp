@@ -131,6 +131,26 @@ void addBenchUpdate(CLI::App* bench) {
   });
 }
 
+// What `bench raster` and `bench scene` share: the view size, probe updates, timed repeats, the
+// reference (samples, cache folder) and the shadow maps.
+struct RenderBenchCli {
+  std::vector<uint32_t>* size;
+  uint32_t* updates;
+  uint32_t* repeats;
+  uint32_t* referenceSpp;
+  std::string* referenceCache;
+  uint32_t* shadowMap;
+  void add(CLI::App* cmd, const std::string& updatesWhat, const std::string& repeatsWhat) const {
+    addSizeOption(cmd, *size, "size of each view WxH", 8, 4096);
+    cmd->add_option("--updates", *updates, updatesWhat)->check(CLI::Range(1, 10000));
+    cmd->add_option("--repeats", *repeats, repeatsWhat)->check(CLI::Range(1, 1000));
+    addReferenceSppOption(cmd, *referenceSpp, 1u << 20, "samples per pixel of the reference (two halves of different seeds)");
+    cmd->add_option("--reference-cache", *referenceCache,
+                    "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
+    cmd->add_option("--shadow-map", *shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
+  }
+};
+
 // `probecast bench raster`: raster client speed and accuracy.
 void addBenchRaster(CLI::App* bench) {
   CLI::App* raster = bench->add_subcommand("raster", "raster client: ms per view for 1..48 views, PSNR/SSIM per representation");
@@ -144,14 +164,9 @@ void addBenchRaster(CLI::App* bench) {
   rt->add(raster);
   raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM, lfh:NxM), comma-separated")
       ->delimiter(',');
-  addSizeOption(raster, ro->size, "size of each view WxH", 8, 4096);
-  raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));
-  raster->add_option("--repeats", ro->bench.repeats, "timed renders per case (median)")->check(CLI::Range(1, 1000));
-  addReferenceSppOption(raster, ro->bench.referenceSpp, 1u << 20);
-  raster->add_option("--reference-cache", ro->bench.referenceCache,
-                     "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
-  raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
-      ->check(CLI::Range(16, 8192));
+  RenderBenchCli{&ro->size, &ro->bench.updates, &ro->bench.repeats, &ro->bench.referenceSpp, &ro->bench.referenceCache,
+                 &ro->bench.raster.shadowMapSize}
+      .add(raster, "probe updates before rendering", "timed renders per case (median)");
   addJsonOption(raster, ro->json);
   raster->add_option("--chart", ro->chart, "write an SVG chart of PSNR against ms here (and *_views.svg)");
   raster->callback([=] {
@@ -188,19 +203,14 @@ void addBenchScene(CLI::App* bench) {
   auto so = std::make_shared<SceneCli>();
   st->add(cmd);
   cmd->add_option("--views", so->bench.views, "mono, stereo or lf:NxM");
-  addSizeOption(cmd, so->size, "size of each view WxH", 8, 4096);
-  cmd->add_option("--updates", so->bench.updates, "probe updates (each timed)")->check(CLI::Range(1, 10000));
-  cmd->add_option("--repeats", so->bench.repeats, "timed renders of the view set per representation (median)")
-      ->check(CLI::Range(1, 1000));
-  addReferenceSppOption(cmd, so->bench.referenceSpp, 1u << 20, "samples per pixel of each reference (two halves)");
+  RenderBenchCli{&so->size, &so->bench.updates, &so->bench.repeats, &so->bench.referenceSpp, &so->bench.referenceCache,
+                 &so->bench.raster.shadowMapSize}
+      .add(cmd, "probe updates (each timed)", "timed renders of the view set per representation (median)");
   cmd->add_option("--reference-bounces", so->bench.referenceBounces, "surface interactions per reference path")
       ->check(CLI::Range(1, 16));
   cmd->add_option("--reference-seed", so->bench.referenceSeed, "seed of the first half-reference");
-  cmd->add_option("--reference-cache", so->bench.referenceCache,
-                  "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
   cmd->add_option("--images", so->bench.imagesDir, "write PNGs of the reference and every representation here");
   cmd->add_option("--exposure", so->bench.exposure, "scale applied to the PNGs only")->check(CLI::Range(1e-6f, 1e6f));
-  cmd->add_option("--shadow-map", so->bench.raster.shadowMapSize, "shadow map texels per side")->check(CLI::Range(16, 8192));
   addJsonOption(cmd, so->json);
   cmd->add_option("--chart", so->chart, "write an SVG chart of PSNR against ms per view here");
   cmd->callback([=] {
