@@ -243,6 +243,8 @@ void addBenchPipeline(CLI::App* bench) {
   pt->add(pipeline, false);
   addSizeOption(pipeline, po->size, "image size WxH", 8, 4096);
   addReferenceSppOption(pipeline, po->bench.referenceSpp, 1u << 20);
+  pipeline->add_option("--reference-cache", po->bench.referenceCache,
+                       "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
   pipeline->add_option("--spps", po->bench.spps, "samples per probe to try")->delimiter(',')->check(CLI::Range(1, 1 << 16));
   pipeline->add_option("--bounces", po->bench.bounces, "bounce limits to try")->delimiter(',')->check(CLI::Range(1, 16));
   pipeline->add_option("--deadzones", po->bench.deadzones, "dead-zones to try")->delimiter(',')->check(CLI::Range(0, 127));
