@@ -158,53 +158,71 @@ ReferenceCache::ReferenceCache(renderer::VulkanContext& context, std::string dir
   if (dir_.empty()) dir_ = defaultReferenceCacheDir();
 }
 
-bool ReferenceCache::load(const nlohmann::json& key, const std::string& stem, Reference& out, std::string& why) const {
-  const std::string base = dir_ + "/" + stem;
-  std::ifstream in(base + ".json");
-  if (!in) {
+namespace {
+
+std::string halfName(int k) { return k == 0 ? "a" : "b"; }
+
+nlohmann::json readJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return nlohmann::json(nlohmann::json::value_t::discarded);
+  std::stringstream text;
+  text << in.rdbuf();
+  return nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+}
+
+// Writes `text` under a temporary name, then renames it into place: a reader sees all or nothing.
+void writeFileAtomically(const std::string& path, const std::string& text) {
+  {
+    std::ofstream out(path + ".tmp");
+    out << text;
+    if (!out) throw std::runtime_error("reference cache: cannot write " + path + ".tmp");
+  }
+  std::error_code ec;
+  std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
+}
+
+}  // namespace
+
+bool ReferenceCache::loadHalf(const nlohmann::json& key, const std::string& stem, int k, uint32_t seed, uint32_t spp,
+                              renderer::Image& out, double& seconds, std::string& why) const {
+  const std::string base = dir_ + "/" + stem + "." + halfName(k);
+  if (!std::filesystem::exists(base + ".json")) {
     why = "absent";
     return false;
   }
-  std::stringstream text;
-  text << in.rdbuf();
-  const nlohmann::json entry = nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  const nlohmann::json entry = readJsonFile(base + ".json");
   if (entry.is_discarded() || !entry.is_object()) {
     why = base + ".json is not valid JSON";
     return false;
   }
-  if (!entry.contains("key") || entry["key"].dump() != key.dump()) {
+  if (!entry.contains("key") || entry["key"].dump() != key.dump() || entry.value("seed", 0u) != seed ||
+      entry.value("spp", 0u) != spp) {
     why = base + ".json holds another key";
     return false;
   }
   const auto w = static_cast<int>(key["size"][0].get<uint32_t>()), h = static_cast<int>(key["size"][1].get<uint32_t>());
-  renderer::Image* halves[2] = {&out.halfA, &out.halfB};
-  const char* names[2] = {"a", "b"};
-  for (int k = 0; k < 2; ++k) {
-    const std::string path = base + "." + names[k] + ".exr";
-    int iw = 0, ih = 0;
-    std::string error;
-    if (!imaging::readExr(path, halves[k]->rgb, iw, ih, error)) {
-      why = error;
-      return false;
-    }
-    if (iw != w || ih != h) {
-      why = fmt::format("{} is {}x{}, the key says {}x{}", path, iw, ih, w, h);
-      return false;
-    }
-    if (imaging::findNonFinitePixels(halves[k]->rgb).count > 0) {
-      why = path + " holds non-finite pixels";
-      return false;
-    }
-    const auto pixels = entry.find("pixels");
-    if (pixels == entry.end() || !pixels->is_array() || pixels->size() != 2 || !(*pixels)[k].is_string() ||
-        (*pixels)[k].get<std::string>() != pixelHash(halves[k]->rgb)) {
-      why = path + " does not match the pixel hash in its JSON";
-      return false;
-    }
-    halves[k]->width = static_cast<uint32_t>(w);
-    halves[k]->height = static_cast<uint32_t>(h);
+  int iw = 0, ih = 0;
+  std::string error;
+  if (!imaging::readExr(base + ".exr", out.rgb, iw, ih, error)) {
+    why = error;
+    return false;
   }
-  out.seconds = entry.value("seconds", 0.0);
+  if (iw != w || ih != h) {
+    why = fmt::format("{}.exr is {}x{}, the key says {}x{}", base, iw, ih, w, h);
+    return false;
+  }
+  if (imaging::findNonFinitePixels(out.rgb).count > 0) {
+    why = base + ".exr holds non-finite pixels";
+    return false;
+  }
+  if (!entry.contains("pixels") || !entry["pixels"].is_string() || entry["pixels"].get<std::string>() != pixelHash(out.rgb)) {
+    why = base + ".exr does not match the pixel hash in its JSON";
+    return false;
+  }
+  out.width = static_cast<uint32_t>(w);
+  out.height = static_cast<uint32_t>(h);
+  seconds = entry.value("seconds", 0.0);
   return true;
 }
 
@@ -219,71 +237,87 @@ Reference ReferenceCache::get(const scene::Scene& scene, const ReferenceRequest&
   const auto say = [&](const std::string& s) {
     if (progress_) progress_(s);
   };
-  std::string why;
-  if (load(key, ref.key, ref, why)) {
-    ref.fromCache = true;
-    say(fmt::format("reference {}: from the cache ({} spp, {}x{})", ref.key, ro.samplesPerPixel, ro.width, ro.height));
-  } else {
-    if (why != "absent") say(fmt::format("reference {}: cache entry unusable ({}); rendering it again", ref.key, why));
+  const uint32_t half = (ro.samplesPerPixel + 1) / 2;
+  const uint32_t seeds[2] = {ro.seed, ro.seed + kSecondSeedOffset};
+  renderer::Image* halves[2] = {&ref.halfA, &ref.halfB};
+  const std::string base = dir_ + "/" + ref.key;
+  nlohmann::json pixels = nlohmann::json::array();
+  int loaded = 0;
+  // Each half is stored on its own as soon as it is traced, so an interrupted run keeps what it finished.
+  for (int k = 0; k < 2; ++k) {
+    std::string why;
+    double seconds = 0.0;
+    if (loadHalf(key, ref.key, k, seeds[k], half, *halves[k], seconds, why)) {
+      ++loaded;
+      ref.seconds += seconds;
+      pixels.push_back(pixelHash(halves[k]->rgb));
+      continue;
+    }
+    if (why != "absent")
+      say(fmt::format("reference {}: half {} unusable ({}); rendering it again", ref.key, halfName(k), why));
     std::error_code ec;
     std::filesystem::create_directories(dir_, ec);
     if (ec) throw std::runtime_error("--reference-cache " + dir_ + ": " + ec.message());
-    const uint32_t half = (ro.samplesPerPixel + 1) / 2;
-    const uint32_t seeds[2] = {ro.seed, ro.seed + kSecondSeedOffset};
-    const char* names[2] = {"a", "b"};
-    renderer::Image* halves[2] = {&ref.halfA, &ref.halfB};
-    const std::string base = dir_ + "/" + ref.key;
-    nlohmann::json pixels = nlohmann::json::array();
+    renderer::ReferenceOptions o = ro;
+    o.samplesPerPixel = half;
+    o.seed = seeds[k];
+    int lastPercent = -1;
     const auto t0 = std::chrono::steady_clock::now();
-    for (int k = 0; k < 2; ++k) {
-      renderer::ReferenceOptions o = ro;
-      o.samplesPerPixel = half;
-      o.seed = seeds[k];
-      int lastPercent = -1;
-      o.progress = [&](uint32_t done, uint32_t total) {
-        const int percent = static_cast<int>(100.0 * done / total);
-        if (percent / 10 == lastPercent / 10 && done != total) return;
-        lastPercent = percent;
-        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        say(fmt::format("reference {}: half {} of 2, {}/{} spp ({}%), {}x{}, {:.0f} s", ref.key, k + 1, done, total,
-                        percent, ro.width, ro.height, s));
-      };
-      renderer::ReferenceStats stats;
-      const renderer::Image image = renderer::renderReference(context_, scene, request.camera, o, &stats);
-      ++renders_;
-      if (stats.droppedSamples > 0)
-        say(fmt::format("reference {}: {} non-finite samples dropped", ref.key, stats.droppedSamples));
-      // Written, then read back: what is returned is exactly what a later run will load.
-      const std::string path = base + "." + names[k] + ".exr";
-      std::string error;
-      int w = 0, h = 0;
-      if (!imaging::writeExr(path + ".tmp", image.rgb, static_cast<int>(image.width), static_cast<int>(image.height),
-                             error) ||
-          !imaging::readExr(path + ".tmp", halves[k]->rgb, w, h, error))
-        throw std::runtime_error("reference cache: " + error);
-      std::filesystem::rename(path + ".tmp", path, ec);
-      if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
-      halves[k]->width = image.width;
-      halves[k]->height = image.height;
-      pixels.push_back(pixelHash(halves[k]->rgb));
-    }
-    ref.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    // The JSON goes last: an entry without one (an interrupted render) is simply absent.
-    const nlohmann::json entry = {{"key", key},
-                                  {"spp", half * 2},
-                                  {"spp_per_half", half},
-                                  {"seeds", {seeds[0], seeds[1]}},
-                                  {"seconds", ref.seconds},
-                                  {"device", context_.deviceName()},
-                                  {"pixels", pixels}};
-    {
-      std::ofstream out(base + ".json.tmp");
-      out << entry.dump(2) << "\n";
-      if (!out) throw std::runtime_error("reference cache: cannot write " + base + ".json.tmp");
-    }
-    std::filesystem::rename(base + ".json.tmp", base + ".json", ec);
-    if (ec) throw std::runtime_error("reference cache: " + base + ".json: " + ec.message());
-    say(fmt::format("reference {}: rendered in {:.1f} s, stored in {}", ref.key, ref.seconds, dir_));
+    o.progress = [&](uint32_t done, uint32_t total) {
+      const int percent = static_cast<int>(100.0 * done / total);
+      if (percent / 10 == lastPercent / 10 && done != total) return;
+      lastPercent = percent;
+      const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      say(fmt::format("reference {}: half {} of 2, {}/{} spp ({}%), {}x{}, {:.0f} s", ref.key, k + 1, done, total,
+                      percent, ro.width, ro.height, sec));
+    };
+    renderer::ReferenceStats stats;
+    const renderer::Image image = renderer::renderReference(context_, scene, request.camera, o, &stats);
+    ++renders_;
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (stats.droppedSamples > 0)
+      say(fmt::format("reference {}: {} non-finite samples dropped", ref.key, stats.droppedSamples));
+    // Written, then read back: what is returned is exactly what a later run will load.
+    const std::string path = base + "." + halfName(k) + ".exr";
+    std::string error;
+    int w = 0, h = 0;
+    if (!imaging::writeExr(path + ".tmp", image.rgb, static_cast<int>(image.width), static_cast<int>(image.height),
+                           error) ||
+        !imaging::readExr(path + ".tmp", halves[k]->rgb, w, h, error))
+      throw std::runtime_error("reference cache: " + error);
+    std::filesystem::rename(path + ".tmp", path, ec);
+    if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
+    halves[k]->width = image.width;
+    halves[k]->height = image.height;
+    pixels.push_back(pixelHash(halves[k]->rgb));
+    ref.seconds += seconds;
+    // The half's JSON goes last: an image without one (an interrupted write) is simply absent.
+    writeFileAtomically(base + "." + halfName(k) + ".json",
+                        nlohmann::json{{"key", key},
+                                       {"half", halfName(k)},
+                                       {"seed", seeds[k]},
+                                       {"spp", half},
+                                       {"seconds", seconds},
+                                       {"device", context_.deviceName()},
+                                       {"pixels", pixels.back()}}
+                                .dump(2) +
+                            "\n");
+  }
+  ref.fromCache = loaded == 2;
+  if (ref.fromCache) {
+    say(fmt::format("reference {}: from the cache ({} spp, {}x{})", ref.key, ro.samplesPerPixel, ro.width, ro.height));
+  } else {
+    // The summary of the whole entry, for people and scripts (loading checks each half's own JSON).
+    writeFileAtomically(base + ".json", nlohmann::json{{"key", key},
+                                                       {"spp", half * 2},
+                                                       {"spp_per_half", half},
+                                                       {"seeds", {seeds[0], seeds[1]}},
+                                                       {"seconds", ref.seconds},
+                                                       {"pixels", pixels}}
+                                                .dump(2) +
+                                            "\n");
+    say(fmt::format("reference {}: {} half-reference(s) rendered, {:.1f} s in all, stored in {}", ref.key,
+                    2 - loaded, ref.seconds, dir_));
   }
   ref.mean.width = ref.halfA.width;
   ref.mean.height = ref.halfA.height;

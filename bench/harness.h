@@ -12,12 +12,14 @@
 // 6 dB relation holds to first order.)
 //
 // Cache entries live in a directory (default $XDG_CACHE_HOME/probecast/references, else
-// ~/.cache/probecast/references) as KEY.json + KEY.a.exr + KEY.b.exr. KEY is a hash of everything
+// ~/.cache/probecast/references) as KEY.json (a summary: key, spp, seconds) and per half KEY.a.exr +
+// KEY.a.json, KEY.b.exr + KEY.b.json, each half stored as soon as it is traced (an interrupted run
+// keeps the half it finished). KEY is a hash of everything
 // that changes the picture: the scene's loaded content (geometry, materials, textures, lights,
 // cameras), the animation time, the camera, size, samples, seed, bounces, the environment's
-// pixels (intensity applied) and rotation, and kReferenceRendererVersion. The JSON repeats the key
-// in full and the hashes of both images' pixels, so a stale, mismatched or damaged entry is found
-// and rendered again, never used.
+// pixels (intensity applied) and rotation, and kReferenceRendererVersion. Each half's JSON repeats
+// the key in full, its seed and samples, and the hash of its image's pixels, so a stale, mismatched
+// or damaged half is found and rendered again, never used.
 #pragma once
 
 #include <cstdint>
@@ -71,12 +73,13 @@ class ReferenceCache {
   // The cached reference, or a new one rendered and stored. Throws std::runtime_error when the
   // directory cannot be written, or the request is unusable (fewer than 2 samples per pixel).
   Reference get(const scene::Scene& scene, const ReferenceRequest& request);
-  // Half-references traced by this cache so far (two per reference rendered).
+  // Half-references traced by this cache so far (two per reference rendered from nothing).
   uint32_t renders() const { return renders_; }
   const std::string& dir() const { return dir_; }
 
  private:
-  bool load(const nlohmann::json& key, const std::string& stem, Reference& out, std::string& why) const;
+  bool loadHalf(const nlohmann::json& key, const std::string& stem, int k, uint32_t seed, uint32_t spp,
+                renderer::Image& out, double& seconds, std::string& why) const;
   renderer::VulkanContext& context_;
   std::string dir_;
   std::function<void(const std::string&)> progress_;

@@ -40,7 +40,8 @@ TEST_F(ReferenceCacheTest, SecondRequestRendersNothingAndReturnsTheSamePixels) {
   const Reference first = cache.get(scene_, request_);
   EXPECT_EQ(cache.renders(), 2u);  // two half-references
   EXPECT_FALSE(first.fromCache);
-  EXPECT_TRUE(fs::exists(dir_ / (first.key + ".json")));
+  for (const char* f : {".json", ".a.json", ".a.exr", ".b.json", ".b.exr"})
+    EXPECT_TRUE(fs::exists(dir_ / (first.key + f))) << f;
 
   ReferenceCache again(context_, dir_.string());  // a later run: nothing shared but the folder
   const Reference second = again.get(scene_, request_);
@@ -92,15 +93,15 @@ TEST_F(ReferenceCacheTest, ChangedKeyRendersAnew) {
   EXPECT_EQ(cache.renders(), expected + 2);
 }
 
-TEST_F(ReferenceCacheTest, DamagedEntriesAreRenderedAgain) {
+TEST_F(ReferenceCacheTest, DamagedHalvesAreRenderedAgain) {
   ReferenceCache cache(context_, dir_.string());
   const Reference good = cache.get(scene_, request_);
-  const fs::path exr = dir_ / (good.key + ".a.exr"), json = dir_ / (good.key + ".json");
+  const fs::path exr = dir_ / (good.key + ".a.exr"), json = dir_ / (good.key + ".a.json");
 
-  // A truncated image.
+  // A truncated image: that half alone is traced again.
   fs::resize_file(exr, fs::file_size(exr) / 2);
   Reference r = cache.get(scene_, request_);
-  EXPECT_EQ(cache.renders(), 4u);
+  EXPECT_EQ(cache.renders(), 3u);
   EXPECT_FALSE(r.fromCache);
   EXPECT_EQ(r.halfA.rgb, good.halfA.rgb);  // the same seed renders the same pixels
 
@@ -109,7 +110,7 @@ TEST_F(ReferenceCacheTest, DamagedEntriesAreRenderedAgain) {
   std::string error;
   ASSERT_TRUE(imaging::writeExr(exr.string(), other, 12, 8, error)) << error;
   r = cache.get(scene_, request_);
-  EXPECT_EQ(cache.renders(), 6u);
+  EXPECT_EQ(cache.renders(), 4u);
   EXPECT_EQ(r.halfA.rgb, good.halfA.rgb);
 
   // A JSON that holds another key (written for other settings), then one that is not JSON.
@@ -119,13 +120,25 @@ TEST_F(ReferenceCacheTest, DamagedEntriesAreRenderedAgain) {
   entry["key"]["spp"] = 4096;
   std::ofstream(json) << entry.dump();
   r = cache.get(scene_, request_);
-  EXPECT_EQ(cache.renders(), 8u);
+  EXPECT_EQ(cache.renders(), 5u);
   std::ofstream(json) << "{ not json";
   r = cache.get(scene_, request_);
-  EXPECT_EQ(cache.renders(), 10u);
+  EXPECT_EQ(cache.renders(), 6u);
   EXPECT_EQ(r.mean.rgb, good.mean.rgb);
   cache.get(scene_, request_);
-  EXPECT_EQ(cache.renders(), 10u);  // repaired: a hit again
+  EXPECT_EQ(cache.renders(), 6u);  // repaired: a hit again
+}
+
+TEST_F(ReferenceCacheTest, InterruptedRenderKeepsItsFinishedHalf) {
+  ReferenceCache cache(context_, dir_.string());
+  const Reference whole = cache.get(scene_, request_);
+  // As if the run had stopped while tracing the second half: its files and the summary missing.
+  for (const char* f : {".b.exr", ".b.json", ".json"}) fs::remove(dir_ / (whole.key + f));
+  ReferenceCache later(context_, dir_.string());
+  const Reference resumed = later.get(scene_, request_);
+  EXPECT_EQ(later.renders(), 1u);
+  EXPECT_EQ(resumed.mean.rgb, whole.mean.rgb);
+  EXPECT_TRUE(fs::exists(dir_ / (whole.key + ".json")));
 }
 
 TEST_F(ReferenceCacheTest, NoiseFloorFromTwoSeeds) {
