@@ -316,7 +316,7 @@ Reference ReferenceCache::get(const scene::Scene& scene, const ReferenceRequest&
                                                        {"pixels", pixels}}
                                                 .dump(2) +
                                             "\n");
-    say(fmt::format("reference {}: {} half-reference(s) rendered, {:.1f} s in all, stored in {}", ref.key,
+    say(fmt::format("reference {}: {} of 2 halves rendered, {:.1f} s in all, stored in {}", ref.key,
                     2 - loaded, ref.seconds, dir_));
   }
   ref.mean.width = ref.halfA.width;
