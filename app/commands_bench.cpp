@@ -1,4 +1,4 @@
-// `probecast bench codec|update|raster|pipeline|environment|stability|stream|edge|adaptive`.
+// `probecast bench codec|update|raster|scene|pipeline|environment|stability|stream|edge|adaptive`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -15,6 +15,7 @@
 #include "scene_options.h"
 #include "pipeline_bench.h"
 #include "raster_bench.h"
+#include "scene_bench.h"
 #include "stability.h"
 #include "stream_bench.h"
 #include "update_bench.h"
@@ -130,6 +131,26 @@ void addBenchUpdate(CLI::App* bench) {
   });
 }
 
+// What `bench raster` and `bench scene` share: the view size, probe updates, timed repeats, the
+// reference (samples, cache folder) and the shadow maps.
+struct RenderBenchCli {
+  std::vector<uint32_t>* size;
+  uint32_t* updates;
+  uint32_t* repeats;
+  uint32_t* referenceSpp;
+  std::string* referenceCache;
+  uint32_t* shadowMap;
+  void add(CLI::App* cmd, const std::string& updatesWhat, const std::string& repeatsWhat) const {
+    addSizeOption(cmd, *size, "size of each view WxH", 8, 4096);
+    cmd->add_option("--updates", *updates, updatesWhat)->check(CLI::Range(1, 10000));
+    cmd->add_option("--repeats", *repeats, repeatsWhat)->check(CLI::Range(1, 1000));
+    addReferenceSppOption(cmd, *referenceSpp, 1u << 20, "samples per pixel of the reference (two halves of different seeds)");
+    cmd->add_option("--reference-cache", *referenceCache,
+                    "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
+    cmd->add_option("--shadow-map", *shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
+  }
+};
+
 // `probecast bench raster`: raster client speed and accuracy.
 void addBenchRaster(CLI::App* bench) {
   CLI::App* raster = bench->add_subcommand("raster", "raster client: ms per view for 1..48 views, PSNR/SSIM per representation");
@@ -144,12 +165,9 @@ void addBenchRaster(CLI::App* bench) {
   rt->add(raster);
   raster->add_option("--views", ro->bench.viewSets, "view sets to time (mono, stereo, lf:NxM, lfh:NxM), comma-separated")
       ->delimiter(',');
-  addSizeOption(raster, ro->size, "size of each view WxH", 8, 4096);
-  raster->add_option("--updates", ro->bench.updates, "probe updates before rendering")->check(CLI::Range(1, 10000));
-  raster->add_option("--repeats", ro->bench.repeats, "timed renders per case (median)")->check(CLI::Range(1, 1000));
-  addReferenceSppOption(raster, ro->bench.referenceSpp, 1u << 20);
-  raster->add_option("--shadow-map", ro->bench.raster.shadowMapSize, "shadow map texels per side")
-      ->check(CLI::Range(16, 8192));
+  RenderBenchCli{&ro->size, &ro->bench.updates, &ro->bench.repeats, &ro->bench.referenceSpp, &ro->bench.referenceCache,
+                 &ro->bench.raster.shadowMapSize}
+      .add(raster, "probe updates before rendering", "timed renders per case (median)");
   addShadowCascadesOption(raster, ro->bench.raster.shadowCascades);
   addVisibilityOption(raster, ro->bench.raster.visibility);
   ro->areaLights.add(raster);
@@ -177,6 +195,46 @@ void addBenchRaster(CLI::App* bench) {
   });
 }
 
+// `probecast bench scene`: the seeds' table for one scene against cached references.
+void addBenchScene(CLI::App* bench) {
+  CLI::App* cmd = bench->add_subcommand(
+      "scene", "one scene: update ms, raster ms per view, PSNR/SSIM per representation against a cached reference");
+  auto st = std::make_shared<TracingOptions>();
+  struct SceneCli {
+    std::string json, chart;
+    std::vector<uint32_t> size{160, 100};
+    bench::SceneBenchOptions bench;
+  };
+  auto so = std::make_shared<SceneCli>();
+  st->add(cmd);
+  cmd->add_option("--views", so->bench.views, "mono, stereo or lf:NxM");
+  RenderBenchCli{&so->size, &so->bench.updates, &so->bench.repeats, &so->bench.referenceSpp, &so->bench.referenceCache,
+                 &so->bench.raster.shadowMapSize}
+      .add(cmd, "probe updates (each timed)", "timed renders of the view set per representation (median)");
+  cmd->add_option("--reference-bounces", so->bench.referenceBounces, "surface interactions per reference path")
+      ->check(CLI::Range(1, 16));
+  cmd->add_option("--reference-seed", so->bench.referenceSeed, "seed of the first half-reference");
+  cmd->add_option("--images", so->bench.imagesDir, "write PNGs of the reference and every representation here");
+  cmd->add_option("--exposure", so->bench.exposure, "scale applied to the PNGs only")->check(CLI::Range(1e-6f, 1e6f));
+  addJsonOption(cmd, so->json);
+  cmd->add_option("--chart", so->chart, "write an SVG chart of PSNR against ms per view here");
+  cmd->callback([=] {
+    bench::SceneBenchOptions& o = so->bench;
+    o.width = so->size[0];
+    o.height = so->size[1];
+    bench::checkSceneBenchOptions(o);  // before loading a large scene
+    o.scene = st->scene.load();
+    o.t = st->scene.t;
+    o.grid = st->grid.resolve(o.scene);
+    o.updater = st->updater(st->scene.environment.load());
+    o.context = st->gpu.context();
+    o.command = commandLine();
+    o.progress = progressLine;
+    const bench::SceneBenchResult r = bench::runSceneBench(o);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
+  });
+}
+
 // `probecast bench pipeline`: PSNR against wire bytes, update time, representation.
 void addBenchPipeline(CLI::App* bench) {
   CLI::App* pipeline = bench->add_subcommand("pipeline", "PSNR against wire bytes, update time and representation");
@@ -190,6 +248,8 @@ void addBenchPipeline(CLI::App* bench) {
   pt->add(pipeline, false);
   addSizeOption(pipeline, po->size, "image size WxH", 8, 4096);
   addReferenceSppOption(pipeline, po->bench.referenceSpp, 1u << 20);
+  pipeline->add_option("--reference-cache", po->bench.referenceCache,
+                       "folder of cached references (default $XDG_CACHE_HOME/probecast/references or ~/.cache/...)");
   pipeline->add_option("--spps", po->bench.spps, "samples per probe to try")->delimiter(',')->check(CLI::Range(1, 1 << 16));
   pipeline->add_option("--bounces", po->bench.bounces, "bounce limits to try")->delimiter(',')->check(CLI::Range(1, 16));
   pipeline->add_option("--deadzones", po->bench.deadzones, "dead-zones to try")->delimiter(',')->check(CLI::Range(0, 127));
@@ -374,6 +434,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchCodec(bench);
   addBenchUpdate(bench);
   addBenchRaster(bench);
+  addBenchScene(bench);
   addBenchPipeline(bench);
   addBenchEnvironment(bench);
   addBenchStability(bench);

@@ -35,6 +35,7 @@ std::string runSuites(const DemoOptions& o, const std::string& dir, const scene:
   po.height = 80;
   po.referenceSpp = 2 * o.referenceSpp;
   po.environment = o.sky;
+  po.referenceCache = dir + "/references";  // beside the report: the demo leaves nothing elsewhere
   po.spps = {32, 128};
   po.bounces = {1, 4};
   po.deadzones = {0, 4, 16};

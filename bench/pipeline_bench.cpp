@@ -1,5 +1,7 @@
 #include "pipeline_bench.h"
 
+#include "harness.h"
+
 #include <algorithm>
 #include <numeric>
 
@@ -77,21 +79,23 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   renderer::VulkanContext context(o.context);
   const scene::Scene finalScene = sceneAt(o.t);
   const renderer::CameraView camera = renderer::CameraView::fromScene(finalScene);
-  renderer::ReferenceOptions ro;
-  ro.width = o.width;
-  ro.height = o.height;
-  ro.samplesPerPixel = o.referenceSpp;
-  ro.environment = o.environment;
+  ReferenceRequest request;
+  request.t = o.t;
+  request.camera = camera;
+  request.options.width = o.width;
+  request.options.height = o.height;
+  request.options.samplesPerPixel = o.referenceSpp;
+  request.options.environment = o.environment;
   say(fmt::format("pipeline bench: reference ({} spp)", o.referenceSpp));
-  const renderer::Image reference = renderer::renderReference(context, finalScene, camera, ro);
+  ReferenceCache cache(context, o.referenceCache, o.progress);
+  const Reference reference = cache.get(finalScene, request);
   renderer::RasterOptions rasterOptions;
   rasterOptions.environment = o.environment;
   renderer::RasterRenderer raster(context, finalScene, o.width, o.height, rasterOptions);
   const auto score = [&](const ProbeVolume& v, Point& p) {
     raster.setProbes(v);
     const renderer::Image img = raster.render(raster.viewProjection(camera), camera.position);
-    const imaging::ImageMetrics m =
-        imaging::compareImages(img.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    const imaging::ImageMetrics m = compareChecked(img, reference.mean, "pipeline bench");
     p.psnr = m.psnrDb;
     p.ssim = m.ssim;
   };
@@ -104,6 +108,9 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   j["size"] = {o.width, o.height};
   j["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
   j["reference_spp"] = o.referenceSpp;
+  j["reference_key"] = reference.key;
+  j["floor_psnr_db"] = reference.floor.psnrDb;
+  j["reference_psnr_db_estimate"] = reference.accuracyDb;
   j["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
   std::string& table = r.table;
   table = fmt::format("pipeline bench: {} at {}x{}, {}x{}x{} probes, on {}\n", finalScene.name, o.width, o.height,

@@ -22,6 +22,7 @@ struct PipelineBenchOptions {
   renderer::ContextOptions context;
   uint32_t width = 160, height = 100;
   uint32_t referenceSpp = 128;
+  std::string referenceCache;  // empty: defaultReferenceCacheDir() (harness.h)
   float t = 0.25f;             // where the light ends (the reference's moment)
   uint32_t streamFrames = 24;  // moving-light frames for the wire-bytes part
   double hz = 10.0;            // lighting updates per second the bytes are quoted at

@@ -1,5 +1,7 @@
 #include "raster_bench.h"
 
+#include "harness.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -68,15 +70,14 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   say(fmt::format("raster bench: {} probe updates of {} probes done", o.updates, o.grid.count()));
 
   const renderer::CameraView camera = renderer::CameraView::fromScene(o.scene);
-  renderer::ReferenceOptions ro;
-  ro.width = o.width;
-  ro.height = o.height;
-  ro.samplesPerPixel = o.referenceSpp;
-  ro.environment = o.updater.environment;  // the same light as the probes
-  ro.progress = [&](uint32_t done, uint32_t total) {
-    if (done == total || done % 64 == 0) say(fmt::format("raster bench: reference {}/{} spp", done, total));
-  };
-  const renderer::Image reference = renderer::renderReference(context, o.scene, camera, ro);
+  ReferenceRequest request;
+  request.camera = camera;
+  request.options.width = o.width;
+  request.options.height = o.height;
+  request.options.samplesPerPixel = o.referenceSpp;
+  request.options.environment = o.updater.environment;  // the same light as the probes
+  ReferenceCache cache(context, o.referenceCache, o.progress);
+  const Reference ref = cache.get(o.scene, request);
 
   nlohmann::json json;
   json["command"] = o.command;
@@ -86,12 +87,15 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
   json["probe_updates"] = o.updates;
   json["reference_spp"] = o.referenceSpp;
+  json["reference_key"] = ref.key;
+  json["floor_psnr_db"] = ref.floor.psnrDb;
+  json["reference_psnr_db_estimate"] = ref.accuracyDb;
   json["shadow_map_size"] = o.raster.shadowMapSize;
   json["shadow_cascades"] = o.raster.shadowCascades;
   json["area_lights"] = o.raster.areaLights.enabled;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
-  std::string table =
-      fmt::format("raster bench: {} at {}x{} on {}\n", o.scene.name, o.width, o.height, context.deviceName());
+  std::string table = fmt::format("raster bench: {} at {}x{} on {}; reference {} spp, {}\n", o.scene.name, o.width,
+                                  o.height, context.deviceName(), o.referenceSpp, describeFloor(ref));
 
   // Quality and mono speed per representation (float = the updater's probes without the codec).
   const std::vector<Representation> reprs = {{"float", false},
@@ -117,8 +121,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
       image = raster.render(vp, camera.position);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     }
-    const imaging::ImageMetrics m =
-        imaging::compareImages(image.rgb, reference.rgb, static_cast<int>(o.width), static_cast<int>(o.height));
+    const imaging::ImageMetrics m = compareChecked(image, ref.mean, r.name);
     const double msPerView = session::medianMidpoint(ms);
     json["representations"].push_back({{"representation", r.name},
                                        {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},

@@ -27,6 +27,7 @@ struct RasterBenchOptions {
   // Probe volumes whose update (setProbes) is timed, 4 × repeats times each.
   std::vector<glm::uvec3> uploadGrids = {{8, 8, 8}, {32, 8, 32}};
   uint32_t referenceSpp = 256;
+  std::string referenceCache;  // empty: defaultReferenceCacheDir() (harness.h)
   std::string command;
   std::function<void(const std::string&)> progress;
 };

@@ -2,7 +2,7 @@
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${PROBECAST} bench raster --scene builtin:cornell --grid 4,4,4 --spp 32 --updates 2
                         --size 32x20 --reference-spp 8 --repeats 1 --views mono,stereo,lf:2x2
-                        --json ${WORK}/raster.json --chart ${WORK}/raster.svg
+                        --reference-cache ${WORK}/cache --json ${WORK}/raster.json --chart ${WORK}/raster.svg
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "bench raster failed (${rc}): ${out} ${err}")

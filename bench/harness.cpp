@@ -1,0 +1,357 @@
+#include "harness.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "probecast/imaging/image_io.h"
+
+namespace probecast::bench {
+namespace {
+
+// FNV-1a, 64 bits: enough to tell entries apart (the JSON holds the full key, checked on load).
+class Hasher {
+ public:
+  void bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) h_ = (h_ ^ p[i]) * 0x100000001b3ull;
+  }
+  template <class T>
+  void pod(const T& v) {
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    pod(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  void str(const std::string& s) {
+    pod(s.size());
+    bytes(s.data(), s.size());
+  }
+  std::string hex() const { return fmt::format("{:016x}", h_); }
+
+ private:
+  uint64_t h_ = 0xcbf29ce484222325ull;
+};
+
+std::string pixelHash(const std::vector<float>& rgb) {
+  Hasher h;
+  h.vec(rgb);
+  return h.hex();
+}
+
+nlohmann::json vec3(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+std::string environmentHash(const renderer::Environment& env) {
+  Hasher h;
+  h.pod(env.width);
+  h.pod(env.height);
+  h.vec(env.rgb);
+  h.pod(env.rotation);
+  return h.hex();
+}
+
+}  // namespace
+
+std::string sceneContentHash(const scene::Scene& s) {
+  Hasher h;
+  h.str(s.name);
+  h.vec(s.positions);
+  h.vec(s.normals);
+  h.vec(s.texcoords);
+  h.vec(s.texcoords1);
+  h.vec(s.indices);
+  h.vec(s.triangleMaterial);
+  h.pod(s.materials.size());
+  for (const scene::Material& m : s.materials) {
+    h.str(m.name);
+    h.pod(m.baseColor);
+    h.pod(m.metallic);
+    h.pod(m.roughness);
+    h.pod(m.emission);
+    h.pod(m.baseColorTexture);
+    h.pod(m.emissiveTexture);
+    for (const scene::TextureTransform* tt : {&m.baseColorTransform, &m.emissiveTransform}) {
+      h.pod(tt->row0);
+      h.pod(tt->row1);
+      h.pod(tt->texCoord);
+    }
+    h.pod(m.alphaMode);
+    h.pod(m.alpha);
+    h.pod(m.alphaCutoff);
+    h.pod(m.transmission);
+  }
+  h.pod(s.textures.size());
+  for (const scene::Texture& t : s.textures) {
+    h.pod(t.width);
+    h.pod(t.height);
+    h.vec(t.rgba);
+  }
+  h.pod(s.lights.size());
+  for (const scene::Light& l : s.lights) {
+    h.pod(l.type);
+    h.pod(l.position);
+    h.pod(l.direction);
+    h.pod(l.color);
+    h.pod(l.intensity);
+    h.pod(l.range);
+    h.pod(l.innerConeAngle);
+    h.pod(l.outerConeAngle);
+  }
+  h.pod(s.boundsMin);
+  h.pod(s.boundsMax);
+  return h.hex();
+}
+
+nlohmann::json referenceKey(const scene::Scene& scene, const ReferenceRequest& r) {
+  const renderer::ReferenceOptions& o = r.options;
+  nlohmann::json env = nullptr;
+  if (o.environment && !o.environment->empty())
+    env = {{"name", o.environment->name},
+           {"size", {o.environment->width, o.environment->height}},
+           {"rotation", o.environment->rotation},
+           {"pixels", environmentHash(*o.environment)},
+           {"sampling", o.environmentSampling}};
+  return {{"renderer_version", kReferenceRendererVersion},
+          {"scene", scene.name},
+          {"scene_hash", sceneContentHash(scene)},
+          {"t", r.t},
+          {"camera",
+           {{"position", vec3(r.camera.position)},
+            {"forward", vec3(r.camera.forward)},
+            {"up", vec3(r.camera.up)},
+            {"yfov", r.camera.yfov},
+            {"shift", {r.camera.shift.x, r.camera.shift.y}}}},
+          {"size", {o.width, o.height}},
+          {"spp", o.samplesPerPixel},
+          {"seed", o.seed},
+          {"bounces", o.maxBounces},
+          {"indirect_clamp", o.indirectClamp},
+          {"environment", env}};
+}
+
+std::string referenceKeyStem(const nlohmann::json& key) {
+  Hasher h;
+  h.str(key.dump());
+  return h.hex();
+}
+
+std::string defaultReferenceCacheDir() {
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  if (xdg != nullptr && *xdg == '/') return std::string(xdg) + "/probecast/references";
+  const char* home = std::getenv("HOME");
+  if (home == nullptr || *home == '\0')
+    throw std::runtime_error("neither XDG_CACHE_HOME nor HOME is set: give --reference-cache DIR");
+  return std::string(home) + "/.cache/probecast/references";
+}
+
+ReferenceCache::ReferenceCache(renderer::VulkanContext& context, std::string dir,
+                               std::function<void(const std::string&)> progress)
+    : context_(context), dir_(std::move(dir)), progress_(std::move(progress)) {
+  if (dir_.empty()) dir_ = defaultReferenceCacheDir();
+}
+
+namespace {
+
+std::string halfName(int k) { return k == 0 ? "a" : "b"; }
+
+nlohmann::json readJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return nlohmann::json(nlohmann::json::value_t::discarded);
+  std::stringstream text;
+  text << in.rdbuf();
+  return nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+}
+
+// Writes `text` under a temporary name, then renames it into place: a reader sees all or nothing.
+void writeFileAtomically(const std::string& path, const std::string& text) {
+  {
+    std::ofstream out(path + ".tmp");
+    out << text;
+    if (!out) throw std::runtime_error("reference cache: cannot write " + path + ".tmp");
+  }
+  std::error_code ec;
+  std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
+}
+
+}  // namespace
+
+bool ReferenceCache::loadHalf(const nlohmann::json& key, const std::string& stem, int k, uint32_t seed, uint32_t spp,
+                              renderer::Image& out, double& seconds, std::string& why) const {
+  const std::string base = dir_ + "/" + stem + "." + halfName(k);
+  if (!std::filesystem::exists(base + ".json")) {
+    why = "absent";
+    return false;
+  }
+  const nlohmann::json entry = readJsonFile(base + ".json");
+  if (entry.is_discarded() || !entry.is_object()) {
+    why = base + ".json is not valid JSON";
+    return false;
+  }
+  if (!entry.contains("key") || entry["key"].dump() != key.dump() || entry.value("seed", 0u) != seed ||
+      entry.value("spp", 0u) != spp) {
+    why = base + ".json holds another key";
+    return false;
+  }
+  const auto w = static_cast<int>(key["size"][0].get<uint32_t>()), h = static_cast<int>(key["size"][1].get<uint32_t>());
+  int iw = 0, ih = 0;
+  std::string error;
+  if (!imaging::readExr(base + ".exr", out.rgb, iw, ih, error)) {
+    why = error;
+    return false;
+  }
+  if (iw != w || ih != h) {
+    why = fmt::format("{}.exr is {}x{}, the key says {}x{}", base, iw, ih, w, h);
+    return false;
+  }
+  if (imaging::findNonFinitePixels(out.rgb).count > 0) {
+    why = base + ".exr holds non-finite pixels";
+    return false;
+  }
+  if (!entry.contains("pixels") || !entry["pixels"].is_string() || entry["pixels"].get<std::string>() != pixelHash(out.rgb)) {
+    why = base + ".exr does not match the pixel hash in its JSON";
+    return false;
+  }
+  out.width = static_cast<uint32_t>(w);
+  out.height = static_cast<uint32_t>(h);
+  seconds = entry.value("seconds", 0.0);
+  return true;
+}
+
+Reference ReferenceCache::get(const scene::Scene& scene, const ReferenceRequest& request) {
+  const renderer::ReferenceOptions& ro = request.options;
+  if (ro.samplesPerPixel < 2)
+    throw std::runtime_error(fmt::format("a reference needs at least 2 samples per pixel (two halves), not {}",
+                                         ro.samplesPerPixel));
+  const nlohmann::json key = referenceKey(scene, request);
+  Reference ref;
+  ref.key = referenceKeyStem(key);
+  const auto say = [&](const std::string& s) {
+    if (progress_) progress_(s);
+  };
+  const uint32_t half = (ro.samplesPerPixel + 1) / 2;
+  const uint32_t seeds[2] = {ro.seed, ro.seed + kSecondSeedOffset};
+  renderer::Image* halves[2] = {&ref.halfA, &ref.halfB};
+  const std::string base = dir_ + "/" + ref.key;
+  nlohmann::json pixels = nlohmann::json::array();
+  int loaded = 0;
+  // Each half is stored on its own as soon as it is traced, so an interrupted run keeps what it finished.
+  for (int k = 0; k < 2; ++k) {
+    std::string why;
+    double seconds = 0.0;
+    if (loadHalf(key, ref.key, k, seeds[k], half, *halves[k], seconds, why)) {
+      ++loaded;
+      ref.seconds += seconds;
+      pixels.push_back(pixelHash(halves[k]->rgb));
+      continue;
+    }
+    if (why != "absent")
+      say(fmt::format("reference {}: half {} unusable ({}); rendering it again", ref.key, halfName(k), why));
+    std::error_code ec;
+    std::filesystem::create_directories(dir_, ec);
+    if (ec) throw std::runtime_error("--reference-cache " + dir_ + ": " + ec.message());
+    renderer::ReferenceOptions o = ro;
+    o.samplesPerPixel = half;
+    o.seed = seeds[k];
+    int lastPercent = -1;
+    const auto t0 = std::chrono::steady_clock::now();
+    o.progress = [&](uint32_t done, uint32_t total) {
+      const int percent = static_cast<int>(100.0 * done / total);
+      if (percent / 10 == lastPercent / 10 && done != total) return;
+      lastPercent = percent;
+      const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      say(fmt::format("reference {}: half {} of 2, {}/{} spp ({}%), {}x{}, {:.0f} s", ref.key, k + 1, done, total,
+                      percent, ro.width, ro.height, sec));
+    };
+    renderer::ReferenceStats stats;
+    const renderer::Image image = renderer::renderReference(context_, scene, request.camera, o, &stats);
+    ++renders_;
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (stats.droppedSamples > 0)
+      say(fmt::format("reference {}: {} non-finite samples dropped", ref.key, stats.droppedSamples));
+    // Written, then read back: what is returned is exactly what a later run will load.
+    const std::string path = base + "." + halfName(k) + ".exr";
+    std::string error;
+    int w = 0, h = 0;
+    if (!imaging::writeExr(path + ".tmp", image.rgb, static_cast<int>(image.width), static_cast<int>(image.height),
+                           error) ||
+        !imaging::readExr(path + ".tmp", halves[k]->rgb, w, h, error))
+      throw std::runtime_error("reference cache: " + error);
+    std::filesystem::rename(path + ".tmp", path, ec);
+    if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
+    halves[k]->width = image.width;
+    halves[k]->height = image.height;
+    pixels.push_back(pixelHash(halves[k]->rgb));
+    ref.seconds += seconds;
+    // The half's JSON goes last: an image without one (an interrupted write) is simply absent.
+    writeFileAtomically(base + "." + halfName(k) + ".json",
+                        nlohmann::json{{"key", key},
+                                       {"half", halfName(k)},
+                                       {"seed", seeds[k]},
+                                       {"spp", half},
+                                       {"seconds", seconds},
+                                       {"device", context_.deviceName()},
+                                       {"pixels", pixels.back()}}
+                                .dump(2) +
+                            "\n");
+  }
+  ref.fromCache = loaded == 2;
+  if (ref.fromCache) {
+    say(fmt::format("reference {}: from the cache ({} spp, {}x{})", ref.key, ro.samplesPerPixel, ro.width, ro.height));
+  } else {
+    // The summary of the whole entry, for people and scripts (loading checks each half's own JSON).
+    writeFileAtomically(base + ".json", nlohmann::json{{"key", key},
+                                                       {"spp", half * 2},
+                                                       {"spp_per_half", half},
+                                                       {"seeds", {seeds[0], seeds[1]}},
+                                                       {"seconds", ref.seconds},
+                                                       {"pixels", pixels}}
+                                                .dump(2) +
+                                            "\n");
+    say(fmt::format("reference {}: {} of 2 halves rendered, {:.1f} s in all, stored in {}", ref.key,
+                    2 - loaded, ref.seconds, dir_));
+  }
+  ref.mean.width = ref.halfA.width;
+  ref.mean.height = ref.halfA.height;
+  ref.mean.rgb.resize(ref.halfA.rgb.size());
+  for (size_t i = 0; i < ref.mean.rgb.size(); ++i) ref.mean.rgb[i] = 0.5f * (ref.halfA.rgb[i] + ref.halfB.rgb[i]);
+  ref.floor = imaging::compareImages(ref.halfA.rgb, ref.halfB.rgb, static_cast<int>(ref.halfA.width),
+                                     static_cast<int>(ref.halfA.height));
+  ref.accuracyDb = ref.floor.psnrDb + 10.0 * std::log10(4.0);
+  return ref;
+}
+
+imaging::ImageMetrics compareChecked(const renderer::Image& image, const renderer::Image& reference,
+                                     const std::string& what) {
+  if (image.width != reference.width || image.height != reference.height || image.rgb.size() != reference.rgb.size())
+    throw std::invalid_argument(fmt::format("{}: {}x{} against a {}x{} reference", what, image.width, image.height,
+                                            reference.width, reference.height));
+  for (const auto* rgb : {&image.rgb, &reference.rgb}) {
+    const imaging::NonFinitePixels nf = imaging::findNonFinitePixels(*rgb);
+    if (nf.count > 0)
+      throw std::invalid_argument(fmt::format("{}: {} non-finite pixels in the {} (the first at x {}, y {})", what,
+                                              nf.count, rgb == &image.rgb ? "render" : "reference",
+                                              nf.first % image.width, nf.first / image.width));
+  }
+  return imaging::compareImages(image.rgb, reference.rgb, static_cast<int>(image.width),
+                                static_cast<int>(image.height));
+}
+
+Comparison compareView(const renderer::Image& image, const Reference& reference, const renderer::Image& floatRender,
+                       const std::string& what) {
+  return {compareChecked(image, reference.mean, what), compareChecked(image, floatRender, what + " (against float probes)")};
+}
+
+std::string describeFloor(const Reference& r) {
+  return fmt::format("floor {:.2f} dB, reference ≈ {:.2f} dB", r.floor.psnrDb, r.accuracyDb);
+}
+
+}  // namespace probecast::bench
