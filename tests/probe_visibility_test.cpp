@@ -38,20 +38,22 @@ TEST(ProbeVisibility, MeanDistanceInAClosedBoxMatchesTheWallsPerDirection) {
   // distance to the walls that way, averaged over the texel's cos^50 lobe (a few % above the
   // central value on a flat wall, where 1/cos grows off-axis; below it near edges and corners,
   // where the distance peaks). 10 % everywhere, 3 % along the six axes. Then the same probe moved
-  // by an offset of (0.5, 0, 0): the cube is drawn from where the probe is, not its grid point.
+  // by an offset of (0.5, 0, 0), half its cell: the cube is drawn from where the probe is,
+  // not its grid point. The probe is the middle one of three along x (spacing 1 m).
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("closed-box");
   RasterRenderer raster(context, s, 16, 16);
-  ProbeVolume v = makeProbeVolume(ProbeGrid{{1, 1, 1}, {{-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}}});  // at the origin
-  for (const glm::vec3 probe : {glm::vec3(0.0f), glm::vec3(0.5f, 0.0f, 0.0f)}) {
-    v.offsets = {probe.x, probe.y, probe.z};
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{3, 1, 1}, {{-1.0f, -0.5f, -0.5f}, {1.0f, 0.5f, 0.5f}}});
+  for (const glm::vec3 probe : {glm::vec3(0.0f), glm::vec3(0.5f, 0.0f, 0.0f)}) {  // probe 1, at the origin
+    v.offsets.assign(9, 0.0f);
+    v.offsets[3] = probe.x;
     raster.setProbes(v);
     ASSERT_TRUE(raster.visibilityActive());
     const auto n = static_cast<int>(RasterRenderer::visibilityMapTexels());
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const glm::vec3 d = octTexelDirection(i, j, n);
-        const glm::vec2 m = raster.probeMoments(0, d);
+        const glm::vec2 m = raster.probeMoments(1, d);
         const float expected = distanceToBoxWalls(probe, d);
         EXPECT_NEAR(m.x, expected, 0.1f * expected) << "probe " << probe.x << " texel " << i << "," << j;
         EXPECT_GE(m.y, m.x * m.x * 0.999f);  // E[r²] ≥ E[r]²
@@ -59,12 +61,12 @@ TEST(ProbeVisibility, MeanDistanceInAClosedBoxMatchesTheWallsPerDirection) {
     const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     for (const glm::vec3& a : axes) {
       // The nearest texel's centre is up to half a texel off the axis: compare with the wall there.
-      const float m = raster.probeMoments(0, a).x, expected = distanceToBoxWalls(probe, a);
+      const float m = raster.probeMoments(1, a).x, expected = distanceToBoxWalls(probe, a);
       EXPECT_NEAR(m, expected, 0.03f * expected + 0.03f) << a.x << "," << a.y << "," << a.z;
     }
   }
-  EXPECT_LT(raster.probeMoments(0, {1, 0, 0}).x, 0.6f);   // 0.5 m to the +x wall from x = 0.5
-  EXPECT_GT(raster.probeMoments(0, {-1, 0, 0}).x, 1.4f);  // 1.5 m to the −x wall
+  EXPECT_LT(raster.probeMoments(1, {1, 0, 0}).x, 0.6f);   // 0.5 m to the +x wall from x = 0.5
+  EXPECT_GT(raster.probeMoments(1, {-1, 0, 0}).x, 1.4f);  // 1.5 m to the −x wall
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 

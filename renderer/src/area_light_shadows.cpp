@@ -46,8 +46,11 @@ void planAreaLights(VulkanDevice& d, const scene::Scene& scene, const scene::Are
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   out.lights = createBufferWithData(d, records.data(), records.size() * sizeof records[0], kStorage);
   out.corners = createBufferWithData(d, corners.data(), corners.size() * sizeof corners[0], kStorage);
+  // Transmissive casters are drawn into the colour layers only (drawShadowMaps), which the
+  // area-light shader does not read: glass lets an area light through untinted.
+  maps.transmissiveFirst = scene::leadingTrianglesBelowClass(scene, 2);
   const std::vector<shaders::RsShadowLight> none{{RS_SHADOW_NONE, 0, 0.0f, 1u}};
-  uploadShadowPlan(d, none, false, maps);
+  uploadShadowPlan(d, none, maps.transmissiveFirst < scene.triangleCount(), maps);
 }
 
 void destroyAreaLights(VulkanDevice& d, AreaLightBuffers& b) {
