@@ -57,14 +57,14 @@ std::vector<VisibilityCluster> clustersOf(const scene::Scene& s, uint32_t first,
   return out;
 }
 
-// Whether a box (relative to the probe) meets the reach sphere and face f's 90° pyramid (the points
-// whose coordinate on the face's axis, signed, is at least the absolute value of the other two):
-// each bounding plane of the pyramid is linear, so the box meets its side when the corner farthest
-// that way does. Generous by a hair, so that triangles on a boundary are kept.
-bool clusterInFace(const glm::vec3& lo, const glm::vec3& hi, uint32_t f, float reach) {
+// Whether a box (relative to the probe) may meet face f's 90° pyramid (the points whose coordinate
+// on the face's axis, signed, is at least the absolute value of the other two): each bounding plane
+// of the pyramid is linear, so the box meets its side when the corner farthest that way does.
+// Generous by a hair of the box's size, so that triangles on a boundary are kept.
+bool clusterInFace(const glm::vec3& lo, const glm::vec3& hi, uint32_t f) {
   const int axis = static_cast<int>(f / 2);
   const float along = f % 2 == 0 ? hi[axis] : -lo[axis];  // the farthest the box goes along the face's axis
-  const float slack = 1e-4f * reach;
+  const float slack = 1e-4f * (glm::length(hi - lo) + glm::length(hi + lo)) + 1e-6f;
   if (along <= -slack) return false;
   for (int b = 0; b < 3; ++b)
     if (b != axis && (along - lo[b] < -slack || along + hi[b] < -slack)) return false;
@@ -207,7 +207,7 @@ void faceRuns(const std::vector<VisibilityCluster>& clusters, const glm::vec3& p
               std::vector<DrawRun>& runs) {
   runs.clear();
   for (const VisibilityCluster& c : clusters) {
-    if (cull && !(clusterInReach(c.lo - probe, c.hi - probe, reach) && clusterInFace(c.lo - probe, c.hi - probe, f, reach)))
+    if (cull && !(clusterInReach(c.lo - probe, c.hi - probe, reach) && clusterInFace(c.lo - probe, c.hi - probe, f)))
       continue;
     if (!runs.empty() && runs.back().firstTriangle + runs.back().triangles == c.first)
       runs.back().triangles += c.count;
