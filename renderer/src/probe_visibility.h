@@ -6,12 +6,14 @@
 // the 8 probes around a point by a Chebyshev bound on the probability that the point is visible
 // from the probe. Made again only when the probe positions change (a new grid, new offsets).
 //
-// Each probe sees only as far as its reach (probeVisibilityReach): a surface farther than that reads
-// as an open direction, so the triangles beyond it need not be drawn. The scene's triangles are cut
-// into clusters of consecutive ones (finalizeScene orders each material class by the Morton code of
-// the centroids, so a run is a compact piece of the scene), each with its bounds; each face of each
-// cube draws only the clusters whose bounds meet both the reach sphere and the face's 90° pyramid. Cut-out (alphaMode Mask) triangles are drawn through shadow.frag, so what is
-// cut away does not block.
+// Each probe sees only as far as its reach (probeVisibilityReach): distances are clamped to it (as
+// DDGI clamps its depth), open directions included, and raster.frag tests a point beyond it as if
+// at it, so the triangles wholly beyond it change nothing and are not drawn. The scene's triangles
+// are cut into clusters of consecutive ones (finalizeScene orders each material class by the Morton
+// code of the centroids, so a run is a compact piece of the scene), each with its bounds; each face
+// of each cube draws only the clusters whose bounds meet both the reach sphere and the face's 90°
+// pyramid. Cut-out (alphaMode Mask) triangles are drawn through shadow.frag, so what is cut away
+// does not block.
 #pragma once
 
 #include <cstdint>

@@ -51,8 +51,8 @@ struct RasterOptions {
   // Probe visibility (depth moments per probe, made by setProbes when the probe positions change);
   // off: hardware trilinear over active probes, as before visibility existed.
   bool visibility = true;
-  // Each probe's depth cube sees as far as visibilityReach × the rule of probeVisibilityReach (1.5
-  // cell diagonals + a quarter spacing); farther surfaces read as open directions and are not
+  // Each probe's depth cube sees as far as visibilityReach × its reach (1.5 cell diagonals + a
+  // quarter of the smallest spacing): distances are clamped there and farther triangles are not
   // drawn. 0: no limit (every face draws the whole scene, as before the limit existed).
   float visibilityReach = 1.0f;
   // Off: every face draws every triangle (the same moments, slower; to compare and measure).
