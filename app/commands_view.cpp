@@ -29,6 +29,8 @@ struct ViewOptions {
   float exposure = 1.0f;
   bool exr = false;
   bool visibility = true;
+  float visibilityReach = 1.0f;
+  bool visibilityCulling = true;
 };
 
 struct Rendered {
@@ -86,9 +88,10 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
   raster.setProbes(volume);
   if (raster.visibilityActive())
-    fmt::print("view: probe visibility for {} probes made in {:.1f} ms (depth cubes) + {:.1f} ms (moments), {} bytes per probe\n",
-               volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityMomentsMs,
-               renderer::RasterRenderer::visibilityBytesPerProbe());
+    fmt::print("view: probe visibility for {} probes made in {:.1f} ms (depth cubes, {} triangles drawn) + {:.1f} ms "
+               "(moments), {} bytes per probe\n",
+               volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityTriangles,
+               raster.timings().visibilityMomentsMs, renderer::RasterRenderer::visibilityBytesPerProbe());
   Rendered r;
   r.images = raster.renderViews(views);
   r.viewsMs = raster.timings().viewsMs;
@@ -137,6 +140,11 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));
   addShadowCascadesOption(cmd, o->shadowCascades);
   addVisibilityOption(cmd, o->visibility);
+  cmd->add_option("--visibility-reach", o->visibilityReach,
+                  "probe visibility sees this many times 1.5 cell diagonals far (0: no limit)")
+      ->check(CLI::Range(0.0f, 1e6f));
+  cmd->add_option("--visibility-culling", o->visibilityCulling,
+                  "on: each depth-cube face draws only the triangles within reach; off: all (same result)");
   o->areaLights.add(cmd);
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
@@ -153,6 +161,8 @@ void addViewCommand(CLI::App& app) {
     ro.shadowMapSize = o->shadowMap;
     ro.shadowCascades = o->shadowCascades;
     ro.visibility = o->visibility;
+    ro.visibilityReach = o->visibilityReach;
+    ro.visibilityCulling = o->visibilityCulling;
     ro.environment = environment;
     ro.areaLights = o->areaLights.options();
     if (ro.areaLights.enabled && (o->probes != "live" || !o->connection.connect.empty()))

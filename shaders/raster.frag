@@ -76,8 +76,8 @@ vec2 probeMomentsToward(uint index, vec3 dir) {
 // its cell, each weighted by trilinear × backface × Chebyshev visibility (DDGI's weights): the
 // point, moved off the surface along ng and wo by a fraction of the probe spacing, is visible from
 // a probe with probability at least σ²/(σ² + (r − μ)²) when farther than the mean distance μ of
-// what the probe sees that way. Inactive probes weigh 0; where all 8 are inactive, the filled
-// trilinear volume answers (probeCoefficients).
+// what the probe sees that way (both no farther than the probe's reach). Inactive probes weigh 0;
+// where all 8 are inactive, the filled trilinear volume answers (probeCoefficients).
 bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
   for (int i = 0; i < 28; ++i) c[i] = 0.0;
   if (pc.volumeMin.w == 0.0) return false;
@@ -107,6 +107,9 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
     vec3 fromProbe = q - probe;
     float r = length(fromProbe);
     vec2 m = probeMomentsToward(index, r > 1e-6 ? fromProbe / r : ng);
+    // The moments stop at the probe's reach (w): a point beyond it is tested as if at the reach,
+    // so that it is hidden by what lies nearer and seen where nothing does.
+    r = min(r, probePositions[index].w);
     if (r > m.x) {
       float variance = abs(m.y - m.x * m.x);
       float d = r - m.x;

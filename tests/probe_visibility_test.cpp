@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/raster_client.h"
@@ -202,6 +203,99 @@ TEST(ProbeVisibility, BoxFaceIsNotDarkenedByProbesInsideTheBox) {
   std::printf("box face with hollow probes / full: visibility off %.4f, on %.4f\n", ratio[0], ratio[1]);
   EXPECT_NEAR(ratio[1], 1.0, 0.05);
   EXPECT_LT(ratio[0], 0.5);  // the darkening visibility removes
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+// Every texel (E[r], E[r²]) of every probe of a raster client's current volume.
+std::vector<glm::vec2> allMoments(const RasterRenderer& raster, uint32_t probes) {
+  std::vector<glm::vec2> out;
+  const auto n = static_cast<int>(RasterRenderer::visibilityMapTexels());
+  for (uint32_t p = 0; p < probes; ++p)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) out.push_back(raster.probeMoments(p, octTexelDirection(i, j, n)));
+  return out;
+}
+
+TEST(ProbeVisibility, CullingToTheReachKeepsTheMomentsAndDrawsAFraction) {
+  // builtin:hall (20 m × 20 m, ≈100k triangles) seen by 8 probes 2 m apart in its middle: reach
+  // 1.5 × 3.46 m + 0.5 m = 5.7 m. Culled and unculled builds under the same reach give the same
+  // moments, bit for bit (only triangles wholly beyond reach, or outside a face, are skipped), while
+  // drawing a fraction of the triangles. Against no reach at all (the build before the limit), a
+  // texel is the same or, where its lobe took in surfaces (or open directions) beyond reach, nearer:
+  // no mean beyond the reach.
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("hall");
+  const ProbeVolume v = makeProbeVolume(ProbeGrid{{2, 2, 2}, {{-1.0f, 1.5f, -1.0f}, {1.0f, 3.5f, 1.0f}}});
+  std::vector<glm::vec2> moments[3];
+  uint64_t triangles[3] = {};
+  for (int k = 0; k < 3; ++k) {
+    RasterOptions ro;
+    ro.visibilityCulling = k == 0;
+    ro.visibilityReach = k == 2 ? 0.0f : 1.0f;
+    RasterRenderer raster(context, s, 8, 8, ro);
+    raster.setProbes(v);
+    ASSERT_TRUE(raster.visibilityActive());
+    moments[k] = allMoments(raster, v.count());
+    triangles[k] = raster.timings().visibilityTriangles;
+  }
+  std::printf("hall, 8 probes: %llu triangles drawn culled, %llu unculled\n",
+              static_cast<unsigned long long>(triangles[0]), static_cast<unsigned long long>(triangles[1]));
+  EXPECT_EQ(triangles[1], 8ull * 6 * s.triangleCount());
+  EXPECT_LT(triangles[0] * 5, triangles[1]);
+  const float reach = 1.5f * std::sqrt(12.0f) + 0.25f * 2.0f;
+  size_t same = 0;
+  for (size_t t = 0; t < moments[0].size(); ++t) {
+    EXPECT_EQ(moments[0][t], moments[1][t]) << "texel " << t;
+    EXPECT_LE(moments[0][t].x, reach * 1.0001f) << "texel " << t;
+    if (moments[0][t] == moments[2][t]) {
+      ++same;
+    } else {
+      EXPECT_LE(moments[0][t].x, moments[2][t].x) << "texel " << t;
+      EXPECT_LT(moments[0][t].y, moments[2][t].y) << "texel " << t;
+    }
+  }
+  std::printf("hall: %zu of %zu texels as without a reach\n", same, moments[0].size());
+  EXPECT_GT(same, moments[0].size() / 4);
+  EXPECT_LT(same, moments[0].size());  // some directions do reach past 5.7 m
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+TEST(ProbeVisibility, CutOutQuadBlocksWhereKeptAndNotWhereCutAway) {
+  // builtin:closed-box split at x = 0.5 by two Mask quads: the z < 0 half kept (alpha 1), the z > 0
+  // half cut away (alpha 0). From the probe at the origin, (1, 0, −0.5) meets the kept half at
+  // 0.56 m; (1, 0, 0.5) passes the cut-away half to the wall at 1.12 m.
+  VulkanContext context(test::validatedContext());
+  scene::Scene s = test::builtinScene("closed-box");
+  scene::Material kept;
+  kept.alphaMode = scene::AlphaMode::Mask;
+  scene::Material cut = kept;
+  cut.alpha = 0.0f;
+  s.materials.push_back(kept);
+  s.materials.push_back(cut);
+  const auto keptId = static_cast<uint32_t>(s.materials.size() - 2), cutId = keptId + 1;
+  scene::addQuad(s, {0.5f, -1, -1}, {0.5f, -1, 0}, {0.5f, 1, 0}, {0.5f, 1, -1}, keptId);
+  scene::addQuad(s, {0.5f, -1, 0}, {0.5f, -1, 1}, {0.5f, 1, 1}, {0.5f, 1, 0}, cutId);
+  scene::finalizeScene(s);
+  RasterRenderer raster(context, s, 8, 8);
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{3, 1, 1}, {{-1.0f, -0.5f, -0.5f}, {1.0f, 0.5f, 0.5f}}});
+  raster.setProbes(v);
+  ASSERT_TRUE(raster.visibilityActive());
+  const float blocked = raster.probeMoments(1, {1.0f, 0.0f, -0.5f}).x;
+  const float open = raster.probeMoments(1, {1.0f, 0.0f, 0.5f}).x;
+  std::printf("cut-out quad: %.3f m where kept, %.3f m where cut away\n", blocked, open);
+  EXPECT_NEAR(blocked, 0.559f, 0.06f);
+  EXPECT_NEAR(open, 1.118f, 0.1f);
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+TEST(ProbeVisibility, ReachThatIsNegativeNotFiniteOrAbsurdIsRefused) {
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("closed-box");
+  for (const float reach : {-1.0f, std::nanf(""), INFINITY, 1e30f}) {
+    RasterOptions ro;
+    ro.visibilityReach = reach;
+    EXPECT_THROW(RasterRenderer(context, s, 8, 8, ro), std::invalid_argument) << reach;
+  }
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 

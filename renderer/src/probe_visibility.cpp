@@ -4,12 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "probecast/codec/probe_offsets.h"
 #include "probecast/renderer/view_sets.h"
+#include "shadow.frag.h"
 #include "shadow.vert.h"
 #include "vk_pipeline.h"
 
@@ -28,6 +31,51 @@ constexpr uint32_t kBatchRows = 16;     // rows of probes per depth atlas: 256 p
 constexpr uint32_t kBatch = kBatchColumns * kBatchRows;
 constexpr uint32_t kAtlasW = kBatchColumns * 6 * kCube, kAtlasH = kBatchRows * kCube;
 constexpr float kNear = 0.005f;  // metres: a surface nearer than this to a probe is not seen
+constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+
+glm::vec3 vertex(const scene::Scene& s, uint32_t triangle, int corner) {
+  return s.positions[s.indices[static_cast<size_t>(triangle) * 3 + static_cast<size_t>(corner)]];
+}
+
+// Clusters of consecutive triangles [first, end) of the scene's order, up to
+// kVisibilityClusterTriangles each.
+std::vector<VisibilityCluster> clustersOf(const scene::Scene& s, uint32_t first, uint32_t end) {
+  std::vector<VisibilityCluster> out;
+  for (uint32_t k = first; k < end; k += kVisibilityClusterTriangles) {
+    VisibilityCluster c;
+    c.first = k;
+    c.count = std::min(kVisibilityClusterTriangles, end - k);
+    c.lo = glm::vec3(std::numeric_limits<float>::max());
+    c.hi = -c.lo;
+    for (uint32_t t = k; t < k + c.count; ++t)
+      for (int v = 0; v < 3; ++v) {
+        c.lo = glm::min(c.lo, vertex(s, t, v));
+        c.hi = glm::max(c.hi, vertex(s, t, v));
+      }
+    out.push_back(c);
+  }
+  return out;
+}
+
+// Whether a box (relative to the probe) may meet face f's 90° pyramid (the points whose coordinate
+// on the face's axis, signed, is at least the absolute value of the other two): each bounding plane
+// of the pyramid is linear, so the box meets its side when the corner farthest that way does.
+// Generous by a hair of the box's size, so that triangles on a boundary are kept.
+bool clusterInFace(const glm::vec3& lo, const glm::vec3& hi, uint32_t f) {
+  const int axis = static_cast<int>(f / 2);
+  const float along = f % 2 == 0 ? hi[axis] : -lo[axis];  // the farthest the box goes along the face's axis
+  const float slack = 1e-4f * (glm::length(hi - lo) + glm::length(hi + lo)) + 1e-6f;
+  if (along <= -slack) return false;
+  for (int b = 0; b < 3; ++b)
+    if (b != axis && (along - lo[b] < -slack || along + hi[b] < -slack)) return false;
+  return true;
+}
+
+// Whether a box (relative to the probe) has any point within `reach` of the probe.
+bool clusterInReach(const glm::vec3& lo, const glm::vec3& hi, float reach) {
+  const glm::vec3 nearest = glm::clamp(glm::vec3(0.0f), lo, hi);
+  return glm::dot(nearest, nearest) <= reach * reach;
+}
 
 // The six 90° faces seen from the origin (+x −x +y −y +z −z), world → Vulkan clip.
 std::vector<glm::mat4> cubeFaceViews(float farDistance) {
@@ -112,11 +160,13 @@ void destroyOwned(VulkanDevice& d, ProbeVisibility& vis) {
 // Uploads an atlas of `width` × `height` RG texels and the positions, replacing the old ones once
 // both are made.
 void uploadMoments(VulkanDevice& d, std::vector<float> atlas, uint32_t width, uint32_t height,
-                   const std::vector<float>& positions, ProbeVisibility& vis) {
+                   const std::vector<float>& positions, float reach, ProbeVisibility& vis) {
   const size_t count = positions.size() / 3;
   std::vector<float> xyzw(std::max<size_t>(count, 1) * 4, 0.0f);
-  for (size_t p = 0; p < count; ++p)
-    for (int c = 0; c < 3; ++c) xyzw[p * 4 + c] = positions[p * 3 + c];
+  for (size_t p = 0; p < std::max<size_t>(count, 1); ++p) {
+    for (int c = 0; c < 3 && p < count; ++c) xyzw[p * 4 + c] = positions[p * 3 + c];
+    xyzw[p * 4 + 3] = std::min(reach, std::numeric_limits<float>::max());  // finite for the shader
+  }
   GpuImage image;
   Buffer pos, staging;
   try {
@@ -147,12 +197,33 @@ void uploadMoments(VulkanDevice& d, std::vector<float> atlas, uint32_t width, ui
   vis.atlasHeight = height;
 }
 
+// One indexed draw per run of consecutive clusters that a face keeps.
+struct DrawRun {
+  uint32_t firstTriangle, triangles;
+};
+
+// The runs of `clusters` that face f of a probe at `probe` draws: all of them without culling.
+void faceRuns(const std::vector<VisibilityCluster>& clusters, const glm::vec3& probe, uint32_t f, float reach, bool cull,
+              std::vector<DrawRun>& runs) {
+  runs.clear();
+  for (const VisibilityCluster& c : clusters) {
+    if (cull && !(clusterInReach(c.lo - probe, c.hi - probe, reach) && clusterInFace(c.lo - probe, c.hi - probe, f)))
+      continue;
+    if (!runs.empty() && runs.back().firstTriangle + runs.back().triangles == c.first)
+      runs.back().triangles += c.count;
+    else
+      runs.push_back({c.first, c.count});
+  }
+}
+
 // Draws the depth cubes of probes [first, first + n) into `depth` (kAtlasW × kAtlasH) and reads
-// the distances back into `distances` (6 kCube² per probe, cubeTexels' order).
-void drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, const std::vector<float>& positions, size_t first,
-                    uint32_t n, const std::vector<glm::mat4>& faces, float farDistance, GpuImage& depth,
-                    Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances) {
-  const uint32_t triangles = gpu.accel.opaqueTriangles;
+// the distances back into `distances` (6 kCube² per probe, cubeTexels' order), clamped to `reach`
+// (an open direction reads farDistance, or reach if nearer). Returns the triangles drawn.
+uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                        const std::vector<float>& positions, size_t first, uint32_t n,
+                        const std::vector<glm::mat4>& faces, float farDistance, float reach, bool cull,
+                        GpuImage& depth, Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances) {
+  uint64_t drawn = 0;
   submitAndWait(d, [&](VkCommandBuffer cmd) {
     transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
     const VkRenderingAttachmentInfo depthInfo =
@@ -162,26 +233,39 @@ void drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, const std::vector<floa
     ri.layerCount = 1;
     ri.pDepthAttachment = &depthInfo;
     vkCmdBeginRendering(cmd, &ri);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vis.pipeline);
     const VkBuffer streams[3] = {gpu.accel.positions.buffer, gpu.normals.buffer, gpu.texcoords.buffer};
     const VkDeviceSize offsets[3] = {0, 0, 0};
     vkCmdBindVertexBuffers(cmd, 0, 3, streams, offsets);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vis.layout, 0, 1, &materials, 0, nullptr);
+    std::vector<DrawRun> runs;
     vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
-    for (uint32_t k = 0; k < n && triangles > 0; ++k) {
-      const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
-      const glm::mat4 move = glm::translate(glm::mat4(1.0f), -probe);
-      for (uint32_t f = 0; f < 6; ++f) {
-        const auto x = static_cast<int32_t>(((k % kBatchColumns) * 6 + f) * kCube);
-        const auto y = static_cast<int32_t>((k / kBatchColumns) * kCube);
-        const VkViewport viewport{static_cast<float>(x), static_cast<float>(y), kCube, kCube, 0.0f, 1.0f};
-        const VkRect2D scissor{{x, y}, {kCube, kCube}};
-        vkCmdSetViewport(cmd, 0, 1, &viewport);
-        vkCmdSetScissor(cmd, 0, 1, &scissor);
-        shaders::RsShadowPush push{};
-        const glm::mat4 vp = faces[f] * move;
-        std::memcpy(&push.viewProj, &vp[0][0], sizeof push.viewProj);
-        vkCmdPushConstants(cmd, vis.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
-        vkCmdDrawIndexed(cmd, 3 * triangles, 1, 0, 0, 0);
+    // The opaque triangles, then the cut-outs (shadow.frag finds each one's material by number).
+    for (int pass = 0; pass < 2; ++pass) {
+      const std::vector<VisibilityCluster>& clusters = pass == 0 ? vis.opaque : vis.cutouts;
+      if (clusters.empty()) continue;
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pass == 0 ? vis.pipeline : vis.cutoutPipeline);
+      for (uint32_t k = 0; k < n; ++k) {
+        const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
+        const glm::mat4 move = glm::translate(glm::mat4(1.0f), -probe);
+        for (uint32_t f = 0; f < 6; ++f) {
+          faceRuns(clusters, probe, f, reach, cull, runs);
+          if (runs.empty()) continue;
+          const auto x = static_cast<int32_t>(((k % kBatchColumns) * 6 + f) * kCube);
+          const auto y = static_cast<int32_t>((k / kBatchColumns) * kCube);
+          const VkViewport viewport{static_cast<float>(x), static_cast<float>(y), kCube, kCube, 0.0f, 1.0f};
+          const VkRect2D scissor{{x, y}, {kCube, kCube}};
+          vkCmdSetViewport(cmd, 0, 1, &viewport);
+          vkCmdSetScissor(cmd, 0, 1, &scissor);
+          shaders::RsShadowPush push{};
+          const glm::mat4 vp = faces[f] * move;
+          std::memcpy(&push.viewProj, &vp[0][0], sizeof push.viewProj);
+          for (const DrawRun& run : runs) {
+            push.primitiveBase = run.firstTriangle;
+            vkCmdPushConstants(cmd, vis.layout, kStages, 0, sizeof push, &push);
+            vkCmdDrawIndexed(cmd, 3 * run.triangles, 1, 3 * run.firstTriangle, 0, 0);
+            drawn += run.triangles;
+          }
+        }
       }
     }
     vkCmdEndRendering(cmd);
@@ -207,13 +291,15 @@ void drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, const std::vector<floa
         for (uint32_t tx = 0; tx < kCube; ++tx) {
           const uint32_t ax = ((k % kBatchColumns) * 6 + f) * kCube + tx, ay = (k / kBatchColumns) * kCube + ty;
           const float depthValue = z[static_cast<size_t>(ay) * kAtlasW + ax];
-          float r = farDistance;
+          float r = std::min(farDistance, reach);
           if (depthValue < 1.0f) {
             const glm::vec4 p = inverse[f] * glm::vec4(texelCentre(tx, kCube), texelCentre(ty, kCube), depthValue, 1.0f);
             r = glm::length(glm::vec3(p) / p.w);
+            r = std::min(r, reach);  // the same whether or not what lies beyond was drawn
           }
           distances[((static_cast<size_t>(k) * 6 + f) * kCube + ty) * kCube + tx] = r;
         }
+  return drawn;
 }
 
 }  // namespace
@@ -271,24 +357,50 @@ glm::vec2 probeMomentsAt(const ProbeVisibility& vis, uint32_t probe, const glm::
 }
 
 void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, ProbeVisibility& out) {
-  out.layout = createPipelineLayout(d, materials, VK_SHADER_STAGE_VERTEX_BIT, sizeof(shaders::RsShadowPush));
+  out.layout = createPipelineLayout(d, materials, kStages, sizeof(shaders::RsShadowPush));
   GraphicsPipelineDesc desc;
   desc.vertexCode = kShadowVert;
   desc.vertexBytes = sizeof kShadowVert;
   desc.layout = out.layout;
   out.pipeline = createGraphicsPipeline(d, desc);
+  desc.fragmentCode = kShadowFrag;
+  desc.fragmentBytes = sizeof kShadowFrag;
+  desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard
+  out.cutoutPipeline = createGraphicsPipeline(d, desc);
   // One tile of a probe that sees nothing: E[r] large, zero variance — every point visible.
   std::vector<float> atlas(RS_VIS_TILE * RS_VIS_TILE * 2);
   for (size_t t = 0; t < atlas.size(); t += 2) {
     atlas[t] = 1e6f;
     atlas[t + 1] = 1e12f;
   }
-  uploadMoments(d, std::move(atlas), RS_VIS_TILE, RS_VIS_TILE, {0.0f, 0.0f, 0.0f}, out);
+  uploadMoments(d, std::move(atlas), RS_VIS_TILE, RS_VIS_TILE, {0.0f, 0.0f, 0.0f},
+                std::numeric_limits<float>::infinity(), out);
 }
 
-bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, const std::vector<float>& positions,
-                          float farDistance, ProbeVisibility& vis) {
-  if (positions == vis.builtFor) return false;
+void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis) {
+  // finalizeScene keeps each class one run, in Morton order within it: runs of it are compact.
+  const uint32_t opaque = scene::leadingTrianglesBelowClass(scene, 1);
+  vis.opaque = clustersOf(scene, 0, opaque);
+  vis.cutouts = clustersOf(scene, opaque, scene::leadingTrianglesBelowClass(scene, 2));
+  vis.builtFor.clear();  // new geometry: the next build draws again
+}
+
+float probeVisibilityReach(const ProbeGrid& grid, const glm::vec3& sceneExtent) {
+  glm::vec3 cell(0.0f);
+  float spacing = std::numeric_limits<float>::max();
+  for (int a = 0; a < 3; ++a) {
+    cell[a] = grid.dims[a] > 1 ? probeCellSize(grid, a) : sceneExtent[a];
+    if (grid.dims[a] > 1) spacing = std::min(spacing, cell[a]);
+  }
+  if (spacing == std::numeric_limits<float>::max()) return std::numeric_limits<float>::infinity();  // one probe
+  return 1.5f * glm::length(cell) + 0.25f * spacing;
+}
+
+bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                          const std::vector<float>& positions, float farDistance, float reach, bool cull,
+                          ProbeVisibility& vis) {
+  if (positions == vis.builtFor && reach == vis.builtReach) return false;
+  if (!(reach > 0.0f)) throw std::invalid_argument("probe visibility reach must be positive");
   const size_t count = positions.size() / 3;
   if (count == 0 || count > kMaxVisibilityProbes)
     throw std::invalid_argument("probe visibility takes 1.." + std::to_string(kMaxVisibilityProbes) + " probes, not " +
@@ -303,13 +415,15 @@ bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, const std::vecto
                                VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
   Buffer readback;
   double momentsMs = 0.0;
+  uint64_t drawn = 0;
   try {
     readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
                             VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     std::vector<float> distances, tile(RS_VIS_TILE * RS_VIS_TILE * 2);
     for (size_t first = 0; first < count; first += kBatch) {
       const auto n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
-      drawDepthCubes(d, gpu, positions, first, n, faces, farDistance, depth, readback, vis, distances);
+      drawn += drawDepthCubes(d, gpu, materials, positions, first, n, faces, farDistance, reach, cull, depth, readback,
+                              vis, distances);
       const auto m0 = Clock::now();
       for (uint32_t k = 0; k < n; ++k) {
         octahedralMoments(distances.data() + static_cast<size_t>(k) * 6 * kCube * kCube, kCube, tile.data());
@@ -328,15 +442,18 @@ bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, const std::vecto
   destroyImage(d, depth);
   destroyBuffer(d, readback);
   const auto u0 = Clock::now();
-  uploadMoments(d, std::move(atlas), width, height, positions, vis);
+  uploadMoments(d, std::move(atlas), width, height, positions, reach, vis);
   vis.momentsMs = momentsMs + msSince(u0);
   vis.renderMs = msSince(t0) - vis.momentsMs;
   vis.builtFor = positions;
+  vis.builtReach = reach;
+  vis.trianglesDrawn = drawn;
   return true;
 }
 
 void destroyProbeVisibility(VulkanDevice& d, ProbeVisibility& vis) {
   destroyOwned(d, vis);
+  if (vis.cutoutPipeline) vkDestroyPipeline(d.device, vis.cutoutPipeline, nullptr);
   if (vis.pipeline) vkDestroyPipeline(d.device, vis.pipeline, nullptr);
   if (vis.layout) vkDestroyPipelineLayout(d.device, vis.layout, nullptr);
   vis = ProbeVisibility{};

@@ -5,6 +5,15 @@
 // cosine-power lobe around its direction (as DDGI filters its depth). raster.frag weighs each of
 // the 8 probes around a point by a Chebyshev bound on the probability that the point is visible
 // from the probe. Made again only when the probe positions change (a new grid, new offsets).
+//
+// Each probe sees only as far as its reach (probeVisibilityReach): distances are clamped to it (as
+// DDGI clamps its depth), open directions included, and raster.frag tests a point beyond it as if
+// at it, so the triangles wholly beyond it change nothing and are not drawn. The scene's triangles
+// are cut into clusters of consecutive ones (finalizeScene orders each material class by the Morton
+// code of the centroids, so a run is a compact piece of the scene), each with its bounds; each face
+// of each cube draws only the clusters whose bounds meet both the reach sphere and the face's 90°
+// pyramid. Cut-out (alphaMode Mask) triangles are drawn through shadow.frag, so what is cut away
+// does not block.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +22,7 @@
 #include <glm/glm.hpp>
 
 #include "gpu_scene.h"
+#include "probecast/codec/probe_volume.h"
 #include "raster_shared.h"
 #include "vk_resources.h"
 
@@ -24,26 +34,51 @@ constexpr float kVisibilityLobePower = 50.0f;        // cos^k lobe of each momen
 // Client memory per probe: the atlas tile, two 32-bit floats per texel, plus its position (vec4).
 constexpr uint32_t kVisibilityBytesPerProbe = RS_VIS_TILE * RS_VIS_TILE * 8 + 16;
 
+// Triangles [first, first + count) of the scene's order, and their bounds.
+struct VisibilityCluster {
+  uint32_t first = 0, count = 0;
+  glm::vec3 lo{0.0f}, hi{0.0f};
+};
+
 struct ProbeVisibility {
   GpuImage moments;                // RG32F atlas (raster_shared.h's layout), sampled by raster.frag
-  Buffer positions;                // vec4 per probe: the moved position, metres
+  Buffer positions;                // vec4 per probe: the moved position and the reach, metres
   std::vector<float> atlas;        // host copy of `moments`, 2 floats per texel
   uint32_t atlasWidth = 0, atlasHeight = 0;
   std::vector<float> builtFor;     // xyz per probe of the last build (skips unchanged positions)
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;  // depth only, no bias
+  VkPipeline pipeline = VK_NULL_HANDLE;        // opaque triangles: depth only, no bias
+  VkPipeline cutoutPipeline = VK_NULL_HANDLE;  // cut-outs: shadow.frag discards what is cut away
+  std::vector<VisibilityCluster> opaque;       // clusters of the opaque triangles
+  std::vector<VisibilityCluster> cutouts;      // clusters of the cut-out (alphaMode Mask) ones
+  float builtReach = 0.0f;                     // reach of the last build
   double renderMs = 0.0, momentsMs = 0.0;  // last build: depth cubes drawn and read back; moments + upload
+  uint64_t trianglesDrawn = 0;             // last build: triangles drawn over every cube face
 };
+
+constexpr uint32_t kVisibilityClusterTriangles = 64;  // most triangles per cluster
 
 // `materials`: the raster client's set layout (the depth pass binds none of it, the layout is shared).
 // Starts with one probe at the origin and an empty map (every direction open), so descriptors are valid.
 void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, ProbeVisibility& out);
-// Rasterises depth cubes of the opaque triangles of `gpu` from `positions` (xyz per probe) and
-// rebuilds the moments; `farDistance` is what an open direction reads. Returns false (and does
-// nothing) when the positions equal those of the last build. Throws std::invalid_argument for more
-// than kMaxVisibilityProbes probes. New images replace the old only once made.
-bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, const std::vector<float>& positions,
-                          float farDistance, ProbeVisibility& vis);
+// Cuts the opaque and cut-out triangles of `scene` (as uploaded to the GpuScene the builds draw)
+// into clusters.
+void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis);
+// How far a probe of `grid` needs to see: 1.5 cell diagonals (a probe moved by at most half its cell
+// per axis weighs points of the 8 cells around its grid point, each within one diagonal of it, so
+// within 1.5 of the probe) plus 0.25 of the smallest spacing (raster.frag moves the point 0.225 ×
+// that off the surface). An axis with one probe counts `sceneExtent` on that axis as its cell.
+float probeVisibilityReach(const ProbeGrid& grid, const glm::vec3& sceneExtent);
+// Rasterises depth cubes of the opaque and cut-out triangles of `gpu` from `positions` (xyz per
+// probe) and rebuilds the moments; `materials`: the raster client's set (cut-outs read their
+// material). `farDistance` is what an open direction reads, and so does any surface farther than
+// `reach` (infinity: no limit). `cull`: draw only the clusters within reach of each face (off: every
+// triangle, the same moments). Returns false (and does nothing) when the positions and reach equal
+// those of the last build. Throws std::invalid_argument for more than kMaxVisibilityProbes probes.
+// New images replace the old only once made.
+bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                          const std::vector<float>& positions, float farDistance, float reach, bool cull,
+                          ProbeVisibility& vis);
 void destroyProbeVisibility(VulkanDevice& d, ProbeVisibility& vis);
 
 // The moments of one probe from its depth cube (6 faces of `size`² distances, face order +x −x +y

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -413,6 +414,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
     : impl_(std::make_unique<Impl>()) {
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
+  if (!(options.visibilityReach >= 0.0f && options.visibilityReach <= 1e6f))
+    throw std::invalid_argument("visibility reach must be 0 (no limit) or a positive multiple of the rule, up to 1e6");
   if (options.shadowMapSize < 16 || options.shadowMapSize > 8192)
     throw std::invalid_argument("shadow map size must be 16..8192");
   if (options.shadowCascades < 1 || options.shadowCascades > RS_MAX_CASCADES)
@@ -480,6 +483,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   createShadowMaps(d, options.shadowMapSize, options.maxShadowLayers, options.shadowCascades, s.setLayout, s.shadows);
   createShadowMaps(d, options.areaShadowMapSize, options.maxShadowLayers, 1, s.setLayout, s.areaShadows);
   createProbeVisibility(d, s.setLayout, s.visibility);
+  setProbeVisibilityScene(scene, s.visibility);
 
   const VkDescriptorPoolSize sizes[2] = {{kSsbo, 12}, {kImage, RS_PROBE_TEXTURES + 6}};
   createSingleDescriptorSet(d, s.setLayout, sizes, 2, s.pool, s.set);
@@ -549,9 +553,14 @@ void RasterRenderer::setProbes(const ProbeVolume& volume) {
     glm::vec3 lo = glm::min(s.sceneMin, glm::vec3(volume.grid.bounds.min[0], volume.grid.bounds.min[1], volume.grid.bounds.min[2]));
     glm::vec3 hi = glm::max(s.sceneMax, glm::vec3(volume.grid.bounds.max[0], volume.grid.bounds.max[1], volume.grid.bounds.max[2]));
     const float farDistance = std::max(2.0f * glm::length(hi - lo), 1.0f);
-    if (buildProbeVisibility(*s.d, s.gpu, positions, farDistance, s.visibility)) {
+    const float reach = s.options.visibilityReach > 0.0f
+                            ? s.options.visibilityReach * probeVisibilityReach(volume.grid, hi - lo)
+                            : std::numeric_limits<float>::infinity();
+    if (buildProbeVisibility(*s.d, s.gpu, s.set, positions, farDistance, reach, s.options.visibilityCulling,
+                             s.visibility)) {
       s.timings.visibilityRenderMs = s.visibility.renderMs;
       s.timings.visibilityMomentsMs = s.visibility.momentsMs;
+      s.timings.visibilityTriangles = s.visibility.trianglesDrawn;
       s.writeDescriptors();
     }
   }

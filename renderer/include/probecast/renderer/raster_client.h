@@ -51,6 +51,12 @@ struct RasterOptions {
   // Probe visibility (depth moments per probe, made by setProbes when the probe positions change);
   // off: hardware trilinear over active probes, as before visibility existed.
   bool visibility = true;
+  // Each probe's depth cube sees as far as visibilityReach × its reach (1.5 cell diagonals + a
+  // quarter of the smallest spacing): distances are clamped there and farther triangles are not
+  // drawn. 0: no limit (every face draws the whole scene, as before the limit existed).
+  float visibilityReach = 1.0f;
+  // Off: every face draws every triangle (the same moments, slower; to compare and measure).
+  bool visibilityCulling = true;
 };
 
 struct RasterTimings {
@@ -59,6 +65,7 @@ struct RasterTimings {
   double viewsMs = 0.0;   // last renderViews, shadows excluded, readback included
   double visibilityRenderMs = 0.0;   // last visibility build: depth cubes drawn and read back
   double visibilityMomentsMs = 0.0;  // last visibility build: moments on the CPU and their upload
+  uint64_t visibilityTriangles = 0;  // last visibility build: triangles drawn over all cube faces
 };
 
 // Replaces inactive probes by the mean of their active neighbours, growing outwards until every
