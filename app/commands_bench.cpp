@@ -204,6 +204,7 @@ void addBenchScene(CLI::App* bench) {
     std::string json, chart;
     std::vector<uint32_t> size{160, 100};
     bench::SceneBenchOptions bench;
+    AreaLightCli areaLights;
   };
   auto so = std::make_shared<SceneCli>();
   st->add(cmd);
@@ -211,6 +212,11 @@ void addBenchScene(CLI::App* bench) {
   RenderBenchCli{&so->size, &so->bench.updates, &so->bench.repeats, &so->bench.referenceSpp, &so->bench.referenceCache,
                  &so->bench.raster.shadowMapSize}
       .add(cmd, "probe updates (each timed)", "timed renders of the view set per representation (median)");
+  cmd->add_option("--supersample", so->bench.supersample,
+                  "raster samples per pixel side, box-filtered to --size (the reference averages each pixel's area)")
+      ->check(CLI::Range(1, 16));
+  addVisibilityOption(cmd, so->bench.raster.visibility);
+  so->areaLights.add(cmd);  // the reference sees every emitter either way, so the cached one still serves
   cmd->add_option("--reference-bounces", so->bench.referenceBounces, "surface interactions per reference path")
       ->check(CLI::Range(1, 16));
   cmd->add_option("--reference-seed", so->bench.referenceSeed, "seed of the first half-reference");
@@ -227,6 +233,7 @@ void addBenchScene(CLI::App* bench) {
     o.t = st->scene.t;
     o.grid = st->grid.resolve(o.scene);
     o.updater = st->updater(st->scene.environment.load());
+    o.updater.areaLights = o.raster.areaLights = so->areaLights.options();
     o.context = st->gpu.context();
     o.command = commandLine();
     o.progress = progressLine;

@@ -44,6 +44,24 @@ struct ReprRun {
 
 }  // namespace
 
+renderer::Image boxDownsample(const renderer::Image& image, uint32_t factor) {
+  if (factor == 0 || image.width % factor != 0 || image.height % factor != 0 ||
+      image.rgb.size() != static_cast<size_t>(image.width) * image.height * 3)
+    throw std::invalid_argument(fmt::format("boxDownsample: a {}x{} image does not split into {}-pixel blocks",
+                                            image.width, image.height, factor));
+  renderer::Image out;
+  out.width = image.width / factor;
+  out.height = image.height / factor;
+  out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 0.0f);
+  const float weight = 1.0f / static_cast<float>(factor * factor);
+  for (uint32_t y = 0; y < image.height; ++y)
+    for (uint32_t x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        out.rgb[(static_cast<size_t>(y / factor) * out.width + x / factor) * 3 + c] +=
+            weight * image.rgb[(static_cast<size_t>(y) * image.width + x) * 3 + c];
+  return out;
+}
+
 void checkSceneBenchOptions(const SceneBenchOptions& o) {
   renderer::ViewSetSpec spec;
   std::string error;
@@ -58,6 +76,10 @@ void checkSceneBenchOptions(const SceneBenchOptions& o) {
         o.referenceSpp, spec.count(), o.width, o.height, samples, kMaxReferenceSamples));
   if (o.updates == 0) throw std::invalid_argument("--updates: at least 1");
   if (o.repeats == 0) throw std::invalid_argument("--repeats: at least 1");
+  if (o.supersample == 0 || o.supersample > 16) throw std::invalid_argument("--supersample: 1 to 16 samples per side");
+  if (static_cast<uint64_t>(o.width) * o.supersample > 16384 || static_cast<uint64_t>(o.height) * o.supersample > 16384)
+    throw std::invalid_argument(fmt::format("--supersample {}: {}x{} would render views over 16384 pixels a side",
+                                            o.supersample, o.width, o.height));
   if (!o.imagesDir.empty() && std::filesystem::exists(o.imagesDir) && !std::filesystem::is_directory(o.imagesDir))
     throw std::invalid_argument("--images " + o.imagesDir + ": exists and is not a directory");
   if (!o.referenceCache.empty() && std::filesystem::exists(o.referenceCache) &&
@@ -108,7 +130,14 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
 
   renderer::RasterOptions ro = o.raster;
   ro.environment = o.updater.environment;
-  renderer::RasterRenderer raster(context, o.scene, o.width, o.height, ro);
+  const uint32_t ss = o.supersample;
+  renderer::RasterRenderer raster(context, o.scene, o.width * ss, o.height * ss, ro);
+  const auto render = [&] {
+    std::vector<renderer::Image> images = raster.renderViews(views);
+    if (ss > 1)
+      for (renderer::Image& image : images) image = boxDownsample(image, ss);
+    return images;
+  };
   if (!o.imagesDir.empty()) {
     std::filesystem::create_directories(o.imagesDir);
     for (size_t v = 0; v < views.size(); ++v)
@@ -120,6 +149,7 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
   json["scene"] = o.scene.name;
   json["device"] = context.deviceName();
   json["size"] = {o.width, o.height};
+  json["supersample"] = o.supersample;  // raster ms per view are for the supersampled size
   json["views"] = o.views;
   json["view_count"] = views.size();
   json["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
@@ -129,6 +159,8 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
   json["probe_updates"] = o.updates;
   json["update_ms_all"] = updateMs;
   json["environment"] = o.updater.environment ? o.updater.environment->name : "none";
+  json["visibility"] = o.raster.visibility;
+  json["area_lights"] = o.raster.areaLights.enabled;
   json["reference_cache"] = cache.dir();
   json["metric"] =
       "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2, per view, then the mean over views; the reference is "
@@ -152,10 +184,11 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
     accuracyMean += r.accuracyDb / static_cast<double>(refs.size());
   }
   std::string table = fmt::format(
-      "scene bench: {} on {}, {} ({} views) of {}x{}, grid {}x{}x{}, {} spp per probe update, environment {}\n"
+      "scene bench: {} on {}, {} ({} views) of {}x{}{}, grid {}x{}x{}, {} spp per probe update, environment {}\n"
       "probe update: {:.1f} ms (median of {})\nreference: {} spp per view; noise floor {:.2f} dB (mean over views), "
       "reference itself ≈ {:.2f} dB\n",
-      o.scene.name, context.deviceName(), o.views, views.size(), o.width, o.height, o.grid.dims[0], o.grid.dims[1],
+      o.scene.name, context.deviceName(), o.views, views.size(), o.width, o.height,
+      ss > 1 ? fmt::format(" (raster {}x{} box-filtered)", o.width * ss, o.height * ss) : std::string(), o.grid.dims[0], o.grid.dims[1],
       o.grid.dims[2], o.updater.samplesPerProbe, json["environment"].get<std::string>(), updateMedian, o.updates,
       o.referenceSpp, floorMean, accuracyMean);
   table += fmt::format("{:<6} {:>9} {:>7} {:>12} {:>11} {:>12} {:>11}\n", "repr", "PSNR dB", "SSIM", "vs float dB",
@@ -173,10 +206,10 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
     const auto c0 = Clock::now();
     raster.setProbes(run.viaCodec ? decodeAs(volume, run.repr, /*zh3PerPixel=*/true) : volume);
     const double codecMs = msSince(c0);
-    std::vector<renderer::Image> images = raster.renderViews(views);  // warm-up (and shadow maps)
+    std::vector<renderer::Image> images = render();  // warm-up (and shadow maps)
     std::vector<double> ms;
     for (uint32_t k = 0; k < o.repeats; ++k) {
-      images = raster.renderViews(views);
+      images = render();
       ms.push_back(raster.timings().viewsMs / static_cast<double>(views.size()));
     }
     if (!run.viaCodec) floatImages = images;

@@ -24,6 +24,10 @@ struct SceneBenchOptions {
   uint32_t updates = 8;              // probe updates, each timed
   std::string views = "mono";        // mono, stereo, lf:NxM (renderer/view_sets.h)
   uint32_t width = 160, height = 100;
+  // Raster samples per pixel side: the views are rendered at supersample × the size and
+  // box-filtered down, so each pixel is, like the reference's, an average over its footprint (at 1,
+  // one sample at the pixel's centre: at small sizes the edges' aliasing dominates the error).
+  uint32_t supersample = 1;
   uint32_t repeats = 3;              // timed renders of the view set per representation (median)
   uint32_t referenceSpp = 4096;
   uint32_t referenceBounces = 8;
@@ -40,6 +44,10 @@ struct SceneBenchResult {
   std::string table;
   std::string svg;  // mean PSNR against ms per view, one point per representation
 };
+
+// The mean of each factor × factor block of `image` (sides divisible by factor): the pixel integral
+// a reference estimates, from a render at factor × the size.
+renderer::Image boxDownsample(const renderer::Image& image, uint32_t factor);
 
 // Throws std::invalid_argument with a message naming the option for nonsense the CLI's own range
 // checks cannot see (a view set that does not parse, a reference of more samples than can finish).
