@@ -81,7 +81,6 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
     renderer::UpdaterOptions uo = o.tracing.updater(ro.environment);
     ro.areaLights = o.areaLights.options();
     uo.areaLights = ro.areaLights;  // the probes leave out exactly what this viewer lights
-    volume.areaLights = session::areaLightRuleOf(uo.areaLights);
     renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), uo);
     Progress progress("view", /*bar=*/false);
     for (uint32_t u = 0; u < o.updates; ++u) {
@@ -89,9 +88,8 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
       progress.update(static_cast<double>(u + 1) / o.updates, fmt::format("probe update {}/{}", u + 1, o.updates));
     }
     progress.finish();
-    const AreaLightRule rule = volume.areaLights;
     volume = updater.volume();
-    volume.areaLights = rule;
+    volume.areaLights = session::areaLightRuleOf(uo.areaLights);
   } else {
     std::string error;
     orThrow(readProbeFile(o.probes, volume, error), error);

@@ -198,7 +198,7 @@ struct AreaLightCli {
   std::string mode;
   float minFraction = 0.05f;
   CLI::Option* minOption = nullptr;
-  explicit AreaLightCli(std::string defaultMode = kAreaLightsDefault) : mode(std::move(defaultMode)) {}
+  AreaLightCli(std::string defaultMode = kAreaLightsDefault) : mode(std::move(defaultMode)) {}
   void add(CLI::App* cmd, bool follows = false) {
     std::vector<std::string> modes{"on", "off"};
     if (follows) modes.push_back("auto");

@@ -51,7 +51,7 @@ TEST(AreaLightStream, AViewerLightsThePanelExactlyWhenTheStreamSaysSo) {
   ASSERT_TRUE(renderer::parseViewSet("mono", spec, error)) << error;
   const std::vector<renderer::ViewInfo> views =
       renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, 32, 32));
-  const uint32_t dims[3] = {2, 2, 2};
+  const uint32_t dims[3] = {4, 4, 4};
   const float lo[3] = {s.boundsMin.x, s.boundsMin.y, s.boundsMin.z}, hi[3] = {s.boundsMax.x, s.boundsMax.y, s.boundsMax.z};
   const ProbeGrid grid = cellCentredGrid(dims, lo, hi);
   double mean[2] = {0.0, 0.0};
