@@ -335,6 +335,14 @@ std::vector<float> sampleOffsets(const ProbeGrid& g) {
   return o;
 }
 
+// Waits until `client` holds what the server has after the producer's 3 frames; false (with the
+// client's last error reported) if it does not within 10 s.
+bool convergedSnapshot(ProbeClient& client, ProbeHub& hub, const Producer& producer, VolumeSnapshot& snap) {
+  const bool held = waitFor([&] { return matchesServer(client, hub) && producer.published() == 3; }, 10s);
+  EXPECT_TRUE(held) << client.stats().lastError;
+  return held && client.snapshot(snap);
+}
+
 TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
   ProbeHub hub(volumeConfig());
   const ProbeGrid g = gridOf(hub.layout(), hub.bounds());
@@ -350,10 +358,8 @@ TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
   Producer producer(hub, 3, 20ms);
   ProbeClient client(clientFor(server.port()));
   client.start();
-  ASSERT_TRUE(waitFor([&] { return matchesServer(client, hub) && producer.published() == 3; }, 10s))
-      << client.stats().lastError;
   VolumeSnapshot snap;
-  ASSERT_TRUE(client.snapshot(snap));
+  ASSERT_TRUE(convergedSnapshot(client, hub, producer, snap));
   EXPECT_EQ(snap.volume.offsets, offsets);  // bit for bit
   EXPECT_EQ(hub.reconstruction().offsets, offsets);
   EXPECT_EQ(hub.epoch(), epoch);
@@ -393,10 +399,8 @@ TEST(Service, AreaLightRuleReachesTheClientAndAChangeStartsANewEpoch) {
   Producer producer(hub, 3, 20ms);
   ProbeClient client(clientFor(server.port()));
   client.start();
-  ASSERT_TRUE(waitFor([&] { return matchesServer(client, hub) && producer.published() == 3; }, 10s))
-      << client.stats().lastError;
   VolumeSnapshot snap;
-  ASSERT_TRUE(client.snapshot(snap));
+  ASSERT_TRUE(convergedSnapshot(client, hub, producer, snap));
   EXPECT_EQ(snap.volume.areaLights, config.areaLights);
   EXPECT_EQ(hub.reconstruction().areaLights, config.areaLights);
   EXPECT_EQ(hub.epoch(), epoch);
