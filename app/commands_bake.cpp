@@ -13,7 +13,9 @@ void addBakeCommand(CLI::App& app) {
   auto tr = std::make_shared<TracingOptions>();
   auto out = std::make_shared<std::string>();
   auto updates = std::make_shared<uint32_t>(4);
+  auto areaLights = std::make_shared<AreaLightCli>();
   tr->add(bake);
+  areaLights->add(bake);
   bake->add_option("--updates", *updates, "updates to accumulate")->check(CLI::Range(1, 100000));
   bake->add_option("--out", *out, "probe volume file to write")->required();
   bake->callback([=] {
@@ -21,7 +23,9 @@ void addBakeCommand(CLI::App& app) {
     const auto env = tr->scene.environment.load();
     renderer::VulkanContext context(tr->gpu.context());
     const ProbeGrid g = tr->grid.resolve(s);
-    renderer::ProbeUpdater updater(context, s, g, tr->updater(env));
+    renderer::UpdaterOptions uo = tr->updater(env);
+    uo.areaLights = areaLights->options();
+    renderer::ProbeUpdater updater(context, s, g, uo);
     fmt::print("bake: {} ({} triangles) on {}, grid {}x{}x{}, {} samples/probe, environment {}\n", s.name,
                s.triangleCount(), context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp,
                env ? env->name : "none");
@@ -39,6 +43,10 @@ void addBakeCommand(CLI::App& app) {
     }
     ProbeVolume volume = updater.volume();
     volume.samplesPerProbe = tr->tracer.spp;  // as asked for (the updater traces it rounded up to 32s)
+    volume.areaLights = session::areaLightRuleOf(uo.areaLights);  // so viewers light what the probes left out
+    fmt::print("bake: client area lights {}\n",
+               uo.areaLights.enabled ? fmt::format("on (emitters of at least {} of the power)", uo.areaLights.minPowerFraction)
+                                     : "off (the probes hold every emitter)");
     std::string error;
     orThrow(writeProbeFile(*out, volume, error), error);
     if (context.validationMessages() > 0)

@@ -20,6 +20,7 @@ std::atomic<bool> gInterrupted{false};
 
 struct ServeOptions {
   TracingOptions tracing;
+  AreaLightCli areaLights{"auto"};  // auto: live, the default; a file, its own rule
   ServerOptions server;
   std::string probes, repr = "zh3";
   std::string publish, stream = "probes";
@@ -44,7 +45,9 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
       throw std::runtime_error("--noise-scale needs live tracing: a --probes file carries no per-probe noise");
     std::string error;
     orThrow(readProbeFile(o.probes, file, error), error);
+    o.areaLights.follow(file.areaLights, o.probes);  // a file's rule is what it was traced with
     hub = service::hubConfigFor(file.grid, repr, o.brick, o.deadzone);
+    hub.areaLights = file.areaLights;
     what = o.probes;
   } else {
     s = tr.scene.load();
@@ -62,7 +65,9 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     animation.start = tr.scene.t;
     animation.perStep = static_cast<float>(o.animate / o.hz);
     animation.reloadScene = session::sceneAnimates(tr.scene.scene);  // a glTF file is the same at every t
-    producer->traceScene(*context, tr.scene.scene, s, g, tr.updater(tr.scene.environment.load()), animation);
+    renderer::UpdaterOptions uo = tr.updater(tr.scene.environment.load());
+    uo.areaLights = o.areaLights.options();
+    producer->traceScene(*context, tr.scene.scene, s, g, uo, animation);
   }
   return producer;
 }
@@ -71,6 +76,7 @@ void addServeCommand(CLI::App& app) {
   CLI::App* serve = app.add_subcommand("serve", "stream probes over gRPC (live from the updater or a probe file)");
   auto o = std::make_shared<ServeOptions>();
   o->tracing.add(serve);
+  o->areaLights.add(serve, /*follows=*/true);
   serve->add_option("--probes", o->probes, "serve a baked probe volume file instead of tracing live");
   addRepresentationOption(serve, o->repr, "l1, zh3h, zh3, l2 or fp16");
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
@@ -105,9 +111,11 @@ void addServeCommand(CLI::App& app) {
       fmt::print("serve: publishing to {} as stream {} (subjects {})\n", bus.url, service::busStreamName(bus.stream),
                  service::busSubjects(bus.stream));
     }
-    fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}\n", what, port,
+    const AreaLightRule rule = producer->hub().volume().areaLights;
+    fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}, client area lights {}\n", what, port,
                sc.tlsCertPem.empty() ? "plaintext" : "TLS", representationName(hc.layout.repr), hc.layout.grid[0],
-               hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file");
+               hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file",
+               rule.on() ? fmt::format("on ({})", rule.minPowerFraction) : "off");
     std::fflush(stdout);
     std::signal(SIGINT, [](int) { gInterrupted = true; });
     std::signal(SIGTERM, [](int) { gInterrupted = true; });

@@ -22,7 +22,7 @@ struct ViewOptions {
   std::string probes = "live", views = "lf:5x5", out = "out/view";
   std::string repr = "float", passes = "per-view", toneMap = "filmic";
   uint32_t shadowMap = 1024, shadowCascades = 4;
-  AreaLightCli areaLights;
+  AreaLightCli areaLights{"auto"};  // live: the default; a file or a server: as their probes say
   double waitSeconds = 3.0;
   std::vector<uint32_t> size{320, 200};
   uint32_t updates = 4;
@@ -38,6 +38,14 @@ struct Rendered {
   double viewsMs = 0.0, shadowMs = 0.0;
 };
 
+void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) {
+  if (rule.on())
+    fmt::print("view: client area lights on as the probes say (emitters of at least {} of the power): {} lights\n",
+               rule.minPowerFraction, set.lights.size());
+  else
+    fmt::print("view: client area lights off (the probes hold every emitter)\n");
+}
+
 // A viewer of a server's stream: subscribe for --wait seconds, then render what it holds.
 Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
                           const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
@@ -47,6 +55,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   vc.raster = ro;
   vc.client = o.connection.client("probecast-view");
   vc.client.zh3PerPixel = true;
+  if (o.areaLights.mode != "auto") vc.areaLights = o.areaLights.mode == "on";
   session::Viewer viewer(context, s, views, vc);
   viewer.start();
   viewer.waitFor(o.waitSeconds);
@@ -60,16 +69,19 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
     throw std::runtime_error("no probe volume from " + o.connection.connect + ": " + st.lastError);
   fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o.connection.connect);
   if (o.repr != "float") throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
+  o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
+  printAreaLights(viewer.areaLightRule(), viewer.areaLights());
   return {viewer.images(), viewer.timings().viewsMs, viewer.timings().shadowMs};
 }
 
 // Local probes: traced now (--probes live) or read from a file, through --repr when given.
 Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
-                     const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
+                     const std::vector<renderer::ViewInfo>& views, renderer::RasterOptions ro) {
   ProbeVolume volume;
   if (o.probes == "live") {
     renderer::UpdaterOptions uo = o.tracing.updater(ro.environment);
+    ro.areaLights = o.areaLights.options();
     uo.areaLights = ro.areaLights;  // the probes leave out exactly what this viewer lights
     renderer::ProbeUpdater updater(context, s, o.tracing.grid.resolve(s), uo);
     Progress progress("view", /*bar=*/false);
@@ -79,14 +91,17 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
     }
     progress.finish();
     volume = updater.volume();
+    volume.areaLights = session::areaLightRuleOf(uo.areaLights);
   } else {
     std::string error;
     orThrow(readProbeFile(o.probes, volume, error), error);
+    ro.areaLights = o.areaLights.follow(volume.areaLights, o.probes);
   }
   if (o.repr != "float")
     volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
   renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
   raster.setProbes(volume);
+  printAreaLights(volume.areaLights, raster.areaLights());
   if (raster.visibilityActive())
     fmt::print("view: probe visibility for {} probes made in {:.1f} ms (depth cubes, {} triangles drawn) + {:.1f} ms "
                "(moments), {} bytes per probe\n",
@@ -145,7 +160,7 @@ void addViewCommand(CLI::App& app) {
       ->check(CLI::Range(0.0f, 1e6f));
   cmd->add_option("--visibility-culling", o->visibilityCulling,
                   "on: each depth-cube face draws only the triangles within reach; off: all (same result)");
-  o->areaLights.add(cmd);
+  o->areaLights.add(cmd, /*follows=*/true);
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
     renderer::ViewSetSpec spec;
@@ -164,10 +179,6 @@ void addViewCommand(CLI::App& app) {
     ro.visibilityReach = o->visibilityReach;
     ro.visibilityCulling = o->visibilityCulling;
     ro.environment = environment;
-    ro.areaLights = o->areaLights.options();
-    if (ro.areaLights.enabled && (o->probes != "live" || !o->connection.connect.empty()))
-      throw std::runtime_error("--area-lights on needs --probes live: probes from a file or a server hold the "
-                               "emitters' direct light already, and it would be counted twice");
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);
     writeViews(*o, r, views, spec);

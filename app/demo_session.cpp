@@ -42,6 +42,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   renderer::UpdaterOptions uo;
   uo.samplesPerProbe = o.spp;
   uo.environment = o.sky;
+  uo.areaLights = o.areaLights.options();  // stated in the description: the viewers light the same emitters
   session::Animation animation;
   animation.mode = session::Animation::Mode::WallClock;
   animation.ratePerSecond = o.turnsPerMinute / 60.0;
@@ -54,8 +55,10 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   const int port = run.producer->serve(sc);
   sc.listen = fmt::format("127.0.0.1:{}", port);
   fmt::print(
-      "demo: server on 127.0.0.1:{} lighting {} ({}x{}x{} probes, {} spp/update, {}), light moving for {:.0f} s\n",
-      port, run.scene0.name, run.grid.dims[0], run.grid.dims[1], run.grid.dims[2], o.spp, o.repr, o.seconds);
+      "demo: server on 127.0.0.1:{} lighting {} ({}x{}x{} probes, {} spp/update, {}, client area lights {}), light "
+      "moving for {:.0f} s\n",
+      port, run.scene0.name, run.grid.dims[0], run.grid.dims[1], run.grid.dims[2], o.spp, o.repr, o.areaLights.mode,
+      o.seconds);
   return sc;
 }
 

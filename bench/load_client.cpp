@@ -122,8 +122,9 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
     StreamLayout layout;
     GridBounds bounds;
     std::string why;
-    std::vector<float> offsets;  // where the probes are: not needed to count bytes
-    if (!service::volumeFromWire(v, layout, bounds, offsets, why)) {
+    std::vector<float> offsets;  // where the probes are and what they leave out: not needed to count bytes
+    AreaLightRule areaLights;
+    if (!service::volumeFromWire(v, layout, bounds, offsets, areaLights, why)) {
       tally_.error("bad volume description: " + why);
       return;
     }

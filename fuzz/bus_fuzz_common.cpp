@@ -21,7 +21,8 @@ std::vector<std::vector<uint8_t>> sampleBusMessages() {
     out.push_back(m);
     const uint32_t n = probeCount(volume.layout);
     // The same volume with probe offsets (3 bytes per probe in the volume message, their checksum
-    // in every brick message below).
+    // in every brick message below) and client area lights.
+    volume.areaLights = {kAreaLightRuleVersion, 0.05f};
     volume.offsets.resize(static_cast<size_t>(n) * 3);
     for (size_t i = 0; i < volume.offsets.size(); ++i) volume.offsets[i] = static_cast<int8_t>(static_cast<int>(i % 11) * 23 - 115);
     bus::writeVolumeMessage(volume, 0, m);

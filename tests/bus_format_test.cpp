@@ -23,6 +23,7 @@ Volume sampleVolume() {
   v.layout.brickDim = 4;
   v.layout.repr = Representation::Zh3;
   v.bounds = {{-2.0f, 0.0f, -2.0f}, {1.5f, 1.5f, 5.5f}};
+  v.areaLights = {kAreaLightRuleVersion, 0.25f};
   return v;
 }
 
@@ -69,15 +70,16 @@ void reseal(std::vector<uint8_t>& m) {
 }
 
 TEST(BusFormat, VolumeMessageGoldenBytes) {
-  // Written out by hand from the format in bus_format.h; the CRC-32C is of bytes 0-11 and 16-71,
+  // Written out by hand from the format in bus_format.h; the CRC-32C is of bytes 0-11 and 16-79,
   // computed independently.
   const uint8_t golden[] = {
-      0x50, 0x43, 0x42, 0x4d, 0x02, 0x01, 0x01, 0x00, 0x38, 0x00, 0x00, 0x00, 0x42, 0x00, 0x46, 0x95,  // header
+      0x50, 0x43, 0x42, 0x4d, 0x03, 0x01, 0x01, 0x00, 0x40, 0x00, 0x00, 0x00, 0x19, 0xaf, 0x25, 0xfb,  // header
       0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01, 0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11,  // epoch, time
       0x01, 0x03, 0x04, 0x00, 0x10, 0x00, 0x04, 0x00, 0x10, 0x00, 0x00, 0x00,                          // layout, no offsets
       0x00, 0x00, 0x00, 0xc0, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xc0,                          // min
       0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xb0, 0x40,                          // max
-      0x00, 0x00, 0x00, 0x00};                                                                         // offsets CRC
+      0x00, 0x00, 0x00, 0x00,                                                                          // offsets CRC
+      0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3e};                                                 // area light rule
   std::vector<uint8_t> out;
   writeVolumeMessage(sampleVolume(), kEndOfBatch, out);
   EXPECT_EQ(out, std::vector<uint8_t>(std::begin(golden), std::end(golden)));
@@ -91,6 +93,7 @@ TEST(BusFormat, VolumeMessageGoldenBytes) {
   EXPECT_EQ(m.volume.layout.grid[2], 16);
   EXPECT_EQ(m.volume.layout.repr, Representation::Zh3);
   EXPECT_EQ(m.volume.bounds.max[2], 5.5f);
+  EXPECT_EQ(m.volume.areaLights, (AreaLightRule{kAreaLightRuleVersion, 0.25f}));
 }
 
 TEST(BusFormat, BrickMessageRoundTripsAndItsSectionsDecode) {
@@ -148,12 +151,18 @@ TEST(BusFormat, FieldsBehindTheChecksumAreCheckedToo) {
     reseal(m);
     return refusal(m);
   };
-  const uint8_t version1 = 1, kindBad = 7, reprBad = 9;
+  const uint8_t version1 = 1, version2 = 2, kindBad = 7, reprBad = 9;
   const uint16_t flagsBad = 2, gridHuge = 60000;
   const uint64_t epoch0 = 0;
   const uint32_t brickOut = 64, version0 = 0, lying = 0xffffffffu;
   const float nan = std::nanf(""), negative = -1.0f, inf = INFINITY;
   EXPECT_NE(with(4, &version1, 1).find("bus format version 1"), std::string::npos);  // before the offsets
+  EXPECT_NE(with(4, &version2, 1).find("bus format version 2"), std::string::npos);  // before the rule
+  const uint32_t ruleUnknown = 2;
+  const float share = 1.5f;
+  EXPECT_NE(with(kHeaderSize + 56, &ruleUnknown, 4).find("rule version 2 is unknown"), std::string::npos);
+  EXPECT_NE(with(kHeaderSize + 60, &share, 4).find("power share"), std::string::npos);
+  EXPECT_NE(with(kHeaderSize + 60, &nan, 4).find("power share"), std::string::npos);
   EXPECT_NE(with(5, &kindBad, 1).find("kind"), std::string::npos);
   EXPECT_NE(with(6, &flagsBad, 2).find("flags"), std::string::npos);
   EXPECT_NE(with(kHeaderSize, &epoch0, 8).find("epoch"), std::string::npos);

@@ -121,6 +121,34 @@ TEST(EdgeHub, ProbeOffsetsComeOnceInTheVolumeMessageAndTheEdgeWaitsForThem) {
   EXPECT_EQ(edge.reconstruction().offsets, offsets);
 }
 
+// Every bus message states the area light rule: an edge describes its volume with the producer's,
+// a message of the same epoch with another rule is refused, and a new rule is a new epoch.
+TEST(EdgeHub, TheAreaLightRuleComesWithEveryMessageAndAChangeIsANewEpoch) {
+  Producer p;
+  const AreaLightRule rule{kAreaLightRuleVersion, 0.2f};
+  p.hub.setAreaLightRule(rule);
+  for (int f = 0; f < 2; ++f) p.publish();
+  ProbeHub edge(gridConfig(), FromBus{});
+  feedAll(edge, p.messages);
+  ASSERT_TRUE(edge.ready());
+  EXPECT_EQ(edge.volume().areaLights, rule);
+  EXPECT_EQ(edge.reconstruction().areaLights, rule);
+  bus::Volume other = p.hub.volume();
+  other.areaLights.minPowerFraction = 0.3f;
+  std::vector<uint8_t> volume;
+  bus::writeVolumeMessage(other, 0, volume);
+  std::string why;
+  EXPECT_EQ(feed(edge, volume, &why), ProbeHub::Received::Refused);
+  EXPECT_NE(why.find("another volume"), std::string::npos) << why;
+  EXPECT_EQ(edge.volume().areaLights, rule);
+  const uint64_t epoch = p.hub.epoch();
+  p.hub.setAreaLightRule({});  // off after publishing: what subscribers were told no longer holds
+  EXPECT_NE(p.hub.epoch(), epoch);
+  p.publish();
+  EXPECT_EQ(feed(edge, p.messages.back()), ProbeHub::Received::NewEpoch);
+  EXPECT_FALSE(edge.volume().areaLights.on());
+}
+
 TEST(EdgeHub, ASubscriberMovingToAnotherEdgeResumesWithDeltas) {
   Producer p;
   ProbeHub a(gridConfig(), FromBus{}), b(gridConfig(), FromBus{});

@@ -30,7 +30,7 @@ std::unique_ptr<pb::ProbeStream::Stub> stubFor(int port) {
 
 pb::ClientMessage helloMessage() {
   pb::ClientMessage m;
-  m.mutable_hello()->set_protocol_version(2);
+  m.mutable_hello()->set_protocol_version(3);
   return m;
 }
 
@@ -310,7 +310,7 @@ class FixedVolumeServer final : public pb::ProbeStream::Service {
 // Defect 6, client side: a bad server's numbers are range-checked before narrowing, not wrapped.
 TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
   pb::VolumeDescription good;
-  good.set_protocol_version(2);
+  good.set_protocol_version(3);
   good.set_codec_format_version(kFormatVersion);
   good.set_grid_x(16);
   good.set_grid_y(4);
@@ -342,6 +342,20 @@ TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
          v.set_probe_offsets(q);
        },
        "probe 17 y offset of -128 steps"},
+      // Client area lights: a rule this build does not know, a threshold that is no power share,
+      // a threshold with the rule off.
+      {[](pb::VolumeDescription& v) { v.set_area_light_rule(2); }, "area light rule version 2 is unknown"},
+      {[](pb::VolumeDescription& v) {
+         v.set_area_light_rule(1);
+         v.set_area_light_min(std::nanf(""));
+       },
+       "threshold is not a power share"},
+      {[](pb::VolumeDescription& v) {
+         v.set_area_light_rule(1);
+         v.set_area_light_min(-0.25f);
+       },
+       "threshold is not a power share"},
+      {[](pb::VolumeDescription& v) { v.set_area_light_min(0.05f); }, "off but a threshold"},
   };
   for (const Case& c : cases) {
     pb::VolumeDescription bad = good;

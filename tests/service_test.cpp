@@ -131,7 +131,7 @@ TEST(Service, StalledSubscriberDoesNotDelayOthers) {
   stalledCtx.AddMetadata("authorization", std::string("Bearer ") + kToken);
   auto stalled = stub->Subscribe(&stalledCtx);
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(2);
+  hello.mutable_hello()->set_protocol_version(3);
   ASSERT_TRUE(stalled->Write(hello));
 
   Producer producer(hub, 60, 10ms);
@@ -159,7 +159,7 @@ TEST(Service, WrongTokenIsUnauthenticatedAndGetsNoPayload) {
   ctx.AddMetadata("authorization", "Bearer nope");
   auto stream = stub->Subscribe(&ctx);
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(2);
+  hello.mutable_hello()->set_protocol_version(3);
   stream->Write(hello);
   pb::ServerMessage msg;
   EXPECT_FALSE(stream->Read(&msg));
@@ -190,16 +190,18 @@ TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {
       grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
 
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(2);
+  hello.mutable_hello()->set_protocol_version(3);
   pb::ClientMessage views;  // a first message that is not hello
   views.mutable_views()->add_views()->add_view_projection(1.0f);
   EXPECT_EQ(statusAfter(*stub, views).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
   pb::ClientMessage v2 = hello;
-  v2.mutable_hello()->set_protocol_version(1);  // before the probe offsets
-  const grpc::Status wrongVersion = statusAfter(*stub, v2);
-  EXPECT_EQ(wrongVersion.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_NE(wrongVersion.error_message().find("protocol version"), std::string::npos);
+  for (uint32_t old : {1u, 2u}) {  // before the probe offsets; before the area light rule
+    v2.mutable_hello()->set_protocol_version(old);
+    const grpc::Status wrongVersion = statusAfter(*stub, v2);
+    EXPECT_EQ(wrongVersion.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(wrongVersion.error_message().find("protocol version " + std::to_string(old)), std::string::npos);
+  }
 
   pb::ClientMessage shortMatrix;  // 15 floats
   for (int i = 0; i < 15; ++i) shortMatrix.mutable_views()->mutable_views()->Add()->add_view_projection(0.0f);
@@ -333,6 +335,14 @@ std::vector<float> sampleOffsets(const ProbeGrid& g) {
   return o;
 }
 
+// Waits until `client` holds what the server has after the producer's 3 frames; false (with the
+// client's last error reported) if it does not within 10 s.
+bool convergedSnapshot(ProbeClient& client, ProbeHub& hub, const Producer& producer, VolumeSnapshot& snap) {
+  const bool held = waitFor([&] { return matchesServer(client, hub) && producer.published() == 3; }, 10s);
+  EXPECT_TRUE(held) << client.stats().lastError;
+  return held && client.snapshot(snap);
+}
+
 TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
   ProbeHub hub(volumeConfig());
   const ProbeGrid g = gridOf(hub.layout(), hub.bounds());
@@ -348,10 +358,8 @@ TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
   Producer producer(hub, 3, 20ms);
   ProbeClient client(clientFor(server.port()));
   client.start();
-  ASSERT_TRUE(waitFor([&] { return matchesServer(client, hub) && producer.published() == 3; }, 10s))
-      << client.stats().lastError;
   VolumeSnapshot snap;
-  ASSERT_TRUE(client.snapshot(snap));
+  ASSERT_TRUE(convergedSnapshot(client, hub, producer, snap));
   EXPECT_EQ(snap.volume.offsets, offsets);  // bit for bit
   EXPECT_EQ(hub.reconstruction().offsets, offsets);
   EXPECT_EQ(hub.epoch(), epoch);
@@ -372,6 +380,36 @@ TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
   EXPECT_NE(hub.epoch(), epoch);
   ASSERT_TRUE(waitFor([&] { return client.snapshot(snap) && snap.volume.offsets == next; }, 10s))
       << client.stats().lastError;
+  client.stop();
+}
+
+// The client area light rule travels in the description: a client holds the rule its probes were
+// made with, and a new rule (a producer restarted with area lights on) is a new epoch.
+TEST(Service, AreaLightRuleReachesTheClientAndAChangeStartsANewEpoch) {
+  HubConfig config = volumeConfig();
+  config.areaLights = {kAreaLightRuleVersion, 0.125f};
+  ProbeHub hub(config);
+  EXPECT_THROW(hub.setAreaLightRule({kAreaLightRuleVersion, 2.0f}), std::invalid_argument);
+  EXPECT_THROW(hub.setAreaLightRule({7, 0.05f}), std::invalid_argument);
+  HubConfig bad = volumeConfig();
+  bad.areaLights = {0, 0.5f};
+  EXPECT_THROW(ProbeHub{bad}, std::invalid_argument);
+  const uint64_t epoch = hub.epoch();
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 3, 20ms);
+  ProbeClient client(clientFor(server.port()));
+  client.start();
+  VolumeSnapshot snap;
+  ASSERT_TRUE(convergedSnapshot(client, hub, producer, snap));
+  EXPECT_EQ(snap.volume.areaLights, config.areaLights);
+  EXPECT_EQ(hub.reconstruction().areaLights, config.areaLights);
+  EXPECT_EQ(hub.epoch(), epoch);
+  producer.stop();
+  hub.setAreaLightRule({});  // off: the probes hold every emitter again
+  EXPECT_NE(hub.epoch(), epoch);
+  ASSERT_TRUE(waitFor([&] { return client.snapshot(snap) && !snap.volume.areaLights.on(); }, 10s))
+      << client.stats().lastError;
+  EXPECT_GE(client.stats().connects, 2u);
   client.stop();
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -47,6 +48,43 @@ TEST(SessionVolumes, HubConfigCarriesGridBoundsAndEncoderSettings) {
   EXPECT_EQ(hc.encoder.deadzone, 2);
   EXPECT_EQ(hc.bounds.max[0], 7.0f);
   EXPECT_EQ(hc.bounds.max[1], 3.0f);
+}
+
+TEST(SessionVolumes, AreaLightOptionsAndTheStatedRuleAreOneDecision) {
+  scene::AreaLightOptions o;
+  EXPECT_FALSE(areaLightRuleOf(o).on());  // off: the probes hold every emitter
+  o.enabled = true;
+  o.minPowerFraction = 0.125f;
+  const AreaLightRule rule = areaLightRuleOf(o);
+  EXPECT_EQ(rule, (AreaLightRule{kAreaLightRuleVersion, 0.125f}));
+  const scene::AreaLightOptions back = areaLightOptionsOf(rule);
+  EXPECT_TRUE(back.enabled);
+  EXPECT_EQ(back.minPowerFraction, 0.125f);
+  EXPECT_EQ(back.maxLights, o.maxLights);
+  EXPECT_EQ(back.maxTriangles, o.maxTriangles);
+  EXPECT_FALSE(areaLightOptionsOf({}).enabled);
+  // Caps a viewer could not know, a threshold that is no share, and unknown rules are refused.
+  scene::AreaLightOptions caps = o;
+  caps.maxLights = 3;
+  EXPECT_THROW(areaLightRuleOf(caps), std::invalid_argument);
+  o.minPowerFraction = std::nanf("");
+  EXPECT_THROW(areaLightRuleOf(o), std::invalid_argument);
+  EXPECT_THROW(areaLightOptionsOf({9, 0.1f}), std::invalid_argument);
+  // A viewer follows the rule, or is refused when it asks for the opposite or another threshold.
+  EXPECT_TRUE(followAreaLightRule(rule, std::nullopt, std::nullopt, "x").enabled);
+  EXPECT_TRUE(followAreaLightRule(rule, true, 0.125f, "x").enabled);
+  EXPECT_FALSE(followAreaLightRule({}, false, std::nullopt, "x").enabled);
+  const auto refusal = [](const AreaLightRule& r, std::optional<bool> wanted, std::optional<float> min) {
+    try {
+      followAreaLightRule(r, wanted, min, "the server");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal(rule, false, std::nullopt).find("would be lost"), std::string::npos);
+  EXPECT_NE(refusal({}, true, std::nullopt).find("twice"), std::string::npos);
+  EXPECT_NE(refusal(rule, std::nullopt, 0.5f).find("were made with 0.125"), std::string::npos);
 }
 
 TEST(SessionVolumes, AnL1OnlyHolderIsComparedOnItsTwelveFloats) {

@@ -424,7 +424,7 @@ TEST(ProbeFile, OffsetsRoundTripAndVersion1FilesAreStillRead) {
   ProbeVolume old = v;
   old.offsets.clear();
   serializeProbeVolume(old, bytes);
-  bytes.erase(bytes.end() - 8, bytes.end() - 4);  // the zero offset count
+  bytes.erase(bytes.end() - 16, bytes.end() - 4);  // the zero offset count and the rule
   bytes[4] = 1;
   bytes.resize(bytes.size() - 4);
   const uint32_t crc = crc32c(bytes.data(), bytes.size());
@@ -444,6 +444,49 @@ TEST(ProbeFile, OffsetsRoundTripAndVersion1FilesAreStillRead) {
   refusedWith(3 * 2, 0.51f, "more than half its cell");
   refusedWith(3 * 2 + 1, std::nanf(""), "non-finite");
   refusedWith(3 * 5 + 2, 0.01f, "more than half its cell (0");  // z has one probe
+}
+
+// Bytes of `v` as a file of `version` (2: without the rule), checksum renewed.
+std::vector<uint8_t> probeFileAs(const ProbeVolume& v, uint8_t version) {
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(v, bytes);
+  bytes.resize(bytes.size() - 4);
+  if (version == 2) bytes.resize(bytes.size() - 8);
+  bytes[4] = version;
+  const uint32_t crc = crc32c(bytes.data(), bytes.size());
+  for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(crc >> (8 * i)));
+  return bytes;
+}
+
+TEST(ProbeFile, AreaLightRuleRoundTripsOldFilesReadAsOffAndABadRuleIsRefused) {
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{2, 2, 1}, {{0, 0, 0}, {1, 1, 0}}});
+  v.areaLights = {kAreaLightRuleVersion, 0.125f};
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(v, bytes);
+  ProbeVolume back;
+  std::string error;
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_EQ(back.areaLights, v.areaLights);
+  for (size_t len = 0; len < bytes.size(); ++len) EXPECT_FALSE(parseProbeVolume(bytes.data(), len, back, error)) << len;
+
+  // A version 2 file (before the rule) holds every emitter: read with the rule off.
+  bytes = probeFileAs(v, 2);
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_FALSE(back.areaLights.on());
+
+  // An unknown rule version, a threshold outside [0, 1] or NaN, or a threshold with the rule off
+  // are refused under a valid checksum.
+  const auto refusedWith = [&](AreaLightRule rule, const std::string& why) {
+    ProbeVolume bad = v;
+    bad.areaLights = rule;
+    bytes = probeFileAs(bad, 3);
+    EXPECT_FALSE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << rule.version;
+    EXPECT_NE(error.find(why), std::string::npos) << error;
+  };
+  refusedWith({2, 0.05f}, "rule version 2 is unknown");
+  refusedWith({1, 1.5f}, "threshold is not a power share");
+  refusedWith({1, std::nanf("")}, "threshold is not a power share");
+  refusedWith({0, 0.05f}, "off but a threshold");
 }
 
 }  // namespace

@@ -15,7 +15,7 @@ namespace probecast {
 namespace {
 
 constexpr uint8_t kMagic[4] = {'P', 'C', 'P', 'V'};
-constexpr uint32_t kVersion = 2;  // 2 adds the offsets; 1 is still read
+constexpr uint32_t kVersion = 3;  // 2 adds the offsets, 3 the area light rule; 1 and 2 are still read
 constexpr size_t kHeaderBytes = 4 + 4 + 12 + 24 + 8;
 
 void putF32(std::vector<uint8_t>& out, float v) {
@@ -45,6 +45,8 @@ void serializeProbeVolume(const ProbeVolume& v, std::vector<uint8_t>& out) {
   out.insert(out.end(), v.active.begin(), v.active.end());
   putU32(out, static_cast<uint32_t>(v.offsets.size()));
   for (float f : v.offsets) putF32(out, f);
+  putU32(out, v.areaLights.version);
+  putF32(out, v.areaLights.minPowerFraction);
   putU32(out, crc32c(out.data(), out.size()));
 }
 
@@ -52,8 +54,8 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
   if (size < kHeaderBytes + 4) return error = "truncated probe file header", false;
   if (std::memcmp(data, kMagic, 4) != 0) return error = "not a probecast probe file (bad magic)", false;
   const uint32_t version = getU32(data + 4);
-  if (version != 1 && version != kVersion)
-    return error = "unsupported probe file version " + std::to_string(version) + " (this build reads 1 and 2)", false;
+  if (version < 1 || version > kVersion)
+    return error = "unsupported probe file version " + std::to_string(version) + " (this build reads 1 to 3)", false;
   ProbeVolume out;
   uint64_t count = 1;
   for (int a = 0; a < 3; ++a) {
@@ -80,7 +82,8 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
                      std::to_string(count) + " probes (3 each, or none)",
              false;
   }
-  const uint64_t expected = samplesEnd + (version >= 2 ? 4 + offsetFloats * 4 : 0) + 4;
+  const uint64_t ruleAt = samplesEnd + (version >= 2 ? 4 + offsetFloats * 4 : 0);
+  const uint64_t expected = ruleAt + (version >= 3 ? 8 : 0) + 4;
   if (size != expected)
     return error = "probe file is " + std::to_string(size) + " bytes, expected " + std::to_string(expected), false;
   if (crc32c(data, size - 4) != getU32(data + size - 4)) return error = "probe file checksum mismatch", false;
@@ -96,6 +99,11 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
   out.offsets.resize(offsetFloats);
   for (size_t i = 0; i < out.offsets.size(); ++i) out.offsets[i] = getF32(data + samplesEnd + 4 + 4 * i);
   if (!checkProbeOffsets(out.grid, out.offsets, error)) return false;
+  if (version >= 3) {
+    out.areaLights.version = getU32(data + ruleAt);
+    out.areaLights.minPowerFraction = getF32(data + ruleAt + 4);
+    if (!checkAreaLightRule(out.areaLights, error)) return false;
+  }
   v = std::move(out);
   return true;
 }

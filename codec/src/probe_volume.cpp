@@ -70,7 +70,21 @@ bool checkProbeVolume(const ProbeVolume& v, std::string& error) {
   for (size_t i = 0; i < v.noise.size(); ++i)
     if (!(std::isfinite(v.noise[i]) && v.noise[i] >= 0.0f))
       return error = "probe volume: noise of probe " + std::to_string(i) + " is not a finite value >= 0", false;
-  return checkProbeOffsets(v.grid, v.offsets, error);
+  return checkAreaLightRule(v.areaLights, error) && checkProbeOffsets(v.grid, v.offsets, error);
+}
+
+bool checkAreaLightRule(const AreaLightRule& r, std::string& error) {
+  if (r.version == 0) {
+    if (r.minPowerFraction != 0.0f) return error = "client area lights are off but a threshold is given", false;
+    return true;
+  }
+  if (r.version != kAreaLightRuleVersion)
+    return error = "client area light rule version " + std::to_string(r.version) + " is unknown (this build knows " +
+                   std::to_string(kAreaLightRuleVersion) + ")",
+           false;
+  if (!(r.minPowerFraction >= 0.0f && r.minPowerFraction <= 1.0f))  // NaN fails too
+    return error = "client area light threshold is not a power share in [0, 1]", false;
+  return true;
 }
 
 ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel) {

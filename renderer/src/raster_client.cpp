@@ -592,6 +592,11 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   s.writeDescriptors();
 }
 
+void RasterRenderer::setAreaLights(const scene::Scene& scene, const scene::AreaLightOptions& options) {
+  impl_->options.areaLights = options;
+  setShading(scene);
+}
+
 std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& views) {
   Impl& s = *impl_;
   if (views.size() > Impl::kMaxViews)

@@ -60,6 +60,8 @@ void writeVolume(const Volume& v, std::vector<uint8_t>& out) {
   for (float f : v.bounds.min) put(out, f);
   for (float f : v.bounds.max) put(out, f);
   put(out, v.offsets.empty() ? v.offsetsCrc : offsetsChecksum(v.offsets));
+  put(out, v.areaLights.version);
+  put(out, v.areaLights.minPowerFraction);
 }
 
 bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
@@ -76,6 +78,8 @@ bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
   v.offsetsCrc = get<uint32_t>(p + 52);
   v.offsets.clear();
   if (!v.hasOffsets && v.offsetsCrc != 0) return why = "a volume without offsets announces an offsets checksum", false;
+  v.areaLights = {get<uint32_t>(p + 56), get<float>(p + 60)};
+  if (!checkAreaLightRule(v.areaLights, why)) return false;
   v.layout.repr = static_cast<Representation>(p[17]);
   v.layout.brickDim = p[18];
   for (int a = 0; a < 3; ++a) v.layout.grid[a] = get<uint16_t>(p + 20 + 2 * a);

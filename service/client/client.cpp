@@ -26,6 +26,7 @@ struct ProbeClient::Impl {
   StreamLayout layout;
   GridBounds bounds;
   std::vector<float> offsets;  // the description's probe offsets, metres
+  AreaLightRule areaLights;    // the description's client area light rule
   uint64_t epoch = 0;
   uint64_t newestServerTimeUs = 0;
   std::vector<uint32_t> latencies;  // ring of the most recent 4096
@@ -70,21 +71,23 @@ struct ProbeClient::Impl {
     StreamLayout l;
     GridBounds b;
     std::vector<float> o;
+    AreaLightRule r;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
-    if (!volumeFromWire(v, l, b, o, why)) {
+    if (!volumeFromWire(v, l, b, o, r, why)) {
       stats.lastError = "bad volume description: " + why;
       return false;
     }
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
-    if (!same || v.stream_epoch() != epoch) {  // nothing held is valid
+    if (!same || v.stream_epoch() != epoch || !(r == areaLights)) {  // nothing held is valid
       decoder = std::make_unique<StreamDecoder>(l);
       decoder->setZh3PerPixel(config.zh3PerPixel);
     }
     layout = l;
     bounds = b;
     offsets = std::move(o);
+    areaLights = r;
     epoch = v.stream_epoch();
     stats.connected = true;
     stats.connects += 1;
@@ -272,6 +275,7 @@ bool ProbeClient::snapshot(VolumeSnapshot& out) const {
   out.layout = impl_->layout;
   impl_->decoder->copyVolume(impl_->bounds, out.volume);
   out.volume.offsets = impl_->offsets;
+  out.volume.areaLights = impl_->areaLights;
   out.framesApplied = impl_->stats.framesApplied;
   out.newestServerTimeUs = impl_->newestServerTimeUs;
   return true;

@@ -21,10 +21,10 @@ uint64_t randomEpoch() {
 }
 
 bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBounds& bounds, bool hasOffsets,
-                uint32_t offsetsCrc) {
+                uint32_t offsetsCrc, const AreaLightRule& areaLights) {
   const StreamLayout& l = a.layout;
   bool same = l.repr == layout.repr && l.brickDim == layout.brickDim && a.hasOffsets == hasOffsets &&
-              a.offsetsCrc == offsetsCrc;
+              a.offsetsCrc == offsetsCrc && a.areaLights == areaLights;
   for (int i = 0; i < 3; ++i)
     same = same && l.grid[i] == layout.grid[i] && a.bounds.min[i] == bounds.min[i] && a.bounds.max[i] == bounds.max[i];
   return same;
@@ -44,6 +44,8 @@ bus::Brick busBrick(const BrickVersionBytes& v) {
 }
 
 ProbeHub::ProbeHub(const HubConfig& config) : config_(config), epoch_(randomEpoch()) {
+  std::string error;
+  if (!checkAreaLightRule(config.areaLights, error)) throw std::invalid_argument(error);
   hasOffsets_ = !config.offsets.empty();
   offsetsCrc_ = bus::offsetsChecksum(config.offsets);
   auto source = std::make_unique<EncoderBricks>(config.layout, config.encoder);
@@ -85,6 +87,7 @@ bus::Volume ProbeHub::volume() const {
   v.offsets = config_.offsets;
   v.hasOffsets = hasOffsets_;
   v.offsetsCrc = offsetsCrc_;
+  v.areaLights = config_.areaLights;
   return v;
 }
 
@@ -101,12 +104,30 @@ void ProbeHub::setProbeOffsets(const std::vector<float>& offsets) {
     config_.offsets = std::move(q);
     hasOffsets_ = !config_.offsets.empty();
     offsetsCrc_ = bus::offsetsChecksum(config_.offsets);
-    if (frame_ > 0 || !subscribers_.empty()) {  // what viewers were told no longer holds
-      epoch_ = randomEpoch();
-      endStreams(wakes);
-    }
+    describedAnew(wakes);
   }
   for (auto& w : wakes) w();
+}
+
+void ProbeHub::setAreaLightRule(const AreaLightRule& rule) {
+  std::vector<std::function<void()>> wakes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    encoderSource("setAreaLightRule");
+    std::string error;
+    if (!checkAreaLightRule(rule, error)) throw std::invalid_argument(error);
+    if (rule == config_.areaLights) return;
+    config_.areaLights = rule;
+    describedAnew(wakes);
+  }
+  for (auto& w : wakes) w();
+}
+
+void ProbeHub::describedAnew(std::vector<std::function<void()>>& wakes) {
+  if (frame_ > 0 || !subscribers_.empty()) {  // what viewers were told no longer holds
+    epoch_ = randomEpoch();
+    endStreams(wakes);
+  }
 }
 
 EncoderBricks& ProbeHub::encoderSource(const char* what) const {
@@ -201,6 +222,7 @@ void ProbeHub::startEpoch(const bus::Volume& volume, std::vector<std::function<v
   config_.offsets = volume.offsets;  // none yet when a brick message opens the epoch: the volume message brings them
   hasOffsets_ = volume.hasOffsets;
   offsetsCrc_ = volume.offsetsCrc;
+  config_.areaLights = volume.areaLights;
   epoch_ = volume.epoch;
   auto source = std::make_unique<BusBricks>(volume.layout);
   bus_ = source.get();
@@ -227,7 +249,7 @@ ProbeHub::Received ProbeHub::receive(const bus::Message& m, bool wake, std::stri
     if (!source_ || m.volume.epoch != epoch_) {
       startEpoch(m.volume, wakes);
       result = Received::NewEpoch;
-    } else if (!sameVolume(m.volume, config_.layout, config_.bounds, hasOffsets_, offsetsCrc_)) {
+    } else if (!sameVolume(m.volume, config_.layout, config_.bounds, hasOffsets_, offsetsCrc_, config_.areaLights)) {
       why = "a message of stream epoch " + std::to_string(epoch_) + " describes another volume than the epoch's";
       return Received::Refused;
     } else if (m.kind == bus::Kind::Volume && config_.offsets.empty() && !m.volume.offsets.empty()) {
@@ -463,6 +485,7 @@ ProbeVolume ProbeHub::reconstruction() const {
   std::string why;
   if (source_ && !dequantizeProbeOffsets(v.grid, config_.offsets.data(), config_.offsets.size(), v.offsets, why))
     v.offsets.clear();  // never: offsets are checked when they arrive
+  v.areaLights = config_.areaLights;
   return v;
 }
 

@@ -267,8 +267,7 @@ class SubscribeReactor : public RawReactor {
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
     out_.Clear();
-    const bus::Volume v = hub_.volume();
-    volumeToWire(v.layout, v.bounds, v.epoch, v.offsets, *out_.mutable_volume());
+    volumeToWire(hub_.volume(), *out_.mutable_volume());
     startWriteLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }
@@ -330,8 +329,7 @@ class Service final : public RawSubscribeService {
       reactor->Finish(notReady());
       return reactor;
     }
-    const bus::Volume v = hub_.volume();
-    volumeToWire(v.layout, v.bounds, v.epoch, v.offsets, *response);
+    volumeToWire(hub_.volume(), *response);
     reactor->Finish(grpc::Status::OK);
     return reactor;
   }

@@ -10,8 +10,9 @@ const char* const kShConvention =
     "real SH L0-L2 without the Condon-Shortley phase, index l(l+1)+m, 27 floats per probe coefficient-major "
     "(RGB per coefficient), incident radiance";
 
-void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t epoch,
-                  const std::vector<int8_t>& offsets, v1::VolumeDescription& out) {
+void volumeToWire(const bus::Volume& v, v1::VolumeDescription& out) {
+  const StreamLayout& layout = v.layout;
+  const GridBounds& bounds = v.bounds;
   out.set_protocol_version(kProtocolVersion);
   out.set_codec_format_version(kFormatVersion);
   out.set_grid_x(layout.grid[0]);
@@ -26,12 +27,14 @@ void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t
     out.add_bounds_max(bounds.max[a]);
   }
   out.set_sh_convention(kShConvention);
-  out.set_stream_epoch(epoch);
-  out.set_probe_offsets(reinterpret_cast<const char*>(offsets.data()), offsets.size());
+  out.set_stream_epoch(v.epoch);
+  out.set_probe_offsets(reinterpret_cast<const char*>(v.offsets.data()), v.offsets.size());
+  out.set_area_light_rule(v.areaLights.version);
+  out.set_area_light_min(v.areaLights.minPowerFraction);
 }
 
 bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds,
-                    std::vector<float>& offsets, std::string& why) {
+                    std::vector<float>& offsets, AreaLightRule& areaLights, std::string& why) {
   if (in.protocol_version() != kProtocolVersion)
     return why = "server speaks protocol version " + std::to_string(in.protocol_version()) + ", not " +
                  std::to_string(kProtocolVersion), false;
@@ -64,10 +67,13 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
     bounds.max[a] = in.bounds_max(a);
     if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a])) return why = "volume bounds not finite", false;
   }
+  const AreaLightRule rule{in.area_light_rule(), in.area_light_min()};
+  if (!checkAreaLightRule(rule, why)) return false;
   const std::string& q = in.probe_offsets();
   if (!dequantizeProbeOffsets(gridOf(l, bounds), reinterpret_cast<const int8_t*>(q.data()), q.size(), offsets, why))
     return false;
   layout = l;
+  areaLights = rule;
   return true;
 }
 

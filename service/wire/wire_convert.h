@@ -7,19 +7,19 @@
 #include "probecast.pb.h"
 #include "probecast/codec/priority.h"
 #include "probecast/codec/stream.h"
+#include "probecast/service/bus_format.h"
 
 namespace probecast::service {
 
-constexpr uint32_t kProtocolVersion = 2;  // 2: VolumeDescription.probe_offsets
+constexpr uint32_t kProtocolVersion = 3;  // 2: VolumeDescription.probe_offsets; 3: area_light_rule
 extern const char* const kShConvention;
 
-// `offsets`: quantised (probe_offsets.h), 3 per probe or none.
-void volumeToWire(const StreamLayout& layout, const GridBounds& bounds, uint64_t epoch,
-                  const std::vector<int8_t>& offsets, v1::VolumeDescription& out);
-// Validates a volume description from a server, its probe offsets too (returned in metres,
-// empty for none); `why` says what is wrong.
+// The hub's volume (bus_format.h): layout, bounds, epoch, quantised offsets and area light rule.
+void volumeToWire(const bus::Volume& volume, v1::VolumeDescription& out);
+// Validates a volume description from a server, its probe offsets (returned in metres, empty for
+// none) and area light rule too; `why` says what is wrong.
 bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds,
-                    std::vector<float>& offsets, std::string& why);
+                    std::vector<float>& offsets, AreaLightRule& areaLights, std::string& why);
 // Validates and converts views: count, 16 finite matrix entries each, finite eyes.
 bool viewsFromWire(const v1::ViewUpdate& in, uint32_t maxViews, std::vector<View>& out, std::string& why);
 void viewsToWire(const std::vector<View>& views, v1::ViewUpdate& out);

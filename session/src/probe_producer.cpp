@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
 
 namespace probecast::session {
 
@@ -39,12 +40,14 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
                                const renderer::UpdaterOptions& options, const Animation& animation) {
   updater_ = std::make_unique<renderer::ProbeUpdater>(context, first, grid, options);
   hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
+  hub_.setAreaLightRule(areaLightRuleOf(options.areaLights));  // what the probes leave out for viewers
   sceneSpec_ = sceneSpec;
   animation_ = animation;
   t_ = animation.start;
 }
 
 void ProbeProducer::serveVolume(const ProbeVolume& volume) {
+  hub_.setAreaLightRule(volume.areaLights);
   hub_.publish(volume);
 }
 

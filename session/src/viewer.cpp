@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "probecast/session/scene_loading.h"
+#include "probecast/session/volumes.h"
 
 namespace probecast::session {
 
@@ -27,10 +28,18 @@ std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views) {
 
 Viewer::Viewer(renderer::VulkanContext& context, const scene::Scene& scene, std::vector<renderer::ViewInfo> views,
                ViewerConfig config)
-    : config_(std::move(config)), views_(std::move(views)) {
+    : config_(std::move(config)), views_(std::move(views)), scene_(scene) {
   client_ = std::make_unique<service::ProbeClient>(config_.client);
   client_->setViews(priorityViews(views_));
+  config_.raster.areaLights = {};  // until a stream states its rule: a volume without one holds every emitter
   raster_ = std::make_unique<renderer::RasterRenderer>(context, scene, config_.width, config_.height, config_.raster);
+}
+
+void Viewer::followAreaLights(const AreaLightRule& rule) {
+  const scene::AreaLightOptions o = followAreaLightRule(rule, config_.areaLights, std::nullopt, config_.client.address);
+  if (rule == lit_) return;
+  raster_->setAreaLights(scene_, o);
+  lit_ = rule;
 }
 
 void Viewer::start() { client_->start(); }
@@ -49,6 +58,7 @@ bool Viewer::renderIfNew() {
 
 bool Viewer::render() {
   if (!client_->snapshot(held_)) return false;  // into the storage of the last snapshot
+  followAreaLights(held_.volume.areaLights);
   stats_.framesSeen = held_.framesApplied;
   if (config_.lightT) raster_->setShading(loadSceneOrThrow(config_.sceneSpec, config_.lightT()));
   raster_->setProbes(held_.volume);

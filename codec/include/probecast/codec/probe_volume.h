@@ -34,6 +34,23 @@ struct ProbeGrid {
 // cells of a dims[0] × dims[1] × dims[2] grid over the box, half a cell in from every face.
 ProbeGrid cellCentredGrid(const uint32_t dims[3], const float lo[3], const float hi[3]);
 
+// Which emitters the probes leave out for every viewer to light itself (client area lights,
+// scene/area_lights.h), stated by the producer so that a viewer applies the same rule: light is
+// then neither counted twice nor lost. version 0: none, the probes hold every emitter (and
+// minPowerFraction is 0). kAreaLightRuleVersion: area_lights.h's rule as this build has it (constant
+// emission only, at most 8 lights and 64 triangles) with the threshold minPowerFraction in [0, 1].
+// A new rule gets a new version; a viewer refuses one it does not know.
+constexpr uint32_t kAreaLightRuleVersion = 1;
+struct AreaLightRule {
+  uint32_t version = 0;
+  float minPowerFraction = 0.0f;  // share of the scene's emitted power an emitter needs
+  bool on() const { return version != 0; }
+  bool operator==(const AreaLightRule&) const = default;
+};
+// The rule above: version 0 with threshold 0, or kAreaLightRuleVersion with a threshold in [0, 1].
+// False with the reason in `error`.
+bool checkAreaLightRule(const AreaLightRule& rule, std::string& error);
+
 struct ProbeVolume {
   ProbeGrid grid;
   std::vector<float> probes;    // 27 floats per probe
@@ -57,6 +74,8 @@ struct ProbeVolume {
   // Relocation: per probe, 3 floats (x, y, z) in metres added to grid.position(i), the position the
   // probe is traced at and interpolated from; empty = every probe at its grid position.
   std::vector<float> offsets;
+  // The emitters these probes leave out (none unless the producer says so).
+  AreaLightRule areaLights;
 
   uint32_t count() const { return grid.count(); }
 };
@@ -67,8 +86,8 @@ ProbeVolume makeProbeVolume(const ProbeGrid& grid);
 // Checks what every consumer relies on: 1 to kMaxGridDim probes per axis and at most kMaxProbes,
 // finite bounds with max > min along every axis of two or more probes, 27 floats and one active
 // byte (0 or 1) per probe, every coefficient finite, `noise` empty or one finite value >= 0 per
-// probe, and `offsets` empty or 3 finite floats per probe, each within half a cell on its axis
-// (probeCellSize; 0 along an axis of one probe). False with the reason in `error`.
+// probe, `offsets` empty or 3 finite floats per probe, each within half a cell on its axis
+// (probeCellSize; 0 along an axis of one probe), and `areaLights` valid (checkAreaLightRule). False with the reason in `error`.
 bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back

@@ -99,6 +99,9 @@ class RasterRenderer {
   glm::vec2 probeMoments(uint32_t probe, const glm::vec3& dir) const;
   // The same geometry with new lights or materials (an animated scene); shadows are redrawn.
   void setShading(const scene::Scene& scene);
+  // The same, with client area lights by other options (those a stream's probes were made with:
+  // RasterOptions::areaLights from now on).
+  void setAreaLights(const scene::Scene& scene, const scene::AreaLightOptions& options);
   // Renders a view set; images in the order of `views`.
   std::vector<Image> renderViews(const std::vector<ViewInfo>& views);
   // Renders one view; `viewProj` maps world to Vulkan clip space (y down, z in [0, 1]).

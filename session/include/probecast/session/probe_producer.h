@@ -84,7 +84,7 @@ class ProbeProducer {
   // The lighting source (one of three). A traced scene: `first` is `sceneSpec` at the animation's start.
   void traceScene(renderer::VulkanContext& context, const std::string& sceneSpec, const scene::Scene& first,
                   const ProbeGrid& grid, const renderer::UpdaterOptions& options, const Animation& animation);
-  // A fixed volume: published once now; every step then only ticks the hub's budgets.
+  // A fixed volume (its area light rule with it): published once now; every step then only ticks the hub's budgets.
   void serveVolume(const ProbeVolume& volume);
   // Generated frames 0, 1, 2, … one per step while moving (setMoving), ticks otherwise.
   void generate(FrameGenerator generator);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,12 @@ std::vector<View> priorityViews(const std::vector<renderer::ViewInfo>& views);
 struct ViewerConfig {
   uint32_t width = 0, height = 0;  // of each view
   service::ClientConfig client;
-  renderer::RasterOptions raster;
+  renderer::RasterOptions raster;  // its areaLights give way to the stream's rule (below)
+  // Client area lights follow the rule the stream's probes were made with (its volume
+  // description): on exactly when the producer left emitters out, with its threshold, so light is
+  // neither counted twice nor lost. Set, the viewer asks for area lights on (true) or off (false)
+  // and render() throws std::runtime_error, rendering nothing, when the stream says otherwise.
+  std::optional<bool> areaLights;
   // Direct light is local: when set, every render first shades with `sceneSpec` at lightT().
   std::string sceneSpec;
   std::function<float()> lightT;
@@ -59,12 +65,20 @@ class Viewer {
   service::ClientStats clientStats() const { return client_->stats(); }
   bool snapshot(service::VolumeSnapshot& out) const { return client_->snapshot(out); }
   const renderer::RasterTimings& timings() const { return raster_->timings(); }
+  // The rule the viewer lights by now (that of the last volume rendered).
+  const AreaLightRule& areaLightRule() const { return lit_; }
+  const scene::AreaLightSet& areaLights() const { return raster_->areaLights(); }
 
  private:
   ViewerConfig config_;
   std::vector<renderer::ViewInfo> views_;
   std::unique_ptr<service::ProbeClient> client_;
+  // Lights by `rule` from now on (or throws, see ViewerConfig::areaLights).
+  void followAreaLights(const AreaLightRule& rule);
+
+  scene::Scene scene_;  // for planning area lights when a stream's rule arrives
   std::unique_ptr<renderer::RasterRenderer> raster_;
+  AreaLightRule lit_;
   service::VolumeSnapshot held_;  // what it rendered last; its storage is reused
   std::vector<renderer::Image> images_;
   ViewerStats stats_;

@@ -4,22 +4,24 @@
 // so the fuzz build links it).
 //
 // Every brick message is self-contained: it carries the volume it belongs to (epoch, layout,
-// bounds, and a checksum of the probe offsets) and both sections of the new version, its keyframe
+// bounds, a checksum of the probe offsets, and the client area light rule) and both sections of the new version, its keyframe
 // and its delta from the version before. A store that keeps only the newest message per brick
 // therefore holds everything a late joiner needs but the offsets themselves (3 bytes per probe),
 // which travel once, in the volume message; a holder one version behind still gets the small delta.
 //
 // Message = header (16 bytes) + body, little-endian:
-//   header: magic "PCBM" | u8 busVersion (2) | u8 kind (1 volume, 2 brick) | u16 flags
+//   header: magic "PCBM" | u8 busVersion (3) | u8 kind (1 volume, 2 brick) | u16 flags
 //           | u32 bodyBytes | u32 CRC-32C of the preceding 12 bytes and the body
 //   volume: u64 epoch (nonzero) | u64 publishedUs | u8 codecFormatVersion (stream.h kFormatVersion)
 //           | u8 representation | u8 brickDim | u8 hasOffsets (0 or 1) | u16 nx, ny, nz
 //           | u16 reserved (0) | f32 boundsMin[3] | f32 boundsMax[3]
-//           | u32 offsetsCrc (CRC-32C of the offset bytes; 0 without offsets)         (56 bytes)
+//           | u32 offsetsCrc (CRC-32C of the offset bytes; 0 without offsets)
+//           | u32 areaLightRule | f32 areaLightMin (probe_volume.h AreaLightRule)   (64 bytes)
 //           The first part of both messages' bodies. A volume message's body is this, then, with
 //           hasOffsets, the offsets: 3 bytes per probe as in probe_offsets.h (int8 steps of 1/256
 //           cell, |q| <= 127, 0 along an axis of one probe).
-// Version 1 (no offsets, a 52-byte volume) is refused: producers and edges are upgraded together.
+// Versions 1 (no offsets, a 52-byte volume) and 2 (no area light rule, 56 bytes) are refused:
+// producers and edges are upgraded together.
 //   brick:  u32 brick | u32 version (>= 1) | u32 producerFrame | f32 change (finite, >= 0)
 //           | u32 keyframeBytes | u32 deltaBytes | keyframe section | delta section  (24 bytes + sections)
 //           Sections exactly as in a codec frame (stream.h); the delta may be absent (0 bytes).
@@ -39,9 +41,9 @@
 
 namespace probecast::bus {
 
-constexpr uint8_t kBusVersion = 2;
+constexpr uint8_t kBusVersion = 3;
 constexpr size_t kHeaderSize = 16;
-constexpr size_t kVolumeSize = 56;
+constexpr size_t kVolumeSize = 64;
 constexpr size_t kBrickFixedSize = 24;
 constexpr uint16_t kEndOfBatch = 1;
 // A brick's relative change above this is nonsense from a broken producer, not lighting.
@@ -62,6 +64,7 @@ struct Volume {
   std::vector<int8_t> offsets;
   bool hasOffsets = false;
   uint32_t offsetsCrc = 0;
+  AreaLightRule areaLights;  // the emitters the probes leave out (checkAreaLightRule)
 };
 
 // Checksum of offsets as a volume announces them (0 for none).

@@ -38,7 +38,7 @@ struct ClientConfig {
 
 struct VolumeSnapshot {
   ProbeVolume volume;           // the last good volume (decodedFrom: the stream's representation;
-                                // offsets: the description's probe offsets)
+                                // offsets and areaLights: the description's)
   StreamLayout layout;          // the stream's grid, brick edge and representation
   uint32_t framesApplied = 0;
   uint64_t newestServerTimeUs = 0;

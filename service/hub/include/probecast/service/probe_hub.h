@@ -36,6 +36,8 @@ struct HubConfig {
   double burstSeconds = 1.0;  // a subscriber's budget bucket holds this many seconds of bytes
   // Probe offsets as descriptions carry them (probe_offsets.h: 3 bytes per probe); empty = none.
   std::vector<int8_t> offsets;
+  // The emitters the probes leave out for viewers to light (ProbeVolume::areaLights); none by default.
+  AreaLightRule areaLights;
 };
 
 // The hub of a probe grid streamed as `repr` in bricks of brickDim³ probes, dropping changes of
@@ -97,7 +99,7 @@ class ProbeHub {
   StreamLayout layout() const;
   GridBounds bounds() const;
   uint64_t epoch() const;
-  // Layout, bounds, epoch and offsets read together (an edge's change with the producer's epoch).
+  // Layout, bounds, epoch, offsets and area light rule read together (an edge's change with the producer's epoch).
   // An edge is not ready() while its epoch announces offsets that have not arrived yet.
   bus::Volume volume() const;
   // A producer's probe offsets (ProbeVolume::offsets, metres, checkProbeOffsets's rules against
@@ -105,6 +107,10 @@ class ProbeHub {
   // once the hub has published or has subscribers starts a new epoch: every stream ends, and
   // clients subscribe again and get the new description.
   void setProbeOffsets(const std::vector<float>& offsets);
+  // A producer's client area light rule (checkAreaLightRule; std::invalid_argument otherwise). A
+  // change once the hub has published or has subscribers starts a new epoch, as for the offsets:
+  // light held by the old rule would be counted twice or lost by the new one.
+  void setAreaLightRule(const AreaLightRule& rule);
 
   // A new lighting frame (27 floats per probe, sh.h layout; active mask or null; per-probe noise
   // or null, see EncoderOptions::noiseScale). Each changed brick gets a new version, encoded once.
@@ -112,7 +118,8 @@ class ProbeHub {
   void publish(const float* probes, const uint8_t* active, const float* noise = nullptr);
   // The same for a volume (its noise too, when it has one, and its offsets: setProbeOffsets), which
   // must pass checkProbeVolume and have the hub's grid size (std::invalid_argument otherwise,
-  // nothing published).
+  // nothing published). Its areaLights are not read: the rule is the hub's (setAreaLightRule), as a
+  // traced volume's samples say nothing of it.
   void publish(const ProbeVolume& volume);
   // Every brick version publish() makes, keyframe and delta, is handed to `output` (called on the
   // publishing thread, outside the hub's lock). Producer hubs only.
@@ -180,6 +187,8 @@ class ProbeHub {
   EncoderBricks& encoderSource(const char* what) const;
   void startEpoch(const bus::Volume& volume, std::vector<std::function<void()>>& wakes);
   void endStreams(std::vector<std::function<void()>>& wakes);
+  // After a change of what descriptions say: a new epoch when anyone may have been told the old.
+  void describedAnew(std::vector<std::function<void()>>& wakes);
 
   HubConfig config_;
   uint64_t epoch_ = 0;
