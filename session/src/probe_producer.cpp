@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "probecast/session/probe_interest.h"
 #include "probecast/session/scene_loading.h"
 
 namespace probecast::session {
@@ -40,6 +41,7 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   updater_ = std::make_unique<renderer::ProbeUpdater>(context, first, grid, options);
   hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
   sceneSpec_ = sceneSpec;
+  rayBudget_ = options.raysPerUpdate > 0;
   animation_ = animation;
   t_ = animation.start;
 }
@@ -69,6 +71,8 @@ void ProbeProducer::step() {
     if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) t_ = t();  // what t() says once the loop ends
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene)
       updater_->setScene(loadSceneOrThrow(sceneSpec_, t()));
+    if (rayBudget_)  // the ray budget traces first what the subscribers can see now
+      updater_->setViewWeights(probeViewWeights(updater_->grid(), updater_->volume().offsets, hub_.subscriberViews()));
     const renderer::UpdateStats st = updater_->update();
     const auto t0 = Clock::now();
     hub_.publish(updater_->volume());
