@@ -21,7 +21,7 @@ struct ReconvergenceOptions {
   std::array<uint32_t, 3> dims = {4, 4, 4};
   uint32_t samplesPerProbe = 32;   // brute force's spp; the budget's nominal update
   uint64_t raysPerUpdate = 0;      // both; 0 = active probes × samplesPerProbe
-  float viewYfov = 0.2f;           // the viewer: the scene's camera with this field of view (radians)
+  float viewYfov = 0.03f;          // the viewer: the scene's camera with this field of view (radians)
   uint32_t convergeUpdates = 24;   // light still at t = 0 before the jump
   uint32_t afterUpdates = 72;      // updates measured after the jump to t = 0.5
   float rejectSigmas = 4.0f;       // both (w_min 0)
