@@ -11,28 +11,20 @@
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/session/probe_interest.h"
+#include "vulkan_test_support.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::renderer {
 namespace {
 
+// Every test checks the validation layer stayed silent.
 class RayBudget : public ::testing::Test {
  protected:
-  void SetUp() override {
-    ContextOptions options;
-    options.validation = true;
-    context_ = std::make_unique<VulkanContext>(options);
-  }
-  void TearDown() override { EXPECT_EQ(context_->validationMessages(), 0u) << "Vulkan validation messages"; }
-  std::unique_ptr<VulkanContext> context_;
+  void TearDown() override { EXPECT_EQ(context_.validationMessages(), 0u) << "Vulkan validation messages"; }
+  VulkanContext context_{test::validatedContext()};
 };
 
-scene::Scene cornell(float t) {
-  scene::Scene s;
-  std::string error;
-  EXPECT_TRUE(scene::makeBuiltinScene("cornell", t, s, error)) << error;
-  return s;
-}
+scene::Scene cornell(float t) { return test::builtinScene("cornell", t); }
 
 // FNV-1a over the bytes of the floats.
 uint64_t fnv(const std::vector<float>& v) {
@@ -50,7 +42,7 @@ TEST_F(RayBudget, NoBudgetIsThePlainUpdateBitForBit) {
   // updates with the light moved after the second (a restart), default blending.
   UpdaterOptions o;
   o.samplesPerProbe = 64;
-  ProbeUpdater u(*context_, cornell(0.0f), sceneGrid(cornell(0.0f), {3, 3, 3}), o);
+  ProbeUpdater u(context_, cornell(0.0f), sceneGrid(cornell(0.0f), {3, 3, 3}), o);
   u.update();
   u.update();
   u.setScene(cornell(0.5f));
@@ -70,7 +62,7 @@ TEST_F(RayBudget, ABudgetOfSppForEveryProbeIsThePlainUpdate) {
   budget.raysPerUpdate = 27 * 64;
   budget.maxSamplesPerProbe = 64;
   const scene::Scene s = cornell(0.0f);
-  ProbeUpdater a(*context_, s, sceneGrid(s, {3, 3, 3}), plain), b(*context_, s, sceneGrid(s, {3, 3, 3}), budget);
+  ProbeUpdater a(context_, s, sceneGrid(s, {3, 3, 3}), plain), b(context_, s, sceneGrid(s, {3, 3, 3}), budget);
   for (int k = 0; k < 3; ++k) {
     a.update();
     EXPECT_EQ(b.update().paths, 27u * 64u);
@@ -107,7 +99,7 @@ TEST_F(RayBudget, InViewProbesGetMoreAndEveryProbeSomeWithinTenUpdates) {
   UpdaterOptions o;
   o.samplesPerProbe = 32;
   o.raysPerUpdate = 64 * 32;  // what brute force spends
-  ProbeUpdater u(*context_, s, g, o);
+  ProbeUpdater u(context_, s, g, o);
   const View view = halfView(g);
   const std::vector<float> weights = session::probeViewWeights(g, u.volume().offsets, std::span<const View>(&view, 1));
   uint32_t seen = 0;
@@ -145,7 +137,7 @@ TEST_F(RayBudget, AProbeGivenNoRaysKeepsItsValueAndItsNoise) {
   UpdaterOptions o;
   o.samplesPerProbe = 32;
   o.raysPerUpdate = 16 * 32;  // a quarter of the probes' worth: most get nothing each update
-  ProbeUpdater u(*context_, s, g, o);
+  ProbeUpdater u(context_, s, g, o);
   const View view = halfView(g);
   u.setViewWeights(session::probeViewWeights(g, u.volume().offsets, std::span<const View>(&view, 1)));
   uint32_t kept = 0, changed = 0;
@@ -174,7 +166,7 @@ TEST_F(RayBudget, AnAbsurdBudgetIsCappedAndBadViewWeightsAreRefused) {
   UpdaterOptions o;
   o.samplesPerProbe = 32;
   o.raysPerUpdate = std::numeric_limits<uint64_t>::max();
-  ProbeUpdater u(*context_, s, g, o);
+  ProbeUpdater u(context_, s, g, o);
   const UpdateStats st = u.update();
   EXPECT_EQ(st.paths, static_cast<uint64_t>(st.activeProbes) * 8u * 32u);  // every probe at its cap
   EXPECT_THROW(u.setViewWeights(std::vector<float>(g.count(), std::nanf(""))), std::invalid_argument);
