@@ -420,6 +420,12 @@ void addBenchAdaptive(CLI::App* bench) {
   addRepresentationOption(adaptive, ao->repr, "l1, zh3h, zh3, l2 or fp16");
   addJsonOption(adaptive, ao->json);
   adaptive->add_option("--chart", ao->chart, "SVG prefix: writes PREFIX_bytes.svg and PREFIX_jump.svg");
+  adaptive->add_option("--rays-per-update", ao->bench.raysPerUpdate,
+                       "rays per update of the budget and of brute force (0 = active probes x --spp)");
+  adaptive->add_option("--view-yfov", ao->bench.viewYfov, "field of view (radians) of the viewer whose probes are scored")
+      ->check(CLI::Range(0.01f, 3.1f));
+  adaptive->add_flag("--reconvergence-only", ao->bench.reconvergenceOnly,
+                     "measure only the re-convergence of the ray budget against brute force");
   adaptive->callback([ao] {
     bench::AdaptiveBenchOptions o = ao->bench;
     o.repr = *parseRepresentation(ao->repr);
@@ -427,7 +433,7 @@ void addBenchAdaptive(CLI::App* bench) {
     o.progress = progressLine;
     const bench::AdaptiveBenchResult r = bench::runAdaptiveBench(o);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", ao->json, "", "");
-    if (!ao->chart.empty())
+    if (!ao->chart.empty() && !o.reconvergenceOnly)
       for (const auto& [suffix, svg] : {std::pair{"_bytes.svg", &r.svgBytes}, std::pair{"_jump.svg", &r.svgJump}})
         writeTextFile(ao->chart + suffix, *svg);
   });

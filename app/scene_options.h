@@ -159,8 +159,12 @@ struct TracerOptions {
   float rejectSigmas = 4.0f;
   float clamp = 16.0f;
   bool relocate = true;
+  uint64_t raysPerUpdate = 0;
   void add(CLI::App* cmd) {
     addSppOption(cmd, spp);
+    cmd->add_option("--rays-per-update", raysPerUpdate,
+                    "paths per update spent over the probes by need (in view, light changed, noisy), in multiples of "
+                    "32; at most 8x --spp per probe (a larger budget is capped); 0 = every probe traces --spp");
     cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
     cmd->add_option("--seed", seed, "random seed (same seed, same result)");
     cmd->add_option("--w-min", wMin, "minimum temporal blend weight (0: a true mean until the history is rejected)")
@@ -182,6 +186,7 @@ struct TracerOptions {
     o.rejectSigmas = rejectSigmas;
     o.indirectClamp = clamp;
     o.relocate = relocate;
+    o.raysPerUpdate = raysPerUpdate;
     return o;
   }
 };

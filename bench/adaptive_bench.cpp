@@ -12,6 +12,7 @@
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/stats.h"
+#include "reconvergence.h"
 #include "stability.h"
 #include "update_bench.h"
 
@@ -41,11 +42,47 @@ struct Moment {
 
 }  // namespace
 
+namespace {
+
+// The ray budget's part of the bench: its JSON and table lines.
+void addReconvergence(renderer::VulkanContext& context, const AdaptiveBenchOptions& o, AdaptiveBenchResult& r) {
+  ReconvergenceOptions ro;
+  ro.sceneSpec = o.sceneSpec;
+  ro.dims = o.dims;
+  ro.samplesPerProbe = o.samplesPerProbe;
+  ro.raysPerUpdate = o.raysPerUpdate;
+  ro.viewYfov = o.viewYfov;
+  ro.rejectSigmas = o.rejectSigmas;
+  const ReconvergenceResult rc = measureReconvergence(context, ro);
+  r.json["reconvergence"] = rc.json();
+  r.json["rays_per_update"] = rc.raysPerUpdate;
+  r.json["summary"]["rays_per_update"] = rc.raysPerUpdate;
+  r.json["summary"]["reconvergence_vs_bruteforce"] = rc.ratio;
+  const auto updates = [&](int n) { return n < 0 ? "> " + std::to_string(ro.afterUpdates) : std::to_string(n); };
+  r.table += fmt::format(
+      "ray budget, light jump t 0 -> 0.5 after {} still updates, {} rays per update, {} of {} probes in view:\n"
+      "  in-view error back to {:.4f} (brute force before the jump) after {} updates with the budget, {} brute force: "
+      "ratio {}\n",
+      ro.convergeUpdates, rc.raysPerUpdate, rc.inViewProbes, rc.activeProbes, rc.threshold, updates(rc.adaptiveUpdates),
+      updates(rc.bruteForceUpdates), rc.ratio < 0 ? std::string("n/a") : fmt::format("{:.3f}", rc.ratio));
+}
+
+}  // namespace
+
 AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
   };
   renderer::VulkanContext context(o.context);
+  if (o.reconvergenceOnly) {
+    AdaptiveBenchResult r;
+    r.json["command"] = o.command;
+    r.json["device"] = context.deviceName();
+    r.json["samples_per_probe"] = o.samplesPerProbe;
+    say("adaptive bench: ray budget against brute force");
+    addReconvergence(context, o, r);
+    return r;
+  }
   const auto sceneAt = [&](float t) { return session::loadSceneOrThrow(o.sceneSpec, t); };
   const scene::Scene first = sceneAt(0.0f);
   const ProbeGrid grid = renderer::sceneGrid(first, o.dims);
@@ -243,6 +280,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                   {"follow_updates", j["jump"].back()["follow_updates"]},
                   {"reconvergence_updates", j["jump"].back()["reconvergence_updates"]},
                   {"worst_psnr_loss_db", noise["worst_psnr_loss_db"]}};
+  say("adaptive bench: ray budget against brute force");
+  addReconvergence(context, o, r);
   return r;
 }
 

@@ -30,6 +30,11 @@ struct AdaptiveBenchOptions {
   Representation repr = Representation::Zh3;
   uint32_t jumpUpdates = 48;         // updates charted after the light jump
   uint32_t width = 160, height = 100;
+  // Re-convergence after a light jump, ray budget against brute force (reconvergence.h).
+  uint64_t raysPerUpdate = 0;        // 0 = active probes × samplesPerProbe
+  float viewYfov = 0.03f;            // the viewer whose probes are scored (builtin:cornell 4³: 16 of 64 probes)
+  bool reconvergenceOnly = false;    // measure only that
+
   renderer::ContextOptions context;
   std::string command;
   std::function<void(const std::string&)> progress;

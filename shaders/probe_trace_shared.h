@@ -21,7 +21,7 @@
 #define PT_BINDING_MATERIALS 4  // PtMaterial[]
 #define PT_BINDING_LIGHTS 5     // PtLight[]
 #define PT_BINDING_DIRECTIONS 6 // vec4[samples], unit directions in a coherent order
-#define PT_BINDING_PROBES 7     // vec4[active probes]: world position, w = grid index
+#define PT_BINDING_PROBES 7     // vec4[active probes]: world position, w = grid index (then perProbeSamples' section)
 #define PT_BINDING_PARTIALS 8   // float[active probes * LANES * PARTIAL_FLOATS]
 #define PT_BINDING_EMITTERS 9   // PtEmitter[]: emissive triangles for next-event estimation
 #define PT_BINDING_NORMALS 10   // float[3 * vertices], shading normals
@@ -129,7 +129,10 @@ struct PtPushConstants {
   float indirectClamp;      // max luminance of one indirect contribution; 0 = off
   uint emitterCount;
   float emitterPower;       // sum of PtEmitter.power
-  uint pad0;
+  // 0: every probe traces sampleCount samples of the directions from 0. 1: a ray budget set them per
+  // probe: PT_BINDING_PROBES holds a second section after the probeCount positions, per probe
+  // x = its samples (multiple of LANES), y = the index of its first direction (as bits).
+  uint perProbeSamples;
   uint pad1;
 };
 

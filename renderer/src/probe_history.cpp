@@ -17,49 +17,63 @@ constexpr float kSpreadDegrees = 4.0f;
 // probe with a (near) deterministic estimate from restarting on rounding.
 constexpr float kRelativeFloor = 1e-3f;
 
-void addStatistics(ProbeHistory& h, const float estimate[27], const float spread[kHistoryLuma]) {
+void addStatistics(ProbeHistory& h, const float estimate[27], const float spread[kHistoryLuma], float weight) {
+  // West's weighted form of Welford's update: an estimate of variance σ² / weight counts `weight`
+  // times, so m2 / (count − 1) still estimates σ² (the spread is of this estimate: σ² / weight).
   ++h.welfordCount;
+  h.welfordWeight += weight;
   ++h.spreadCount;
   for (int k = 0; k < kHistoryLuma; ++k) {
     const float x = coefficientLuminance(estimate, k);
     const float delta = x - h.mean[k];
-    h.mean[k] += delta / static_cast<float>(h.welfordCount);
-    h.m2[k] += delta * (x - h.mean[k]);
-    h.spreadVariance[k] += (spread[k] - h.spreadVariance[k]) / static_cast<float>(h.spreadCount);
+    h.mean[k] += delta * weight / h.welfordWeight;
+    h.m2[k] += weight * delta * (x - h.mean[k]);
+    h.spreadVariance[k] += (spread[k] * weight - h.spreadVariance[k]) / static_cast<float>(h.spreadCount);
   }
 }
 
+// The blend weight of `weight` updates' worth under a floor of `floor` per update: what that
+// many successive updates at the floor would give.
+float floorFor(float floor, float weight) {
+  return weight == 1.0f ? floor : 1.0f - std::pow(1.0f - floor, weight);
+}
+
+struct Estimate {
+  const float* value;
+  const float* spread;
+  float weight;
+};
+
 // The history becomes `probe`, worth `n` estimates; the statistics restart from `estimates`.
-void restart(ProbeHistory& h, float probe[27], const float value[27], uint32_t n,
-             std::initializer_list<std::pair<const float*, const float*>> estimates) {
+void restart(ProbeHistory& h, float probe[27], const float value[27], float n, std::initializer_list<Estimate> estimates) {
   std::copy(value, value + 27, probe);
   std::copy(value, value + 27, h.fast);
   h.n = n;
-  h.varianceFactor = 1.0f / static_cast<float>(n);
+  h.varianceFactor = 1.0f / n;
   h.fastCount = n;
   h.fastFactor = h.varianceFactor;
   h.welfordCount = 0;
+  h.welfordWeight = 0.0f;
   h.spreadCount = 0;
   std::fill(h.mean, h.mean + kHistoryLuma, 0.0f);
   std::fill(h.m2, h.m2 + kHistoryLuma, 0.0f);
   std::fill(h.spreadVariance, h.spreadVariance + kHistoryLuma, 0.0f);
-  for (auto [estimate, spread] : estimates) addStatistics(h, estimate, spread);
+  for (const Estimate& e : estimates) addStatistics(h, e.value, e.spread, e.weight);
   h.pending = false;
 }
 
 // Blends one estimate into the history; `fastInput` is what the short average gets (the history
 // itself for an estimate that disagreed on its own, so one outlier cannot move it far).
-void accumulate(ProbeHistory& h, float probe[27], const float estimate[27], const float spread[kHistoryLuma],
-                const float fastInput[27], float minBlendWeight) {
-  ++h.n;
-  const float w = std::max(1.0f / static_cast<float>(h.n), minBlendWeight);
-  for (int i = 0; i < 27; ++i) probe[i] = (1.0f - w) * probe[i] + w * estimate[i];
-  h.varianceFactor = (1.0f - w) * (1.0f - w) * h.varianceFactor + w * w;
-  addStatistics(h, estimate, spread);
-  ++h.fastCount;
-  const float wf = std::max(1.0f / static_cast<float>(h.fastCount), kFastWeight);
+void accumulate(ProbeHistory& h, float probe[27], const Estimate& e, const float fastInput[27], float minBlendWeight) {
+  h.n += e.weight;
+  const float w = std::min(1.0f, std::max(e.weight / h.n, floorFor(minBlendWeight, e.weight)));
+  for (int i = 0; i < 27; ++i) probe[i] = (1.0f - w) * probe[i] + w * e.value[i];
+  h.varianceFactor = (1.0f - w) * (1.0f - w) * h.varianceFactor + w * w / e.weight;
+  addStatistics(h, e.value, e.spread, e.weight);
+  h.fastCount += e.weight;
+  const float wf = std::min(1.0f, std::max(e.weight / h.fastCount, floorFor(kFastWeight, e.weight)));
   for (int i = 0; i < 27; ++i) h.fast[i] = (1.0f - wf) * h.fast[i] + wf * fastInput[i];
-  h.fastFactor = (1.0f - wf) * (1.0f - wf) * h.fastFactor + wf * wf;
+  h.fastFactor = (1.0f - wf) * (1.0f - wf) * h.fastFactor + wf * wf / e.weight;
 }
 
 // True when `a` and `b` differ by more than k standard errors in any of the luminances, the
@@ -87,45 +101,49 @@ float estimateVariance(const ProbeHistory& h, int k) {
 }
 
 float historyStandardError(const ProbeHistory& h) {
-  return h.n == 0 ? 0.0f : std::sqrt(std::max(0.0f, estimateVariance(h, 0) * h.varianceFactor));
+  return h.n == 0.0f ? 0.0f : std::sqrt(std::max(0.0f, estimateVariance(h, 0) * h.varianceFactor));
 }
 
 BlendOutcome blendEstimate(ProbeHistory& h, float probe[27], const float estimate[27],
-                           const float spread[kHistoryLuma], const HistoryOptions& o) {
-  if (h.n == 0) {
-    restart(h, probe, estimate, 1, {{estimate, spread}});
+                           const float spread[kHistoryLuma], const HistoryOptions& o, float weight) {
+  const Estimate fresh{estimate, spread, weight};
+  if (h.n == 0.0f) {
+    restart(h, probe, estimate, weight, {fresh});
     return BlendOutcome::Accumulated;
   }
   if (!(o.rejectSigmas > 0.0f)) {
-    accumulate(h, probe, estimate, spread, estimate, o.minBlendWeight);
+    accumulate(h, probe, fresh, estimate, o.minBlendWeight);
     return BlendOutcome::Accumulated;
   }
   const float k = o.rejectSigmas;
-  // A new estimate and the history differ by noise of variance σ² (1 + f) when nothing moved.
-  const bool alone = disagree(h, estimate, probe, 1.0f + h.varianceFactor, k);
+  // A new estimate and the history differ by noise of variance σ² (1 / weight + f) when nothing moved.
+  const bool alone = disagree(h, estimate, probe, 1.0f / weight + h.varianceFactor, k);
   if (h.pending) {
-    float pair[27];
-    for (int i = 0; i < 27; ++i) pair[i] = 0.5f * (h.pendingEstimate[i] + estimate[i]);
-    if (disagree(h, pair, probe, 0.5f + h.varianceFactor, k)) {
-      restart(h, probe, pair, 2, {{h.pendingEstimate, h.pendingSpread}, {estimate, spread}});
+    const Estimate held{h.pendingEstimate, h.pendingSpread, h.pendingWeight};
+    const float both = held.weight + weight;
+    float pair[27];  // their weighted mean, of variance σ² / both
+    for (int i = 0; i < 27; ++i) pair[i] = (held.weight * held.value[i] + weight * estimate[i]) / both;
+    if (disagree(h, pair, probe, 1.0f / both + h.varianceFactor, k)) {
+      restart(h, probe, pair, both, {held, fresh});
       return BlendOutcome::Restarted;
     }
     h.pending = false;
-    accumulate(h, probe, h.pendingEstimate, h.pendingSpread, probe, o.minBlendWeight);
+    accumulate(h, probe, held, probe, o.minBlendWeight);
   } else if (alone) {
     std::copy(estimate, estimate + 27, h.pendingEstimate);
     std::copy(spread, spread + kHistoryLuma, h.pendingSpread);
+    h.pendingWeight = weight;
     h.pending = true;
     return BlendOutcome::Held;
   }
-  accumulate(h, probe, estimate, spread, alone ? probe : estimate, o.minBlendWeight);
+  accumulate(h, probe, fresh, alone ? probe : estimate, o.minBlendWeight);
   // A change below one update's noise shows in the short average within a few updates. Their
   // difference has variance at most σ² (f_fast + f) (the two share samples, which only lowers it).
   if (disagree(h, h.fast, probe, h.fastFactor + h.varianceFactor, k)) {
     float fast[27];
     std::copy(h.fast, h.fast + 27, fast);
-    const uint32_t n = std::max(1u, static_cast<uint32_t>(std::lround(1.0f / h.fastFactor)));
-    restart(h, probe, fast, n, {{estimate, spread}});
+    const float n = static_cast<float>(std::max(1L, std::lround(1.0f / h.fastFactor)));
+    restart(h, probe, fast, n, {fresh});
     return BlendOutcome::RestartedFromAverage;
   }
   return BlendOutcome::Accumulated;

@@ -9,6 +9,11 @@
 // per-update estimates since its last restart; their variance σ² (pooled with the within-update
 // estimate, which is all there is right after a restart) sets the standard error of the history,
 // σ √f, where f = Var(history) / σ² follows the blend weights (f = 1/n for a true mean).
+//
+// An estimate may come from more or fewer samples than the nominal count per update (a ray
+// budget, probe_updater.h): it then counts as `weight` = its samples / the nominal samples
+// updates, its variance σ² / weight. Variances and weights are in units of one nominal update; a
+// weight of exactly 1 gives the same floats as the rule without weights.
 #pragma once
 
 #include <cstdint>
@@ -23,19 +28,21 @@ struct HistoryOptions {
 };
 
 struct ProbeHistory {
-  uint32_t n = 0;                   // estimates blended since the last restart
+  float n = 0.0f;                   // estimates (nominal updates' worth) blended since the last restart
   float varianceFactor = 0.0f;      // f = Var(history) / σ²
-  uint32_t welfordCount = 0;
-  float mean[kHistoryLuma] = {};    // Welford mean of the per-update luminance estimates
-  float m2[kHistoryLuma] = {};      // and their sum of squared deviations
+  uint32_t welfordCount = 0;       // estimates in the statistics
+  float welfordWeight = 0.0f;       // and their summed weight
+  float mean[kHistoryLuma] = {};    // weighted Welford mean of the per-update luminance estimates
+  float m2[kHistoryLuma] = {};      // and their weighted sum of squared deviations
   uint32_t spreadCount = 0;
   float spreadVariance[kHistoryLuma] = {};  // mean within-update variance estimate since the restart
-  uint32_t fastCount = 0;
+  float fastCount = 0.0f;
   float fastFactor = 0.0f;          // Var(fast) / σ²
   float fast[27] = {};              // short moving average of the estimates
   bool pending = false;             // the last estimate disagreed: held back until the next one
   float pendingEstimate[27] = {};
   float pendingSpread[kHistoryLuma] = {};
+  float pendingWeight = 0.0f;
 };
 
 // Accumulated: blended in. Held: it disagreed, the next estimate decides. Restarted: it and the
@@ -44,9 +51,11 @@ struct ProbeHistory {
 enum class BlendOutcome { Accumulated, Held, Restarted, RestartedFromAverage };
 
 // Blends `estimate` into `probe` (27 floats) under the rule above; `spreadVariance` is this
-// update's within-update variance estimate of the kHistoryLuma luminances.
+// update's within-update variance estimate of the kHistoryLuma luminances (of this estimate, with
+// its weight), `weight` > 0 the estimate's samples over the nominal samples per update.
 BlendOutcome blendEstimate(ProbeHistory& history, float probe[27], const float estimate[27],
-                           const float spreadVariance[kHistoryLuma], const HistoryOptions& options);
+                           const float spreadVariance[kHistoryLuma], const HistoryOptions& options,
+                           float weight = 1.0f);
 
 // σ² of one update's estimate of luminance `k` (0 = c00), as the history knows it.
 float estimateVariance(const ProbeHistory& history, int k);

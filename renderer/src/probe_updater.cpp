@@ -12,6 +12,7 @@
 #include "gpu_scene.h"
 #include "probe_history.h"
 #include "probe_relocation.h"
+#include "ray_budget.h"
 #include "probecast/codec/probe_offsets.h"
 #include "vk_raytracing.h"
 
@@ -102,6 +103,11 @@ struct ProbeUpdater::Impl {
   std::vector<uint32_t> activeList;
   ClassifyStats classifyStats;
   std::vector<ProbeHistory> history;  // per probe: blend count and noise statistics
+  // The ray budget: per probe its view weight (empty = all seen), updates since it was traced,
+  // and the samples of the last update.
+  std::vector<float> viewWeights;
+  std::vector<uint32_t> age, lastSamples;
+  uint32_t maxSamples = 0;
   size_t geometryVertices = 0, geometryTriangles = 0;
   std::vector<glm::vec3> geometryPositions;
   std::vector<uint32_t> geometryIndices;
@@ -109,8 +115,10 @@ struct ProbeUpdater::Impl {
   RayTracingPass pass;
   GpuScene gpu;
   Buffer directions, classifyDirections, probeList, partials;
+  Buffer levelDirections;  // with a budget: direction sets of 32, 64, … maxSamples, one after another
 
-  void uploadProbeList(const std::vector<uint32_t>& list) {
+  // `perProbeSamples`: empty, or each listed probe's samples (a multiple of the lanes, ≤ maxSamples).
+  void uploadProbeList(const std::vector<uint32_t>& list, const std::vector<uint32_t>& perProbeSamples = {}) {
     destroyBuffer(*d, probeList);
     destroyBuffer(*d, partials);
     std::vector<shaders::vec4> data(list.size());
@@ -123,12 +131,21 @@ struct ProbeUpdater::Impl {
       std::memcpy(&key, &list[i], sizeof key);  // the grid index as bits: the shader's RNG stream
       data[i] = {p[0], p[1], p[2], key};
     }
+    for (uint32_t n : perProbeSamples) {  // the second section (probe_trace_shared.h)
+      const uint32_t level = n / kLanes, first = kLanes * (level - 1) * level / 2;
+      shaders::vec4 budget{};
+      std::memcpy(&budget.x, &n, sizeof n);
+      std::memcpy(&budget.y, &first, sizeof first);
+      data.push_back(budget);
+    }
     probeList = createBufferWithData(*d, data.data(), data.size() * sizeof(shaders::vec4), kStorage);
     partials = createBuffer(*d, list.size() * kLanes * PT_PARTIAL_FLOATS * sizeof(float), kStorage);
   }
 
-  void dispatch(uint32_t count, uint32_t sampleCount, const Buffer& dirs, uint32_t mode, const shaders::mat4& rotation) {
+  void dispatch(uint32_t count, uint32_t sampleCount, const Buffer& dirs, uint32_t mode, const shaders::mat4& rotation,
+                uint32_t perProbeSamples = 0) {
     PtPushConstants push{};
+    push.perProbeSamples = perProbeSamples;
     push.rotation = rotation;
     push.sampleCount = sampleCount;
     push.probeCount = count;
@@ -251,6 +268,9 @@ struct ProbeUpdater::Impl {
   void markClientLit(const scene::Scene& s) {
     markClientLitMaterials(scene::extractAreaLights(s, options.areaLights).clientLitMaterial, gpu);
   }
+  // Blends the estimates of the last trace dispatch (the probes of `list`, `traced[i]` samples each) into
+  // the probes' histories.
+  void blendTraced(const std::vector<uint32_t>& list, const std::vector<uint32_t>& traced, UpdateStats& stats);
   void setGeometry(const scene::Scene& s) {
     uploadGpuScene(*d, s, gpu);
     markClientLit(s);
@@ -271,11 +291,25 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   s.volume = makeProbeVolume(grid);
   s.volume.samplesPerProbe = s.samples;
   s.history.assign(grid.count(), ProbeHistory{});
+  s.age.assign(grid.count(), 0u);
+  s.lastSamples.assign(grid.count(), 0u);
   createRayTracingPass(*s.d, kProbeTraceRgen, sizeof kProbeTraceRgen, sizeof(PtPushConstants), s.pass);
   const auto dirs = coherentFibonacci(s.samples);
   s.directions = createBufferWithData(*s.d, dirs.data(), dirs.size() * sizeof(shaders::vec4), kStorage);
   const auto cdirs = coherentFibonacci(roundUpLanes(options.classifySamples));
   s.classifyDirections = createBufferWithData(*s.d, cdirs.data(), cdirs.size() * sizeof(shaders::vec4), kStorage);
+  if (options.raysPerUpdate > 0) {
+    // Each probe's samples come from a set of its own size: the first m of a larger set are one
+    // patch of the sphere (the sets are ordered along a curve).
+    const uint32_t cap = options.maxSamplesPerProbe ? options.maxSamplesPerProbe : 8 * s.samples;
+    s.maxSamples = std::max(s.samples, roundUpLanes(std::min(cap, 4096u)));
+    std::vector<shaders::vec4> levels;
+    for (uint32_t n = kLanes; n <= s.maxSamples; n += kLanes) {
+      const auto set = coherentFibonacci(n);
+      levels.insert(levels.end(), set.begin(), set.end());
+    }
+    s.levelDirections = createBufferWithData(*s.d, levels.data(), levels.size() * sizeof(shaders::vec4), kStorage);
+  }
   s.setGeometry(scene);
   uploadGpuEnvironment(*s.d, options.environment.get(), options.environmentSampling, s.gpu);
   s.classify();
@@ -284,7 +318,7 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
 ProbeUpdater::~ProbeUpdater() {
   Impl& s = *impl_;
   destroyGpuScene(*s.d, s.gpu);
-  for (Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials})
+  for (Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.levelDirections})
     destroyBuffer(*s.d, *b);
   destroyRayTracingPass(*s.d, s.pass);
 }
@@ -307,54 +341,109 @@ UpdateStats ProbeUpdater::update() {
   const auto t0 = std::chrono::steady_clock::now();
   UpdateStats stats;
   stats.activeProbes = static_cast<uint32_t>(s.activeList.size());
-  if (!s.activeList.empty()) {
+  s.lastSamples.assign(s.volume.count(), 0u);
+  if (!s.activeList.empty() && s.options.raysPerUpdate == 0) {
     s.dispatch(static_cast<uint32_t>(s.activeList.size()), s.samples, s.directions, PT_MODE_TRACE,
                randomRotation(s.options.seed, s.volume.updates));
-    // ĉ = (4π/S) Σ lanes, summed in a fixed order (deterministic). The lanes' partial sums are
-    // independent estimates over interleaved subsets of the directions: their spread estimates
-    // the variance of ĉ before any history exists.
-    const float* part = static_cast<const float*>(s.partials.mapped);
-    const float scale = 4.0f * 3.14159265358979f / static_cast<float>(s.samples);
-    const HistoryOptions blend{s.options.minBlendWeight, s.options.rejectSigmas};
-    s.volume.noise.resize(s.volume.count(), 0.0f);
-    for (size_t i = 0; i < s.activeList.size(); ++i) {
+    s.blendTraced(s.activeList, std::vector<uint32_t>(s.activeList.size(), s.samples), stats);
+  } else if (!s.activeList.empty()) {
+    std::vector<ProbeNeed> needs(s.activeList.size());
+    for (size_t i = 0; i < needs.size(); ++i) {
       const uint32_t p = s.activeList[i];
-      float sum[27] = {};
-      for (uint32_t lane = 0; lane < kLanes; ++lane) {
-        const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
-        for (int k = 0; k < 27; ++k) sum[k] += src[k];
-        stats.closestHitRays += static_cast<uint64_t>(src[28]);
-        stats.shadowRays += static_cast<uint64_t>(src[29]);
-        stats.droppedSamples += static_cast<uint64_t>(src[30]);
-      }
-      float fresh[27];
-      bool finite = true;
-      for (int k = 0; k < 27; ++k) {
-        fresh[k] = sum[k] * scale;
-        finite = finite && std::isfinite(fresh[k]);
-      }
-      if (!finite) continue;  // an overflowing estimate is dropped whole, the history kept
-      float spread[kHistoryLuma] = {};
-      for (uint32_t lane = 0; lane < kLanes; ++lane) {
-        const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
-        for (int k = 0; k < kHistoryLuma; ++k) {
-          const float d = coefficientLuminance(src, k) * scale * static_cast<float>(kLanes) - coefficientLuminance(fresh, k);
-          spread[k] += d * d;
-        }
-      }
-      for (float& v : spread) v /= static_cast<float>(kLanes) * static_cast<float>(kLanes - 1);
-      float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
-      const BlendOutcome outcome = blendEstimate(s.history[p], c, fresh, spread, blend);
-      stats.restartedProbes +=
-          outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage ? 1u : 0u;
-      s.volume.noise[p] = historyStandardError(s.history[p]);
+      const ProbeHistory& h = s.history[p];
+      const float signal = coefficientLuminance(&s.volume.probes[static_cast<size_t>(p) * 27], 0);
+      ProbeNeed& need = needs[i];
+      need.viewWeight = s.viewWeights.empty() ? 1.0f : s.viewWeights[p];
+      need.historyWeight = h.n;
+      need.relativeVariance = h.n > 0.0f ? estimateVariance(h, 0) / std::max(signal * signal, 1e-12f) : 1.0f;
+      need.suspect = h.pending;
+      need.age = s.age[p];
     }
-    stats.paths = static_cast<uint64_t>(s.activeList.size()) * s.samples;
+    RayBudgetRule rule;
+    rule.rays = s.options.raysPerUpdate;
+    rule.lane = kLanes;
+    rule.nominalSamples = s.samples;
+    rule.maxSamples = s.maxSamples;
+    rule.refreshShare = s.options.refreshShare;
+    rule.outOfViewWeight = s.options.outOfViewWeight;
+    std::vector<uint32_t> given(needs.size());
+    allocateRays(needs, rule, given.data());
+    std::vector<uint32_t> list, samples;
+    for (size_t i = 0; i < given.size(); ++i) {
+      const uint32_t p = s.activeList[i];
+      s.age[p] = given[i] ? 0u : s.age[p] + 1u;
+      if (given[i] == 0) continue;
+      list.push_back(p);
+      samples.push_back(given[i]);
+    }
+    s.uploadProbeList(list, samples);  // the allocation gives at least one lane: never empty
+    s.dispatch(static_cast<uint32_t>(list.size()), 0, s.levelDirections, PT_MODE_TRACE,
+               randomRotation(s.options.seed, s.volume.updates), 1);
+    s.blendTraced(list, samples, stats);
   }
   ++s.volume.updates;
   stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return stats;
 }
+
+void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const std::vector<uint32_t>& traced,
+                                     UpdateStats& stats) {
+  Impl& s = *this;
+  // ĉ = (4π/S) Σ lanes, summed in a fixed order (deterministic). The lanes' partial sums are
+  // independent estimates over interleaved subsets of the directions: their spread estimates
+  // the variance of ĉ before any history exists.
+  const float* part = static_cast<const float*>(s.partials.mapped);
+  const HistoryOptions blend{s.options.minBlendWeight, s.options.rejectSigmas};
+  s.volume.noise.resize(s.volume.count(), 0.0f);
+  for (size_t i = 0; i < list.size(); ++i) {
+    const uint32_t p = list[i];
+    const float scale = 4.0f * 3.14159265358979f / static_cast<float>(traced[i]);
+    const float weight = static_cast<float>(traced[i]) / static_cast<float>(s.samples);  // 1 without a budget
+    s.lastSamples[p] = traced[i];
+    stats.paths += traced[i];
+    ++stats.tracedProbes;
+    float sum[27] = {};
+    for (uint32_t lane = 0; lane < kLanes; ++lane) {
+      const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
+      for (int k = 0; k < 27; ++k) sum[k] += src[k];
+      stats.closestHitRays += static_cast<uint64_t>(src[28]);
+      stats.shadowRays += static_cast<uint64_t>(src[29]);
+      stats.droppedSamples += static_cast<uint64_t>(src[30]);
+    }
+    float fresh[27];
+    bool finite = true;
+    for (int k = 0; k < 27; ++k) {
+      fresh[k] = sum[k] * scale;
+      finite = finite && std::isfinite(fresh[k]);
+    }
+    if (!finite) continue;  // an overflowing estimate is dropped whole, the history kept
+    float spread[kHistoryLuma] = {};
+    for (uint32_t lane = 0; lane < kLanes; ++lane) {
+      const float* src = part + (i * kLanes + lane) * PT_PARTIAL_FLOATS;
+      for (int k = 0; k < kHistoryLuma; ++k) {
+        const float dev = coefficientLuminance(src, k) * scale * static_cast<float>(kLanes) - coefficientLuminance(fresh, k);
+        spread[k] += dev * dev;
+      }
+    }
+    for (float& v : spread) v /= static_cast<float>(kLanes) * static_cast<float>(kLanes - 1);
+    float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
+    const BlendOutcome outcome = blendEstimate(s.history[p], c, fresh, spread, blend, weight);
+    stats.restartedProbes +=
+        outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage ? 1u : 0u;
+    s.volume.noise[p] = historyStandardError(s.history[p]);
+  }
+}
+
+void ProbeUpdater::setViewWeights(std::vector<float> weights) {
+  if (!weights.empty() && weights.size() != impl_->volume.count())
+    throw std::invalid_argument("view weights: " + std::to_string(weights.size()) + " for " +
+                                std::to_string(impl_->volume.count()) + " probes");
+  for (float w : weights)
+    if (!(w >= 0.0f && w <= 1.0f)) throw std::invalid_argument("view weights: each must be in [0, 1]");
+  impl_->viewWeights = std::move(weights);
+}
+
+const std::vector<uint32_t>& ProbeUpdater::lastSamples() const { return impl_->lastSamples; }
 
 uint32_t ProbeUpdater::probeCount() const { return impl_->volume.count(); }
 uint32_t ProbeUpdater::updates() const { return impl_->volume.updates; }
@@ -365,7 +454,7 @@ const ClassifyStats& ProbeUpdater::classifyStats() const { return impl_->classif
 uint64_t ProbeUpdater::deviceBytes() const {
   const Impl& s = *impl_;
   uint64_t total = 0;
-  for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.gpu.triangleMaterial,
+  for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.levelDirections, &s.gpu.triangleMaterial,
                           &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.normals, &s.gpu.texcoords, &s.gpu.texels,
                           &s.gpu.textures, &s.gpu.environment, &s.gpu.environmentData, &s.gpu.accel.positions, &s.gpu.accel.indices,
                           &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.blasNonOpaque.storage,

@@ -345,6 +345,13 @@ void ProbeHub::setViews(uint64_t id, std::vector<View> views) {
   if (wake) wake();
 }
 
+std::vector<View> ProbeHub::subscriberViews() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<View> views;
+  for (const auto& [id, s] : subscribers_) views.insert(views.end(), s.views.begin(), s.views.end());
+  return views;
+}
+
 size_t ProbeHub::subscriberCount() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return subscribers_.size();

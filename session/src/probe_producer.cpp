@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "probecast/session/probe_interest.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/volumes.h"
 
@@ -42,6 +43,7 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
   hub_.setAreaLightRule(areaLightRuleOf(options.areaLights));  // what the probes leave out for viewers
   sceneSpec_ = sceneSpec;
+  rayBudget_ = options.raysPerUpdate > 0;
   animation_ = animation;
   t_ = animation.start;
 }
@@ -72,6 +74,8 @@ void ProbeProducer::step() {
     if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) t_ = t();  // what t() says once the loop ends
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene)
       updater_->setScene(loadSceneOrThrow(sceneSpec_, t()));
+    if (rayBudget_)  // the ray budget traces first what the subscribers can see now
+      updater_->setViewWeights(probeViewWeights(updater_->grid(), updater_->volume().offsets, hub_.subscriberViews()));
     const renderer::UpdateStats st = updater_->update();
     const auto t0 = Clock::now();
     hub_.publish(updater_->volume());

@@ -10,7 +10,10 @@
 // (a light or an object moved); a short moving average catches changes smaller than one update's
 // noise within a few updates. Probes whose rays see back faces too often are inside geometry: they
 // move out of it when they can (UpdaterOptions::relocate, ProbeVolume::offsets), else they are
-// inactive, get no rays and stay zero. Output is the codec's ProbeVolume (probe_volume.h): 27
+// inactive, get no rays and stay zero. With a ray budget (raysPerUpdate) an update traces probes by
+// need instead — in a viewer's sight (setViewWeights), just restarted or held back, noisy — each
+// with its own sample count, in multiples of the lanes; an estimate counts in the blend as its
+// samples over samplesPerProbe updates, and a probe given none keeps its history and its noise. Output is the codec's ProbeVolume (probe_volume.h): 27
 // floats per probe, coefficient-major, no Condon-Shortley phase; probe (x, y, z) at x + nx (y + ny z).
 #pragma once
 
@@ -31,7 +34,7 @@ namespace probecast::renderer {
 ProbeGrid sceneGrid(const scene::Scene& scene, const std::array<uint32_t, 3>& dims);
 
 struct UpdaterOptions {
-  uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32
+  uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32; with a budget, one update's worth in the blend
   uint32_t maxBounces = 4;         // surface interactions per path
   float indirectClamp = 16.0f;     // max luminance of one contribution after the first bounce; 0 = off
   float minBlendWeight = 0.05f;    // w_min of the temporal blend (0: a true mean until rejected)
@@ -58,6 +61,12 @@ struct UpdaterOptions {
   // Emitters the raster client lights itself (the same options as RasterOptions::areaLights):
   // probe rays see none of their emission directly; light bounced from them stays in.
   scene::AreaLightOptions areaLights;
+  // Ray budget: primary paths per update, spent over the active probes by need (renderer/src/
+  // ray_budget.h), rounded down to whole lanes (32); 0 = every active probe traces samplesPerProbe.
+  uint64_t raysPerUpdate = 0;
+  uint32_t maxSamplesPerProbe = 0;  // with a budget, per probe and update; 0 = 8 × samplesPerProbe (≤ 4096)
+  float refreshShare = 0.1f;        // of the budget, one lane each to the probes traced longest ago
+  float outOfViewWeight = 0.05f;    // need of a probe outside every view, against 1 inside one
 };
 
 struct UpdateStats {
@@ -68,6 +77,7 @@ struct UpdateStats {
   uint32_t activeProbes = 0;
   uint64_t droppedSamples = 0;  // non-finite path samples replaced by 0 (a defect if ever nonzero)
   uint32_t restartedProbes = 0; // probes whose history was rejected this update
+  uint32_t tracedProbes = 0;    // probes given rays (all active ones without a budget)
 };
 
 // The last classification (at construction and after each geometry change).
@@ -93,6 +103,12 @@ class ProbeUpdater {
   // acceleration structures and reclassifies the probes.
   void setScene(const scene::Scene& scene);
   UpdateStats update();
+  // How much each probe (grid order) matters to viewers, in [0, 1]: 1 inside some subscriber's
+  // view, 0 outside every one (session/probe_interest.h). Empty: every probe counts as seen.
+  // Used by the ray budget only. std::invalid_argument for a wrong size or a weight outside [0, 1].
+  void setViewWeights(std::vector<float> weights);
+  // Samples each probe (grid order) traced in the last update.
+  const std::vector<uint32_t>& lastSamples() const;
 
   uint32_t probeCount() const;
   uint32_t updates() const;

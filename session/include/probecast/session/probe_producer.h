@@ -82,6 +82,8 @@ class ProbeProducer {
   service::PublisherStats busStats() const;
 
   // The lighting source (one of three). A traced scene: `first` is `sceneSpec` at the animation's start.
+  // With a ray budget (options.raysPerUpdate), every update first tells the updater which probes
+  // the hub's subscribers can see (probe_interest.h).
   void traceScene(renderer::VulkanContext& context, const std::string& sceneSpec, const scene::Scene& first,
                   const ProbeGrid& grid, const renderer::UpdaterOptions& options, const Animation& animation);
   // A fixed volume (its area light rule with it): published once now; every step then only ticks the hub's budgets.
@@ -123,6 +125,7 @@ class ProbeProducer {
   // Source.
   std::unique_ptr<renderer::ProbeUpdater> updater_;
   std::string sceneSpec_;
+  bool rayBudget_ = false;  // the updater spends a ray budget: it is told the subscribers' views
   Animation animation_;
   FrameGenerator generator_;
   std::vector<float> frame_;

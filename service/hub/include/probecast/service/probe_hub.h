@@ -143,6 +143,9 @@ class ProbeHub {
                          std::function<void()> wake);
   void removeSubscriber(uint64_t id);
   void setViews(uint64_t id, std::vector<View> views);
+  // Every view of every subscriber, one after another (what anyone may look at: the producer's
+  // ray budget traces those probes first). Read-only.
+  std::vector<View> subscriberViews() const;
   size_t subscriberCount() const;
 
   // The next frame for this subscriber: the bricks it lacks, best first, within its budget.
