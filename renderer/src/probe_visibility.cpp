@@ -12,8 +12,7 @@
 
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/renderer/view_sets.h"
-#include "shadow.frag.h"
-#include "shadow.vert.h"
+#include "shadow_maps.h"
 #include "vk_pipeline.h"
 
 namespace probecast::renderer {
@@ -358,15 +357,7 @@ glm::vec2 probeMomentsAt(const ProbeVisibility& vis, uint32_t probe, const glm::
 
 void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, ProbeVisibility& out) {
   out.layout = createPipelineLayout(d, materials, kStages, sizeof(shaders::RsShadowPush));
-  GraphicsPipelineDesc desc;
-  desc.vertexCode = kShadowVert;
-  desc.vertexBytes = sizeof kShadowVert;
-  desc.layout = out.layout;
-  out.pipeline = createGraphicsPipeline(d, desc);
-  desc.fragmentCode = kShadowFrag;
-  desc.fragmentBytes = sizeof kShadowFrag;
-  desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard
-  out.cutoutPipeline = createGraphicsPipeline(d, desc);
+  createDepthPipelines(d, out.layout, false, out.pipeline, out.cutoutPipeline);
   // One tile of a probe that sees nothing: E[r] large, zero variance — every point visible.
   std::vector<float> atlas(RS_VIS_TILE * RS_VIS_TILE * 2);
   for (size_t t = 0; t < atlas.size(); t += 2) {

@@ -87,6 +87,20 @@ void uploadLayers(const ShadowMaps& maps) {
 
 }  // namespace
 
+void createDepthPipelines(VulkanDevice& d, VkPipelineLayout layout, bool depthBias, VkPipeline& opaque,
+                          VkPipeline& cutout) {
+  GraphicsPipelineDesc desc;
+  desc.vertexCode = kShadowVert;
+  desc.vertexBytes = sizeof kShadowVert;
+  desc.depthBias = depthBias;
+  desc.layout = layout;
+  opaque = createGraphicsPipeline(d, desc);
+  desc.fragmentCode = kShadowFrag;
+  desc.fragmentBytes = sizeof kShadowFrag;
+  desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard
+  cutout = createGraphicsPipeline(d, desc);
+}
+
 void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, uint32_t cascades,
                       VkDescriptorSetLayout materials, ShadowMaps& out) {
   if (cascades < 1 || cascades > RS_MAX_CASCADES)
@@ -95,21 +109,15 @@ void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, uint32
   out.maxLayers = maxLayers;
   out.cascades = cascades;
   out.layout = createPipelineLayout(d, materials, kShadowStages, sizeof(shaders::RsShadowPush));
+  createDepthPipelines(d, out.layout, true, out.pipeline, out.cutoutPipeline);
   GraphicsPipelineDesc desc;
   desc.vertexCode = kShadowVert;
   desc.vertexBytes = sizeof kShadowVert;
-  desc.depthBias = true;
   desc.layout = out.layout;
-  out.pipeline = createGraphicsPipeline(d, desc);
-  desc.fragmentCode = kShadowFrag;
-  desc.fragmentBytes = sizeof kShadowFrag;
-  desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard
-  out.cutoutPipeline = createGraphicsPipeline(d, desc);
   desc.fragmentCode = kShadowTransmitFrag;
   desc.fragmentBytes = sizeof kShadowTransmitFrag;
   desc.colorFormat = kTransmitFormat;
   desc.blend = ColorBlend::MultiplyMinAlpha;
-  desc.depthBias = false;
   out.transmitPipeline = createGraphicsPipeline(d, desc);
 }
 

@@ -52,6 +52,11 @@ struct ShadowMaps {
 
 // `materials`: a set layout with the raster client's material bindings (RS_BINDING_*).
 // `cascades`: layers per directional light (1..RS_MAX_CASCADES; 1 = one layer over the scene).
+// The depth-only pipelines of the scene's triangles from a point of view (shadow.vert): opaque, and
+// cut-out with shadow.frag's alpha-test discard. Shadow layers and probe depth cubes both use them.
+void createDepthPipelines(VulkanDevice& d, VkPipelineLayout layout, bool depthBias, VkPipeline& opaque,
+                          VkPipeline& cutout);
+
 void createShadowMaps(VulkanDevice& d, uint32_t size, uint32_t maxLayers, uint32_t cascades,
                       VkDescriptorSetLayout materials, ShadowMaps& out);
 // Plans the layers for the scene's lights (bounds from the scene); drawn at the next draw call.
