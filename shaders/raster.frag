@@ -90,6 +90,7 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
   vec3 q = p + (0.2 * ng + 0.8 * wo) * (0.75 * 0.3 * pc.volumeMax.w);
   float total = 0.0;
   int activeProbes = 0;
+  bool anyInFront = false;
   for (int k = 0; k < 8; ++k) {
     ivec3 off = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
     vec3 t3 = mix(1.0 - alpha, alpha, vec3(off));
@@ -103,6 +104,7 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
     vec3 toProbe = probe - p;
     float len = length(toProbe);
     float facing = len > 1e-6 ? (dot(toProbe / len, ng) + 1.0) * 0.5 : 1.0;
+    anyInFront = anyInFront || dot(toProbe, ng) > -1e-3 * pc.volumeMax.w;
     float w = facing * facing + 0.2;
     vec3 fromProbe = q - probe;
     float r = length(fromProbe);
@@ -129,9 +131,10 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
     total += w;
   }
   if (activeProbes == 0) return probeCoefficients(p, c);
-  // Every active probe hidden (the outer face of a wall, probes all inside): no probe sees the
-  // point, so none lights it; weights this small would only rank the hidden probes.
-  float scale = total > 1e-10 ? 1.0 / total : 0.0;
+  // Every active probe behind the surface's plane (the outer face of a wall or ceiling, probes all
+  // inside) or hidden: no probe sees the point, so none lights it. Renormalising the backface
+  // floor's small weights would light it fully from the far side.
+  float scale = anyInFront && total > 1e-10 ? 1.0 / total : 0.0;
   for (int i = 0; i < 27; ++i) c[i] *= scale;
   return true;
 }

@@ -206,6 +206,43 @@ TEST(ProbeVisibility, BoxFaceIsNotDarkenedByProbesInsideTheBox) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+TEST(ProbeVisibility, OuterFaceOfACeilingAboveEveryProbeGetsNoProbeLight) {
+  // A ceiling quad at y = 1 above a grid that ends at y = 0.8, every probe holding constant light
+  // L (as the probes inside the demo's room do). Seen from below, its face is lit by the probes in
+  // front of it; seen from above (the light field's top row of eyes), every probe lies behind its
+  // plane, so nothing any probe holds reaches it: the reference leaves it black. Without the rule
+  // the backface floor's small weights were renormalised and lit it fully.
+  VulkanContext context(test::validatedContext());
+  scene::Scene s;
+  scene::Material white;
+  white.baseColor = glm::vec3(0.8f);
+  s.materials.push_back(white);
+  scene::addQuad(s, {-1.0f, 1.0f, -1.0f}, {1.0f, 1.0f, -1.0f}, {1.0f, 1.0f, 1.0f}, {-1.0f, 1.0f, 1.0f}, 0);
+  scene::finalizeScene(s);
+  const ProbeGrid grid{{5, 5, 5}, {{-1.0f, -1.0f, -1.0f}, {1.0f, 0.8f, 1.0f}}};
+  ProbeVolume volume = makeProbeVolume(grid);
+  for (uint32_t p = 0; p < grid.count(); ++p) volume.probes[p * 27] = volume.probes[p * 27 + 1] = volume.probes[p * 27 + 2] = 3.5449077f;
+  CameraView above;
+  above.position = {0.0f, 3.0f, 0.0f};
+  above.forward = {0.0f, -1.0f, 0.0f};
+  above.up = {0.0f, 0.0f, -1.0f};
+  above.yfov = 0.3f;  // the quad fills the image
+  CameraView below = above;
+  below.position.y = 0.0f;
+  below.forward.y = 1.0f;
+  below.yfov = 1.2f;
+  RasterOptions ro;
+  ro.visibility = true;
+  RasterRenderer raster(context, s, 32, 32, ro);
+  raster.setProbes(volume);
+  const double outer = imageMean(raster.render(raster.viewProjection(above), above.position));
+  const double inner = imageMean(raster.render(raster.viewProjection(below), below.position));
+  std::printf("ceiling seen from above %.4f, from below %.4f\n", outer, inner);
+  EXPECT_GT(inner, 0.5);  // L · albedo = 0.8 where fully lit
+  EXPECT_LT(outer, 0.01 * inner);
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
 // Every texel (E[r], E[r²]) of every probe of a raster client's current volume.
 std::vector<glm::vec2> allMoments(const RasterRenderer& raster, uint32_t probes) {
   std::vector<glm::vec2> out;
