@@ -1,4 +1,5 @@
 // `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
+#include <algorithm>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -26,6 +27,7 @@ struct ViewOptions {
   double waitSeconds = 3.0;
   std::vector<uint32_t> size{320, 200};
   uint32_t updates = 4;
+  uint32_t supersample = 1;  // raster samples per pixel side
   float exposure = 1.0f;
   bool exr = false;
   bool visibility = true;
@@ -37,6 +39,13 @@ struct Rendered {
   std::vector<renderer::Image> images;
   double viewsMs = 0.0, shadowMs = 0.0;
 };
+
+// Views rendered at --supersample × the size, brought back to one value per pixel.
+std::vector<renderer::Image> averagePixels(std::vector<renderer::Image> images, uint32_t supersample) {
+  if (supersample > 1)
+    for (renderer::Image& image : images) image = renderer::boxDownsample(image, supersample);
+  return images;
+}
 
 void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) {
   if (rule.on())
@@ -50,8 +59,8 @@ void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) 
 Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
                           const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
   session::ViewerConfig vc;
-  vc.width = o.size[0];
-  vc.height = o.size[1];
+  vc.width = o.size[0] * o.supersample;
+  vc.height = o.size[1] * o.supersample;
   vc.raster = ro;
   vc.client = o.connection.client("probecast-view");
   vc.client.zh3PerPixel = true;
@@ -72,7 +81,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
   printAreaLights(viewer.areaLightRule(), viewer.areaLights());
-  return {viewer.images(), viewer.timings().viewsMs, viewer.timings().shadowMs};
+  return {averagePixels(viewer.images(), o.supersample), viewer.timings().viewsMs, viewer.timings().shadowMs};
 }
 
 // Local probes: traced now (--probes live) or read from a file, through --repr when given.
@@ -99,7 +108,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   }
   if (o.repr != "float")
     volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
-  renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
+  renderer::RasterRenderer raster(context, s, o.size[0] * o.supersample, o.size[1] * o.supersample, ro);
   raster.setProbes(volume);
   printAreaLights(volume.areaLights, raster.areaLights());
   if (raster.visibilityActive())
@@ -108,7 +117,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
                volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityTriangles,
                raster.timings().visibilityMomentsMs, renderer::RasterRenderer::visibilityBytesPerProbe());
   Rendered r;
-  r.images = raster.renderViews(views);
+  r.images = averagePixels(raster.renderViews(views), o.supersample);
   r.viewsMs = raster.timings().viewsMs;
   r.shadowMs = raster.timings().shadowMs;
   return r;
@@ -146,6 +155,10 @@ void addViewCommand(CLI::App& app) {
       ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
   addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
+  cmd->add_option("--supersample", o->supersample,
+                  "render at N × the size and average each N × N block (N² samples per pixel, as a reference "
+                  "averages the pixel's footprint)")
+      ->check(CLI::Range(1, 8));
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
@@ -166,6 +179,9 @@ void addViewCommand(CLI::App& app) {
     renderer::ViewSetSpec spec;
     std::string error;
     orThrow(renderer::parseViewSet(o->views, spec, error), error);
+    if (std::max(o->size[0], o->size[1]) * o->supersample > 16384)
+      throw std::invalid_argument(fmt::format("--supersample {}: {}x{} views would render over 16384 pixels a side",
+                                              o->supersample, o->size[0], o->size[1]));
     const scene::Scene s = o->tracing.scene.load();
     const auto environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
@@ -182,9 +198,9 @@ void addViewCommand(CLI::App& app) {
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);
     writeViews(*o, r, views, spec);
-    fmt::print("view: {} {} views of {}x{} on {}: {:.1f} ms per view, shadow maps {:.1f} ms; wrote {}/quilt.png and "
-               "quilt.exr\n",
-               o->views, views.size(), o->size[0], o->size[1], context.deviceName(),
+    fmt::print("view: {} {} views of {}x{} ({}² samples per pixel) on {}: {:.1f} ms per view, shadow maps {:.1f} ms; "
+               "wrote {}/quilt.png and quilt.exr\n",
+               o->views, views.size(), o->size[0], o->size[1], o->supersample, context.deviceName(),
                r.viewsMs / static_cast<double>(views.size()), r.shadowMs, o->out);
   });
 }

@@ -44,24 +44,6 @@ struct ReprRun {
 
 }  // namespace
 
-renderer::Image boxDownsample(const renderer::Image& image, uint32_t factor) {
-  if (factor == 0 || image.width % factor != 0 || image.height % factor != 0 ||
-      image.rgb.size() != static_cast<size_t>(image.width) * image.height * 3)
-    throw std::invalid_argument(fmt::format("boxDownsample: a {}x{} image does not split into {}-pixel blocks",
-                                            image.width, image.height, factor));
-  renderer::Image out;
-  out.width = image.width / factor;
-  out.height = image.height / factor;
-  out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 0.0f);
-  const float weight = 1.0f / static_cast<float>(factor * factor);
-  for (uint32_t y = 0; y < image.height; ++y)
-    for (uint32_t x = 0; x < image.width; ++x)
-      for (int c = 0; c < 3; ++c)
-        out.rgb[(static_cast<size_t>(y / factor) * out.width + x / factor) * 3 + c] +=
-            weight * image.rgb[(static_cast<size_t>(y) * image.width + x) * 3 + c];
-  return out;
-}
-
 void checkSceneBenchOptions(const SceneBenchOptions& o) {
   renderer::ViewSetSpec spec;
   std::string error;

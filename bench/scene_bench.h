@@ -45,10 +45,6 @@ struct SceneBenchResult {
   std::string svg;  // mean PSNR against ms per view, one point per representation
 };
 
-// The mean of each factor × factor block of `image` (sides divisible by factor): the pixel integral
-// a reference estimates, from a render at factor × the size.
-renderer::Image boxDownsample(const renderer::Image& image, uint32_t factor);
-
 // Throws std::invalid_argument with a message naming the option for nonsense the CLI's own range
 // checks cannot see (a view set that does not parse, a reference of more samples than can finish).
 void checkSceneBenchOptions(const SceneBenchOptions& options);

@@ -7,6 +7,7 @@
 
 #include "harness.h"
 #include "scene_bench.h"
+#include "probecast/renderer/view_sets.h"
 #include "probecast/imaging/image_io.h"
 #include "vulkan_test_support.h"
 
