@@ -1,11 +1,35 @@
 // probecast: one binary, one subcommand per job (see README.md).
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
 #include "progress.h"
+
+namespace {
+
+// CLI11 reads "nan", "inf" and overflowing literals into floating-point options, and its Range
+// checks compare false against NaN, so NaN would pass every range. Every floating-point option of
+// every command therefore also refuses what is not a finite number.
+void refuseNonFiniteNumbers(CLI::App& app) {
+  const CLI::Validator finite(
+      [](std::string& value) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (end != value.c_str() && !std::isfinite(v)) return "not a finite number: " + value;
+        return {};
+      },
+      "", "FINITE");
+  for (CLI::Option* option : app.get_options())
+    if (option->get_type_name().find("FLOAT") != std::string::npos) option->check(finite);
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuseNonFiniteNumbers(*sub);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   probecast::app::setCommandLine(argc, argv);
@@ -23,6 +47,7 @@ int main(int argc, char** argv) {
   probecast::app::addEdgeCommand(app);
   probecast::app::addCompareCommand(app);
   probecast::app::addViewCommand(app);
+  refuseNonFiniteNumbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
