@@ -126,6 +126,8 @@ void addServeCommand(CLI::App& app) {
     pacing.seconds = o->seconds;
     double lastReport = 0.0;
     producer->run(pacing, &gInterrupted, [&](double seconds) {
+      if (!o->publish.empty() && producer->busStats().displaced)
+        throw std::runtime_error("--publish: " + producer->busStats().lastError);
       if (seconds - lastReport < 5.0) return;
       const service::PublisherStats sent = producer->busStats();
       fmt::print("serve: {:.0f} s, {} updates, {} subscribers{}\n", seconds, producer->stats().updates,

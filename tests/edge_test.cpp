@@ -141,11 +141,13 @@ TEST_F(Edge, AnEdgeShutDownMidStreamItsSubscribersResumeOnTheOtherWithoutAKeyfra
 // An edge that hangs (SIGSTOP) keeps its TCP connections open and sends nothing: only keepalive
 // pings notice. Its subscribers must fail over to the other edge, not wait forever.
 TEST_F(Edge, AFrozenEdgeIsNoticedByKeepaliveAndItsSubscribersFailOver) {
-  BusProducer producer(bus);
   EdgeConfig fast = edgeConfig();
   fast.server.minClientPingMs = 100;
+  // The edge process is forked from this one: before any NATS client thread runs here (one
+  // holding a library lock at the fork would leave it held in the child for good).
   session::EdgeProcess a(fast);
   const int portA = a.start();
+  BusProducer producer(bus);
   EdgeServer b(fast);
   const std::string onA = "127.0.0.1:" + std::to_string(portA), onB = "127.0.0.1:" + std::to_string(b.port());
   producer.publish(1);
@@ -254,6 +256,64 @@ TEST_F(Edge, ARestartedProducerIsANewEpochEdgesEndTheirStreamsAndClientsConverge
   EXPECT_EQ(edge.hub().epoch(), second.hub.epoch());
   EXPECT_GE(client.stats().connects, 2u);  // its stream was ended and it subscribed again
   EXPECT_EQ(client.stats().framesRejected, 0u);
+}
+
+TEST_F(Edge, ASecondProducerOnALiveStreamIsDisplacedAndTheFirstsVolumeStays) {
+  // Two producers started on one stream name by mistake: without the claim the second purged the
+  // first's bricks and both overwrote each other's. Now the second sees the first renew its claim
+  // and stops without touching the stream; the edge's subscribers keep the first's volume.
+  bus.claimRenewMs = 200;
+  EdgeServer edge(edgeConfig());
+  ProbeClient client(clientFor({edge.port()}));
+  client.start();
+  BusProducer first(bus);
+  first.publish(5);
+  ASSERT_TRUE(waitFor([&] { return matchesServer(client, first.hub); }, 10s));
+  BusProducer second(bus);
+  second.rng.seed(77);  // other lighting
+  second.publish(3);
+  const auto displaced = [&] { return second.publisher.stats().displaced; };
+  for (int i = 0; i < 100 && !displaced(); ++i) first.publish(1, 50ms);  // the first keeps renewing
+  ASSERT_TRUE(displaced());
+  EXPECT_NE(second.publisher.stats().lastError.find("has a live producer"), std::string::npos)
+      << second.publisher.stats().lastError;
+  EXPECT_EQ(second.publisher.stats().messages, 0u);
+  second.publish(3);  // a displaced producer's new versions go nowhere
+  first.publish(5);
+  ASSERT_TRUE(first.caughtUp()) << first.publisher.stats().lastError;
+  EXPECT_FALSE(first.publisher.stats().displaced);
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, first.hub); }, 10s)) << edge.stats().lastError;
+  EXPECT_EQ(edge.hub().epoch(), first.hub.epoch());
+  EXPECT_EQ(client.stats().framesRejected, 0u);
+}
+
+TEST_F(Edge, AProducerWhoseClaimIsTakenOverStopsPublishing) {
+  // A producer cut off from the bus for longer than its claim lasts may find, on its return, that
+  // another producer took the stream over: it must stop, not overwrite the new owner's bricks.
+  bus.claimRenewMs = 200;
+  BusProducer first(bus);
+  first.publish(3);
+  ASSERT_TRUE(first.caughtUp());
+  // Another producer's claim, as one would publish it after taking over.
+  natsConnection* nc = nullptr;
+  jsCtx* js = nullptr;
+  ASSERT_EQ(natsConnection_ConnectTo(&nc, bus.url.c_str()), NATS_OK);
+  ASSERT_EQ(natsConnection_JetStream(&js, nc, nullptr), NATS_OK);
+  const std::string other = "probecast producer elsewhere";
+  jsPubAck* ack = nullptr;
+  ASSERT_EQ(js_Publish(&ack, js, producerSubject(bus.stream).c_str(), other.data(), static_cast<int>(other.size()),
+                       nullptr, nullptr),
+            NATS_OK);
+  jsPubAck_Destroy(ack);
+  jsCtx_Destroy(js);
+  natsConnection_Destroy(nc);
+  EXPECT_TRUE(waitFor([&] { return first.publisher.stats().displaced; }, 5s));
+  EXPECT_NE(first.publisher.stats().lastError.find("took stream"), std::string::npos)
+      << first.publisher.stats().lastError;
+  const uint64_t sent = first.publisher.stats().messages;
+  first.publish(3);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(first.publisher.stats().messages, sent);
 }
 
 }  // namespace

@@ -3,8 +3,11 @@
 #include <condition_variable>
 #include <map>
 #include <mutex>
+#include <random>
 #include <stdexcept>
 #include <thread>
+
+#include <unistd.h>
 
 #include "nats_link.h"
 #include "probecast/service/bus_format.h"
@@ -22,10 +25,95 @@ struct BusPublisher::Impl {
   std::string failure;  // an acknowledgement that came back refused, from the library's thread
   PublisherStats stats;
   uint64_t volumeEpochSent = 0;  // the producer's epoch of the last volume message the bus acknowledged
+  // The claim on the stream: who this publisher is (host, process, a random number), the sequence
+  // of its newest claim message (0 before the first) and when to renew it.
+  std::string identity;
+  uint64_t claimSequence = 0;
+  std::chrono::steady_clock::time_point renewAt{};
   std::unique_ptr<NatsLink> link;
   std::thread worker;
 
-  Impl(const BusConfig& c, ProbeHub& h) : config(c), hub(h) {}
+  Impl(const BusConfig& c, ProbeHub& h) : config(c), hub(h) {
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    identity = "probecast producer " + std::string(host) + " pid " + std::to_string(getpid()) + " id " +
+               std::to_string(std::random_device{}());
+  }
+
+  // The newest claim on the stream: its sequence (0 when there is none) and its text.
+  bool lastClaim(uint64_t& sequence, std::string& holder, std::string& why) {
+    natsMsg* msg = nullptr;
+    jsOptions jo = link->requestOptions();
+    jsErrCode code = static_cast<jsErrCode>(0);
+    const natsStatus s = js_GetLastMsg(&msg, link->jetStream(), busStreamName(config.stream).c_str(),
+                                       producerSubject(config.stream).c_str(), &jo, &code);
+    if (s == NATS_NOT_FOUND || code == JSNoMessageFoundErr) {
+      sequence = 0;
+      holder.clear();
+      return true;
+    }
+    if (s != NATS_OK) return why = "cannot read the stream's producer claim: " + natsErrorText(s, code), false;
+    sequence = natsMsg_GetSequence(msg);
+    holder.assign(natsMsg_GetData(msg), static_cast<size_t>(natsMsg_GetDataLength(msg)));
+    natsMsg_Destroy(msg);
+    return true;
+  }
+
+  enum class Claim { Held, Lost, Failed };
+
+  // Publishes this publisher's claim, accepted only while the claim subject's newest message is
+  // sequence `expected` (0: no condition, for a subject that held nothing).
+  Claim publishClaim(uint64_t expected, std::string& why) {
+    jsPubOptions po;
+    jsPubOptions_Init(&po);
+    po.MaxWait = config.requestTimeoutMs;
+    po.ExpectLastSubjectSeq = expected;
+    jsPubAck* ack = nullptr;
+    jsErrCode code = static_cast<jsErrCode>(0);
+    const natsStatus s = js_Publish(&ack, link->jetStream(), producerSubject(config.stream).c_str(), identity.data(),
+                                    static_cast<int>(identity.size()), &po, &code);
+    if (s == NATS_OK) {
+      claimSequence = ack->Sequence;
+      jsPubAck_Destroy(ack);
+      renewAt = std::chrono::steady_clock::now() + std::chrono::milliseconds(config.claimRenewMs);
+      return Claim::Held;
+    }
+    if (code == JSStreamWrongLastSequenceErr) return Claim::Lost;
+    why = "cannot claim stream " + busStreamName(config.stream) + ": " + natsErrorText(s, code);
+    return Claim::Failed;
+  }
+
+  // Makes sure this publisher owns the stream before it purges or publishes: keeps its own claim,
+  // takes over one that is not renewed for two renewal periods, claims a stream nobody holds.
+  // Returns Lost when another producer holds it (why says who).
+  Claim claim(std::string& why) {
+    uint64_t sequence = 0;
+    std::string holder;
+    if (!lastClaim(sequence, holder, why)) return Claim::Failed;
+    if (sequence != 0 && holder == identity) return publishClaim(sequence, why);
+    if (sequence != 0) {
+      if (claimSequence != 0) {  // this publisher held the stream, and another producer took it over
+        why = "another producer took stream " + busStreamName(config.stream) + " over (" + holder + ")";
+        return Claim::Lost;
+      }
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        wake.wait_for(lock, std::chrono::milliseconds(2 * config.claimRenewMs), [this] { return stopping; });
+        if (stopping) return why = "stopping", Claim::Failed;
+      }
+      uint64_t now = 0;
+      if (!lastClaim(now, holder, why)) return Claim::Failed;
+      if (now != sequence) {
+        why = "stream " + busStreamName(config.stream) + " has a live producer (" + holder +
+              "): stop it, or publish under another --stream";
+        return Claim::Lost;
+      }
+    }
+    const Claim c = publishClaim(sequence, why);
+    if (c == Claim::Lost)
+      why = "another producer claimed stream " + busStreamName(config.stream) + " at the same moment";
+    return c;
+  }
 
   static void refused(jsCtx*, jsPubAckErr* pae, void* self) {
     auto* s = static_cast<Impl*>(self);
@@ -34,15 +122,17 @@ struct BusPublisher::Impl {
                  (pae->ErrText ? std::string(" ") + pae->ErrText : std::string());
   }
 
-  // Creates the stream or brings its limits up to date; the first time, drops what it held.
-  bool ensureStream(bool purgeIt, std::string& why) {
-    const std::string name = busStreamName(config.stream), subjects = busSubjects(config.stream);
-    const char* subjectList[] = {subjects.c_str()};
+  // Creates the stream or brings its limits up to date, and claims it; the first time, drops the
+  // volume an earlier producer left. Sets `lost` when another producer owns the stream.
+  bool ensureStream(bool purgeIt, bool& lost, std::string& why) {
+    const std::string name = busStreamName(config.stream), subjects = busSubjects(config.stream),
+                      claims = producerSubject(config.stream);
+    const char* subjectList[] = {subjects.c_str(), claims.c_str()};
     jsStreamConfig sc;
     jsStreamConfig_Init(&sc);
     sc.Name = name.c_str();
     sc.Subjects = subjectList;
-    sc.SubjectsLen = 1;
+    sc.SubjectsLen = 2;
     sc.Retention = js_LimitsPolicy;
     sc.Storage = js_FileStorage;
     sc.MaxMsgsPerSubject = 1;  // the newest version of each brick is all anyone needs
@@ -58,6 +148,10 @@ struct BusPublisher::Impl {
     }
     if (info) jsStreamInfo_Destroy(info);
     if (s != NATS_OK) return why = "cannot create stream " + name + ": " + natsErrorText(s, code), false;
+    const Claim c = claim(why);
+    lost = c == Claim::Lost;
+    if (c != Claim::Held) return false;
+    jo.Stream.Purge.Subject = subjects.c_str();  // the claim stays
     if (purgeIt && (s = js_PurgeStream(link->jetStream(), name.c_str(), &jo, &code)) != NATS_OK)
       return why = "cannot purge stream " + name + ": " + natsErrorText(s, code), false;
     return true;
@@ -110,21 +204,45 @@ struct BusPublisher::Impl {
     return true;
   }
 
+  // Gives the stream up for good: another producer owns it.
+  void displaced(const std::string& why) {
+    stats.displaced = true;
+    stats.lastError = why;
+    pending.clear();
+    busy = false;
+  }
+
   void run() {
     std::unique_lock<std::mutex> lock(mutex);
-    while (!stopping) {
+    while (!stopping && !stats.displaced) {
       wake.wait_for(lock, std::chrono::milliseconds(200), [this] {
         return stopping || (link->connected() && (needStream || resync || !pending.empty()));
       });
       if (stopping) break;
+      if (link->connected() && !needStream && std::chrono::steady_clock::now() >= renewAt) {
+        lock.unlock();
+        std::string why;
+        const Claim c = publishClaim(claimSequence, why);
+        lock.lock();
+        if (c == Claim::Lost) {
+          displaced("another producer took stream " + busStreamName(config.stream) + " over");
+          break;
+        }
+        if (c == Claim::Failed) needStream = true;  // the server may have lost the stream: claim it anew
+      }
       if (!link->connected() || !(needStream || resync || !pending.empty())) continue;
       busy = true;
       if (needStream) {
         const bool purgeIt = purge;
         lock.unlock();
         std::string why;
-        const bool ok = ensureStream(purgeIt, why);
+        bool lost = false;
+        const bool ok = ensureStream(purgeIt, lost, why);
         lock.lock();
+        if (lost) {
+          displaced(why);
+          break;
+        }
         if (!ok) {
           stats.lastError = why;
           busy = false;
@@ -182,7 +300,7 @@ BusPublisher::BusPublisher(const BusConfig& config, ProbeHub& hub) : impl_(std::
     const std::shared_ptr<Impl> self = weak.lock();
     if (!self) return;
     std::lock_guard<std::mutex> lock(self->mutex);
-    if (self->stopping) return;
+    if (self->stopping || self->stats.displaced) return;
     for (BrickVersionBytes& v : made)
       if (!self->pending.insert_or_assign(v.brick, std::move(v)).second) ++self->stats.superseded;
     self->wake.notify_all();

@@ -26,7 +26,8 @@ bool checkBusConfig(const BusConfig& c, std::string& why) {
       return why = "NATS URL '" + one + "' is not nats://host:port", false;
     start = end + 1;
   }
-  if (c.reconnectWaitMs < 1 || c.requestTimeoutMs < 1) return why = "bus timeouts must be positive", false;
+  if (c.reconnectWaitMs < 1 || c.requestTimeoutMs < 1 || c.claimRenewMs < 1)
+    return why = "bus timeouts must be positive", false;
   return true;
 }
 
@@ -36,6 +37,7 @@ std::string volumeSubject(const std::string& stream) { return "probecast." + str
 std::string brickSubject(const std::string& stream, uint32_t brick) {
   return "probecast." + stream + ".brick." + std::to_string(brick);
 }
+std::string producerSubject(const std::string& stream) { return "probecast-producer." + stream; }
 
 std::string natsErrorText(natsStatus status, jsErrCode code) {
   std::string text = natsStatus_GetText(status);

@@ -23,6 +23,7 @@ struct BusConfig {
   std::string stream = "probes";              // the volume's name on the bus
   int reconnectWaitMs = 100;                  // between reconnect attempts (forever)
   int requestTimeoutMs = 2000;                // JetStream requests and publish acknowledgements
+  int claimRenewMs = 1000;                    // a producer renews its claim on the stream this often
 };
 
 // A stream name is part of subjects and of the JetStream name: letters, digits, '-' and '_', at
@@ -32,6 +33,9 @@ std::string busStreamName(const std::string& stream);
 std::string busSubjects(const std::string& stream);  // probecast.<name>.>
 std::string volumeSubject(const std::string& stream);
 std::string brickSubject(const std::string& stream, uint32_t brick);
+// Where the producer that owns the stream renews its claim: probecast-producer.<name>, in the
+// stream but outside the subjects edges consume.
+std::string producerSubject(const std::string& stream);
 
 struct PublisherStats {
   bool connected = false;
@@ -40,6 +44,7 @@ struct PublisherStats {
   uint64_t keyframeBytes = 0, deltaBytes = 0;  // of which brick sections: keyframes, deltas
   uint64_t superseded = 0; // brick versions replaced by a newer one before they went out
   uint32_t resyncs = 0;    // times every brick was published again (after a reconnect or a failure)
+  bool displaced = false;  // another producer owns the stream: this one has stopped publishing for good
   std::string lastError;
 };
 
@@ -49,6 +54,14 @@ struct PublisherStats {
 // its whole store). The first connect purges what an earlier producer left under the name. A
 // bus that is slow or away never slows the producer: versions of a brick not yet sent are
 // replaced by newer ones.
+//
+// One producer per stream: before purging, a publisher claims the stream on producerSubject and
+// renews the claim every claimRenewMs, each renewal conditional on the subject's last sequence
+// being its own. A claim left by another producer is taken over only when it is not renewed for
+// two renewal periods (that producer stopped); a live one leaves this publisher displaced
+// (PublisherStats::displaced, with the reason in lastError) without touching the stream. A
+// producer whose renewal finds another's claim (it took over while this one was cut off) stops
+// publishing the same way.
 class BusPublisher {
  public:
   // Throws std::invalid_argument for a bad config (checkBusConfig). The hub must outlive this.
