@@ -278,6 +278,7 @@ TEST_F(Edge, ASecondProducerOnALiveStreamIsDisplacedAndTheFirstsVolumeStays) {
   EXPECT_NE(second.publisher.stats().lastError.find("has a live producer"), std::string::npos)
       << second.publisher.stats().lastError;
   EXPECT_EQ(second.publisher.stats().messages, 0u);
+  EXPECT_FALSE(second.publisher.caughtUp());
   second.publish(3);  // a displaced producer's new versions go nowhere
   first.publish(5);
   ASSERT_TRUE(first.caughtUp()) << first.publisher.stats().lastError;

@@ -329,7 +329,7 @@ PublisherStats BusPublisher::stats() const {
 bool BusPublisher::caughtUp() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   const Impl& s = *impl_;
-  return s.link->connected() && !s.busy && !s.needStream && !s.resync && s.pending.empty();
+  return s.link->connected() && !s.stats.displaced && !s.busy && !s.needStream && !s.resync && s.pending.empty();
 }
 
 }  // namespace probecast::service

@@ -73,7 +73,8 @@ class BusPublisher {
   BusPublisher& operator=(const BusPublisher&) = delete;
 
   PublisherStats stats() const;
-  // True once every version the hub made so far has been acknowledged by the bus (for tests and tools).
+  // True once every version the hub made so far has been acknowledged by the bus (for tests and
+  // tools); never while displaced.
   bool caughtUp() const;
 
  private:
