@@ -98,7 +98,7 @@ struct BusPublisher::Impl {
       }
       {
         std::unique_lock<std::mutex> lock(mutex);
-        wake.wait_for(lock, std::chrono::milliseconds(2 * config.claimRenewMs), [this] { return stopping; });
+        wake.wait_for(lock, std::chrono::milliseconds(2LL * config.claimRenewMs), [this] { return stopping; });
         if (stopping) return why = "stopping", Claim::Failed;
       }
       uint64_t now = 0;
