@@ -40,13 +40,6 @@ struct Rendered {
   double viewsMs = 0.0, shadowMs = 0.0;
 };
 
-// Views rendered at --supersample × the size, brought back to one value per pixel.
-std::vector<renderer::Image> averagePixels(std::vector<renderer::Image> images, uint32_t supersample) {
-  if (supersample > 1)
-    for (renderer::Image& image : images) image = renderer::boxDownsample(image, supersample);
-  return images;
-}
-
 void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) {
   if (rule.on())
     fmt::print("view: client area lights on as the probes say (emitters of at least {} of the power): {} lights\n",
@@ -81,7 +74,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
   printAreaLights(viewer.areaLightRule(), viewer.areaLights());
-  return {averagePixels(viewer.images(), o.supersample), viewer.timings().viewsMs, viewer.timings().shadowMs};
+  return {renderer::boxDownsample(viewer.images(), o.supersample), viewer.timings().viewsMs, viewer.timings().shadowMs};
 }
 
 // Local probes: traced now (--probes live) or read from a file, through --repr when given.
@@ -117,7 +110,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
                volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityTriangles,
                raster.timings().visibilityMomentsMs, renderer::RasterRenderer::visibilityBytesPerProbe());
   Rendered r;
-  r.images = averagePixels(raster.renderViews(views), o.supersample);
+  r.images = renderer::boxDownsample(raster.renderViews(views), o.supersample);
   r.viewsMs = raster.timings().viewsMs;
   r.shadowMs = raster.timings().shadowMs;
   return r;

@@ -114,12 +114,7 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
   ro.environment = o.updater.environment;
   const uint32_t ss = o.supersample;
   renderer::RasterRenderer raster(context, o.scene, o.width * ss, o.height * ss, ro);
-  const auto render = [&] {
-    std::vector<renderer::Image> images = raster.renderViews(views);
-    if (ss > 1)
-      for (renderer::Image& image : images) image = boxDownsample(image, ss);
-    return images;
-  };
+  const auto render = [&] { return renderer::boxDownsample(raster.renderViews(views), ss); };
   if (!o.imagesDir.empty()) {
     std::filesystem::create_directories(o.imagesDir);
     for (size_t v = 0; v < views.size(); ++v)

@@ -134,4 +134,10 @@ Image boxDownsample(const Image& image, uint32_t factor) {
   return out;
 }
 
+std::vector<Image> boxDownsample(std::vector<Image> images, uint32_t factor) {
+  if (factor != 1)
+    for (Image& image : images) image = boxDownsample(image, factor);
+  return images;
+}
+
 }  // namespace probecast::renderer

@@ -61,5 +61,7 @@ Image composeQuilt(const std::vector<Image>& views, const std::vector<ViewInfo>&
 // one value per pixel that averages the pixel's whole footprint (as a path-traced reference does).
 // Throws std::invalid_argument when the sides do not divide by factor.
 Image boxDownsample(const Image& image, uint32_t factor);
+// Every view of a set, each as above (factor 1 returns them as they are).
+std::vector<Image> boxDownsample(std::vector<Image> images, uint32_t factor);
 
 }  // namespace probecast::renderer
