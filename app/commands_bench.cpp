@@ -212,8 +212,8 @@ void addBenchScene(CLI::App* bench) {
   RenderBenchCli{&so->size, &so->bench.updates, &so->bench.repeats, &so->bench.referenceSpp, &so->bench.referenceCache,
                  &so->bench.raster.shadowMapSize}
       .add(cmd, "probe updates (each timed)", "timed renders of the view set per representation (median)");
-  cmd->add_option("--supersample", so->bench.supersample,
-                  "raster samples per pixel side, box-filtered to --size (the reference averages each pixel's area)")
+  cmd->add_option("--supersample", so->bench.raster.samplesPerSide,
+                  "N × N raster samples per pixel, averaged (as the reference averages each pixel's area)")
       ->check(CLI::Range(1, 16));
   addVisibilityOption(cmd, so->bench.raster.visibility);
   so->areaLights.add(cmd);  // the reference sees every emitter either way, so the cached one still serves

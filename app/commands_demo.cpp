@@ -27,6 +27,9 @@ void addDemoCommand(CLI::App& app) {
       ->check(CLI::Range(1, 10000));
   addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
   addVisibilityOption(demo, o->visibility);
+  demo->add_option("--supersample", o->supersample,
+                   "the viewers' N × N raster samples per pixel, averaged (as the references average each pixel)")
+      ->check(CLI::Range(1, 16));
   o->areaLights.add(demo);
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
   o->environment.add(demo);

@@ -52,8 +52,8 @@ void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) 
 Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
                           const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
   session::ViewerConfig vc;
-  vc.width = o.size[0] * o.supersample;
-  vc.height = o.size[1] * o.supersample;
+  vc.width = o.size[0];
+  vc.height = o.size[1];
   vc.raster = ro;
   vc.client = o.connection.client("probecast-view");
   vc.client.zh3PerPixel = true;
@@ -74,7 +74,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
   printAreaLights(viewer.areaLightRule(), viewer.areaLights());
-  return {renderer::boxDownsample(viewer.images(), o.supersample), viewer.timings().viewsMs, viewer.timings().shadowMs};
+  return {viewer.images(), viewer.timings().viewsMs, viewer.timings().shadowMs};
 }
 
 // Local probes: traced now (--probes live) or read from a file, through --repr when given.
@@ -101,7 +101,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   }
   if (o.repr != "float")
     volume = decodeAs(volume, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
-  renderer::RasterRenderer raster(context, s, o.size[0] * o.supersample, o.size[1] * o.supersample, ro);
+  renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
   raster.setProbes(volume);
   printAreaLights(volume.areaLights, raster.areaLights());
   if (raster.visibilityActive())
@@ -110,7 +110,7 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
                volume.count(), raster.timings().visibilityRenderMs, raster.timings().visibilityTriangles,
                raster.timings().visibilityMomentsMs, renderer::RasterRenderer::visibilityBytesPerProbe());
   Rendered r;
-  r.images = renderer::boxDownsample(raster.renderViews(views), o.supersample);
+  r.images = raster.renderViews(views);
   r.viewsMs = raster.timings().viewsMs;
   r.shadowMs = raster.timings().shadowMs;
   return r;
@@ -149,9 +149,8 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
   addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
   cmd->add_option("--supersample", o->supersample,
-                  "render at N × the size and average each N × N block (N² samples per pixel, as a reference "
-                  "averages the pixel's footprint)")
-      ->check(CLI::Range(1, 8));
+                  "N × N raster samples per pixel, averaged (as a reference averages the pixel's footprint)")
+      ->check(CLI::Range(1, 16));
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
@@ -172,9 +171,6 @@ void addViewCommand(CLI::App& app) {
     renderer::ViewSetSpec spec;
     std::string error;
     orThrow(renderer::parseViewSet(o->views, spec, error), error);
-    if (std::max(o->size[0], o->size[1]) * o->supersample > 16384)
-      throw std::invalid_argument(fmt::format("--supersample {}: {}x{} views would render over 16384 pixels a side",
-                                              o->supersample, o->size[0], o->size[1]));
     const scene::Scene s = o->tracing.scene.load();
     const auto environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
@@ -188,6 +184,8 @@ void addViewCommand(CLI::App& app) {
     ro.visibilityReach = o->visibilityReach;
     ro.visibilityCulling = o->visibilityCulling;
     ro.environment = environment;
+    ro.samplesPerSide = o->supersample;
+    renderer::checkRasterSize(o->size[0], o->size[1], ro);  // before any tracing or connecting
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, views, ro);
     writeViews(*o, r, views, spec);

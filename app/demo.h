@@ -40,6 +40,7 @@ struct DemoOptions {
   EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
   std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
+  uint32_t supersample = 4;              // the viewers' raster samples per pixel side (RasterOptions)
   AreaLightCli areaLights;               // the server's rule; the viewers follow what the stream says
 };
 

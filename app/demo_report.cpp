@@ -100,17 +100,18 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
         v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
   md += fmt::format(
       "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without "
-      "clamping; the PNGs use a filmic tone map. The reference has noise of its own: two "
+      "clamping; the PNGs use a filmic tone map. Each viewer pixel is the mean of {}² raster samples, "
+      "as each reference pixel averages its area. The reference has noise of its own: two "
       "references of the headset's left eye with different seeds differ by {:.2f} dB PSNR, SSIM "
       "{:.4f} — the ceiling these figures can reach. Light-field views compared: the corners and "
       "the centre ({} in quilt order).\n\n",
-      report["reference_noise_floor"]["psnr_db"].get<double>(), report["reference_noise_floor"]["ssim"].get<double>(),
-      report["viewers"][1]["reference_views"].dump());
+      o.supersample, report["reference_noise_floor"]["psnr_db"].get<double>(),
+      report["reference_noise_floor"]["ssim"].get<double>(), report["viewers"][1]["reference_views"].dump());
   if (!viewsAboveScene.empty())
     md += fmt::format(
         "Views {} look from above the scene's top (the light field's top rows): they see the "
-        "outer face of the ceiling lit by the probes inside — a leak the reference does not have, "
-        "and why they score lowest.\n\n",
+        "outer face of the ceiling, which takes no probe light (every probe of its cells lies behind "
+        "it), as in the reference.\n\n",
         nlohmann::json(viewsAboveScene).dump());
   md += "## While the light moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
   for (const auto& m : report["moments"])
@@ -265,6 +266,7 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
                           : !o.environment.sky.empty() ? nlohmann::json({{"sky", o.environment.sky}})
                                                        : nlohmann::json(nullptr);
   report["spp_per_update"] = o.spp;
+  report["raster_samples_per_pixel"] = o.supersample * o.supersample;
   report["stream_seconds"] = run.streamSeconds;
   report["updates"] = producer.updates;
   report["update_ms_median"] = session::median(producer.updateMs);

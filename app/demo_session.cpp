@@ -83,6 +83,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
     vc.width = v.width;
     vc.height = v.height;
     vc.raster.visibility = o.visibility;
+    vc.raster.samplesPerSide = o.supersample;
     vc.client.address = server.listen;
     vc.client.token = server.token;
     vc.client.name = v.name;

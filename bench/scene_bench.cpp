@@ -58,10 +58,7 @@ void checkSceneBenchOptions(const SceneBenchOptions& o) {
         o.referenceSpp, spec.count(), o.width, o.height, samples, kMaxReferenceSamples));
   if (o.updates == 0) throw std::invalid_argument("--updates: at least 1");
   if (o.repeats == 0) throw std::invalid_argument("--repeats: at least 1");
-  if (o.supersample == 0 || o.supersample > 16) throw std::invalid_argument("--supersample: 1 to 16 samples per side");
-  if (static_cast<uint64_t>(o.width) * o.supersample > 16384 || static_cast<uint64_t>(o.height) * o.supersample > 16384)
-    throw std::invalid_argument(fmt::format("--supersample {}: {}x{} would render views over 16384 pixels a side",
-                                            o.supersample, o.width, o.height));
+  renderer::checkRasterSize(o.width, o.height, o.raster);
   if (!o.imagesDir.empty() && std::filesystem::exists(o.imagesDir) && !std::filesystem::is_directory(o.imagesDir))
     throw std::invalid_argument("--images " + o.imagesDir + ": exists and is not a directory");
   if (!o.referenceCache.empty() && std::filesystem::exists(o.referenceCache) &&
@@ -112,9 +109,8 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
 
   renderer::RasterOptions ro = o.raster;
   ro.environment = o.updater.environment;
-  const uint32_t ss = o.supersample;
-  renderer::RasterRenderer raster(context, o.scene, o.width * ss, o.height * ss, ro);
-  const auto render = [&] { return renderer::boxDownsample(raster.renderViews(views), ss); };
+  renderer::RasterRenderer raster(context, o.scene, o.width, o.height, ro);
+  const auto render = [&] { return raster.renderViews(views); };
   if (!o.imagesDir.empty()) {
     std::filesystem::create_directories(o.imagesDir);
     for (size_t v = 0; v < views.size(); ++v)
@@ -126,7 +122,7 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
   json["scene"] = o.scene.name;
   json["device"] = context.deviceName();
   json["size"] = {o.width, o.height};
-  json["supersample"] = o.supersample;  // raster ms per view are for the supersampled size
+  json["supersample"] = o.raster.samplesPerSide;  // raster ms per view are for the supersampled size
   json["views"] = o.views;
   json["view_count"] = views.size();
   json["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
@@ -165,7 +161,9 @@ SceneBenchResult runSceneBench(const SceneBenchOptions& o) {
       "probe update: {:.1f} ms (median of {})\nreference: {} spp per view; noise floor {:.2f} dB (mean over views), "
       "reference itself ≈ {:.2f} dB\n",
       o.scene.name, context.deviceName(), o.views, views.size(), o.width, o.height,
-      ss > 1 ? fmt::format(" (raster {}x{} box-filtered)", o.width * ss, o.height * ss) : std::string(), o.grid.dims[0], o.grid.dims[1],
+      ro.samplesPerSide > 1 ? fmt::format(" ({}x{} raster samples per pixel)", ro.samplesPerSide, ro.samplesPerSide)
+                            : std::string(),
+      o.grid.dims[0], o.grid.dims[1],
       o.grid.dims[2], o.updater.samplesPerProbe, json["environment"].get<std::string>(), updateMedian, o.updates,
       o.referenceSpp, floorMean, accuracyMean);
   table += fmt::format("{:<6} {:>9} {:>7} {:>12} {:>11} {:>12} {:>11}\n", "repr", "PSNR dB", "SSIM", "vs float dB",

@@ -20,14 +20,10 @@ struct SceneBenchOptions {
   ProbeGrid grid;
   renderer::UpdaterOptions updater;  // its environment lights the probes, the reference and the background
   renderer::ContextOptions context;
-  renderer::RasterOptions raster;
+  renderer::RasterOptions raster;   // samplesPerSide > 1: each pixel averages its footprint, like the reference's
   uint32_t updates = 8;              // probe updates, each timed
   std::string views = "mono";        // mono, stereo, lf:NxM (renderer/view_sets.h)
   uint32_t width = 160, height = 100;
-  // Raster samples per pixel side: the views are rendered at supersample × the size and
-  // box-filtered down, so each pixel is, like the reference's, an average over its footprint (at 1,
-  // one sample at the pixel's centre: at small sizes the edges' aliasing dominates the error).
-  uint32_t supersample = 1;
   uint32_t repeats = 3;              // timed renders of the view set per representation (median)
   uint32_t referenceSpp = 4096;
   uint32_t referenceBounces = 8;

@@ -185,21 +185,6 @@ TEST(ImageHarness, ComparisonRefusesNonFinitePixelsAndSizeMismatch) {
   EXPECT_THROW(compareChecked(a, c, "size"), std::invalid_argument);
 }
 
-TEST(SceneBench, BoxDownsampleAveragesEachBlock) {
-  // 4x2 → 2x1: each output pixel is the mean of its 2x2 block, per channel.
-  renderer::Image big{4, 2, {}};
-  for (int i = 0; i < 4 * 2 * 3; ++i) big.rgb.push_back(static_cast<float>(i));
-  const renderer::Image small = boxDownsample(big, 2);
-  ASSERT_EQ(small.width, 2u);
-  ASSERT_EQ(small.height, 1u);
-  // Block 0: pixels 0, 1, 4, 5 → red 0, 3, 12, 15.
-  EXPECT_FLOAT_EQ(small.rgb[0], (0.0f + 3.0f + 12.0f + 15.0f) / 4.0f);
-  EXPECT_FLOAT_EQ(small.rgb[5], (8.0f + 11.0f + 20.0f + 23.0f) / 4.0f);
-  EXPECT_EQ(boxDownsample(big, 1).rgb, big.rgb);
-  EXPECT_THROW(boxDownsample(big, 3), std::invalid_argument);
-  EXPECT_THROW(boxDownsample(big, 0), std::invalid_argument);
-}
-
 // At a small size the raster client's one sample per pixel aliases every edge, while the
 // reference averages each pixel's area: supersampling the raster (the same footprint) must score
 // clearly closer to the reference than one sample per pixel.
@@ -220,13 +205,13 @@ TEST(SceneBench, SupersamplingMatchesThePixelFootprintOfTheReference) {
   o.context = test::validatedContext();
   const auto floatPsnr = [](const SceneBenchResult& r) { return r.json["representations"][0]["psnr_db"].get<double>(); };
   const SceneBenchResult one = runSceneBench(o);
-  o.supersample = 4;
+  o.raster.samplesPerSide = 4;
   const SceneBenchResult four = runSceneBench(o);  // the cached reference, the same probes
   EXPECT_EQ(four.json["supersample"].get<uint32_t>(), 4u);
   EXPECT_GT(floatPsnr(four), floatPsnr(one) + 2.0) << "1 sample per pixel " << floatPsnr(one) << " dB, 16: "
                                                    << floatPsnr(four) << " dB";
   std::filesystem::remove_all(dir);
-  o.supersample = 0;
+  o.raster.samplesPerSide = 0;
   EXPECT_THROW(checkSceneBenchOptions(o), std::invalid_argument);
 }
 

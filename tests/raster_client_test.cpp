@@ -127,6 +127,53 @@ TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+// N × N samples per pixel: each pixel of a W × H image is the mean of its N × N block of the same
+// view drawn at one sample per pixel and N × the size (same aspect, so the same projection and the
+// same sample positions). Differs from the one-sample W × H image at the box's edges.
+TEST(RasterClient, SupersampledPixelsAreTheMeanOfTheirBlockAtNTimesTheSize) {
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
+  const glm::vec3 lo = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
+  const glm::vec3 hi = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
+  const ProbeGrid g{{3, 3, 3}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}};
+  UpdaterOptions uo;
+  uo.samplesPerProbe = 16;
+  ProbeUpdater updater(context, s, g, uo);
+  updater.update();
+  constexpr uint32_t kW = 20, kH = 16, kN = 3;
+  RasterOptions one, three;
+  three.samplesPerSide = kN;
+  RasterRenderer small(context, s, kW, kH, one), large(context, s, kW * kN, kH * kN, one),
+      supersampled(context, s, kW, kH, three);
+  const CameraView cam = CameraView::fromScene(s);
+  const auto draw = [&](RasterRenderer& r) {
+    r.setProbes(updater.volume());
+    return r.render(r.viewProjection(cam), cam.position);
+  };
+  const Image a = draw(small), big = draw(large), ss = draw(supersampled);
+  ASSERT_EQ(ss.width, kW);
+  ASSERT_EQ(ss.height, kH);
+  ASSERT_EQ(ss.rgb.size(), a.rgb.size());
+  for (uint32_t y = 0; y < kH; ++y)
+    for (uint32_t x = 0; x < kW; ++x)
+      for (uint32_t c = 0; c < 3; ++c) {
+        float mean = 0.0f;
+        for (uint32_t j = 0; j < kN; ++j)
+          for (uint32_t i = 0; i < kN; ++i) mean += big.rgb[((y * kN + j) * kW * kN + x * kN + i) * 3 + c];
+        mean /= static_cast<float>(kN * kN);
+        ASSERT_NEAR(ss.rgb[(y * kW + x) * 3 + c], mean, 1e-5f * (1.0f + mean)) << x << "," << y << "," << c;
+      }
+  EXPECT_NE(ss.rgb, a.rgb);  // the edges are averaged now
+  RasterOptions bad;
+  bad.samplesPerSide = 0;
+  EXPECT_THROW(RasterRenderer(context, s, kW, kH, bad), std::invalid_argument);
+  bad.samplesPerSide = 17;
+  EXPECT_THROW(RasterRenderer(context, s, kW, kH, bad), std::invalid_argument);
+  bad.samplesPerSide = 4;
+  EXPECT_THROW(RasterRenderer(context, s, 4097, kH, bad), std::invalid_argument);  // 16388 pixels a side
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
 TEST(RasterClient, BadProbeVolumesAreRefusedAndTheLastGoodOneKept) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);

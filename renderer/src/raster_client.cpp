@@ -140,7 +140,7 @@ struct RasterRenderer::Impl {
   VulkanDevice* d = nullptr;
   RasterOptions options;
   RasterTimings timings;
-  uint32_t width = 0, height = 0, chunk = 1;
+  uint32_t width = 0, height = 0, chunk = 1;  // of the targets: samplesPerSide × the images' size
   GpuScene gpu;
   GpuImage color, depth;  // `chunk` layers each
   GpuImage probeTextures[RS_PROBE_TEXTURES];
@@ -396,24 +396,41 @@ struct RasterRenderer::Impl {
       vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr,
                            0, nullptr);
     });
+    // Each image pixel is the mean of its samplesPerSide² target pixels (one: a plain copy).
     const float* src = static_cast<const float*>(readback.mapped);
+    const uint32_t n = options.samplesPerSide;
+    const float weight = 1.0f / static_cast<float>(n * n);
     for (uint32_t v = 0; v < count; ++v) {
       Image& img = out[first + v];
-      img.width = width;
-      img.height = height;
-      img.rgb.resize(pixels * 3);
+      img.width = width / n;
+      img.height = height / n;
+      img.rgb.assign(static_cast<size_t>(img.width) * img.height * 3, 0.0f);
       const float* layer = src + v * pixels * 4;
-      for (size_t i = 0; i < pixels; ++i)
-        for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = layer[i * 4 + c];
+      for (uint32_t y = 0; y < height; ++y) {
+        float* row = img.rgb.data() + static_cast<size_t>(y / n) * img.width * 3;
+        const float* in = layer + static_cast<size_t>(y) * width * 4;
+        for (uint32_t x = 0; x < width; ++x)
+          for (uint32_t c = 0; c < 3; ++c) row[(x / n) * 3 + c] += weight * in[x * 4 + c];
+      }
     }
   }
 };
+
+void checkRasterSize(uint32_t width, uint32_t height, const RasterOptions& options) {
+  if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
+  if (options.samplesPerSide < 1 || options.samplesPerSide > 16)
+    throw std::invalid_argument("raster samples per pixel side must be 1..16");
+  if (std::max(width, height) > 16384u / options.samplesPerSide)
+    throw std::invalid_argument("a " + std::to_string(width) + "x" + std::to_string(height) + " view at " +
+                                std::to_string(options.samplesPerSide) +
+                                " samples per pixel side would render over 16384 pixels a side");
+}
 
 RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene, uint32_t width, uint32_t height,
                                const RasterOptions& options)
     : impl_(std::make_unique<Impl>()) {
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
-  if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
+  checkRasterSize(width, height, options);
   if (!(options.visibilityReach >= 0.0f && options.visibilityReach <= 1e6f))
     throw std::invalid_argument("visibility reach must be 0 (no limit) or a positive multiple of the rule, up to 1e6");
   if (options.shadowMapSize < 16 || options.shadowMapSize > 8192)
@@ -424,20 +441,20 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.d = &context.device();
   VulkanDevice& d = *s.d;
   s.options = options;
-  s.width = width;
-  s.height = height;
+  s.width = width * options.samplesPerSide;
+  s.height = height * options.samplesPerSide;
   s.chunk = std::min<uint32_t>(8, d.maxMultiviewViewCount);
   s.sceneMin = scene.boundsMin;
   s.sceneMax = scene.boundsMax;
   uploadGpuScene(d, scene, s.gpu);
   s.indexCount = static_cast<uint32_t>(scene.indices.size());
   s.drawnOpaque = scene::leadingTrianglesBelowClass(scene, 2);
-  s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {width, height}, s.chunk,
+  s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {s.width, s.height}, s.chunk,
                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
                                  VK_IMAGE_USAGE_TRANSFER_DST_BIT);  // starts as the background
-  s.depth = createImageArray(d, VK_FORMAT_D32_SFLOAT, {width, height}, s.chunk,
+  s.depth = createImageArray(d, VK_FORMAT_D32_SFLOAT, {s.width, s.height}, s.chunk,
                              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
-  s.readback = createBuffer(d, static_cast<VkDeviceSize>(width) * height * 16 * s.chunk,
+  s.readback = createBuffer(d, static_cast<VkDeviceSize>(s.width) * s.height * 16 * s.chunk,
                             VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   s.views = createBuffer(d, sizeof(shaders::RsView) * Impl::kMaxViews, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};

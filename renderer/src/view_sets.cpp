@@ -116,28 +116,4 @@ Image composeQuilt(const std::vector<Image>& views, const std::vector<ViewInfo>&
   return quilt;
 }
 
-Image boxDownsample(const Image& image, uint32_t factor) {
-  if (factor == 0 || image.width % factor != 0 || image.height % factor != 0 ||
-      image.rgb.size() != static_cast<size_t>(image.width) * image.height * 3)
-    throw std::invalid_argument("boxDownsample: a " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                " image does not split into " + std::to_string(factor) + "-pixel blocks");
-  Image out;
-  out.width = image.width / factor;
-  out.height = image.height / factor;
-  out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 0.0f);
-  const float weight = 1.0f / static_cast<float>(factor * factor);
-  for (uint32_t y = 0; y < image.height; ++y)
-    for (uint32_t x = 0; x < image.width; ++x)
-      for (int c = 0; c < 3; ++c)
-        out.rgb[(static_cast<size_t>(y / factor) * out.width + x / factor) * 3 + c] +=
-            weight * image.rgb[(static_cast<size_t>(y) * image.width + x) * 3 + c];
-  return out;
-}
-
-std::vector<Image> boxDownsample(std::vector<Image> images, uint32_t factor) {
-  if (factor != 1)
-    for (Image& image : images) image = boxDownsample(image, factor);
-  return images;
-}
-
 }  // namespace probecast::renderer

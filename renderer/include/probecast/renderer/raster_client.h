@@ -57,6 +57,10 @@ struct RasterOptions {
   float visibilityReach = 1.0f;
   // Off: every face draws every triangle (the same moments, slower; to compare and measure).
   bool visibilityCulling = true;
+  // Raster samples per pixel side (1..16): views are drawn at this multiple of the size and each
+  // pixel is the mean of its N × N block, the footprint a path-traced reference averages. Costs
+  // about N² the shading time; the images keep the size the renderer was made with.
+  uint32_t samplesPerSide = 1;
 };
 
 struct RasterTimings {
@@ -68,12 +72,18 @@ struct RasterTimings {
   uint64_t visibilityTriangles = 0;  // last visibility build: triangles drawn over all cube faces
 };
 
+// Throws std::invalid_argument unless views of width × height at options.samplesPerSide fit a
+// raster target (1..16 samples per side, at most 16384 pixels a side): to refuse before slow work.
+void checkRasterSize(uint32_t width, uint32_t height, const RasterOptions& options);
+
 // Replaces inactive probes by the mean of their active neighbours, growing outwards until every
 // probe has a value (so trilinear filtering never blends in zeros from inside walls).
 void fillInactiveProbes(ProbeVolume& volume);
 
 class RasterRenderer {
  public:
+  // Images of width × height; the targets are samplesPerSide times larger, at most 16384 a side
+  // (std::invalid_argument otherwise).
   RasterRenderer(VulkanContext& context, const scene::Scene& scene, uint32_t width, uint32_t height,
                  const RasterOptions& options = {});
   ~RasterRenderer();

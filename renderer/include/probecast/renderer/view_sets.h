@@ -57,11 +57,4 @@ std::vector<ViewInfo> makeViewSet(const CameraView& camera, const ViewSetSpec& s
 // x = column, y = rows − 1 − row (row 0 at the bottom, as Looking Glass quilts).
 Image composeQuilt(const std::vector<Image>& views, const std::vector<ViewInfo>& info, int columns, int rows);
 
-// The mean of each factor × factor block: an image rendered at factor × the size, brought back to
-// one value per pixel that averages the pixel's whole footprint (as a path-traced reference does).
-// Throws std::invalid_argument when the sides do not divide by factor.
-Image boxDownsample(const Image& image, uint32_t factor);
-// Every view of a set, each as above (factor 1 returns them as they are).
-std::vector<Image> boxDownsample(std::vector<Image> images, uint32_t factor);
-
 }  // namespace probecast::renderer
