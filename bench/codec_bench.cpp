@@ -159,6 +159,36 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   }
   json["representations"] = reprJson;
 
+  // zh3h per map: the per-probe choice against l1 and against format 1 (every probe hallucinating
+  // from the same L1 bytes), irradiance error against the true irradiance.
+  nlohmann::json zh3hMaps = nlohmann::json::array();
+  std::string zh3hTable;
+  if (!mapProbes.empty()) {
+    zh3hTable = fmt::format("\nzh3h per map (E rmse vs true): {:<28} {:>8} {:>14} {:>8} {:>9}\n", "map", "l1",
+                            "zh3h format 1", "zh3h", "decodes");
+    for (size_t m = 0; m < mapProbes.size(); ++m) {
+      uint8_t rec[kMaxRecordBytes];
+      encodeProbeRecord(Representation::L1, mapProbes[m].data(), rec);
+      Probe always{};
+      decodeProbeRecord(Representation::L1, rec, always.data());
+      zh3HallucinateInPlace(always.data());
+      encodeProbeRecord(Representation::Zh3Hallucinated, mapProbes[m].data(), rec);
+      Probe chosen{};
+      decodeProbeRecord(Representation::Zh3Hallucinated, rec, chosen.data());
+      const bool keptL1 = std::all_of(chosen.begin() + 12, chosen.end(), [](float v) { return v == 0.0f; });
+      const double l1 = results["l1"].perMap[names[m]], format1 = rmseAgainst(always, normals, trueIrradiance[m]),
+                   zh3h = results["zh3h"].perMap[names[m]];
+      zh3hMaps.push_back({{"map", names[m]},
+                          {"l1", l1},
+                          {"zh3h_format1", format1},
+                          {"zh3h", zh3h},
+                          {"decodes_as", keptL1 ? "l1" : "hallucinated"}});
+      zh3hTable += fmt::format("{:>31}{:<28} {:>7.2f}% {:>13.2f}% {:>7.2f}% {:>9}\n", "", names[m], 100 * l1,
+                               100 * format1, 100 * zh3h, keptL1 ? "l1" : "zh3h");
+    }
+  }
+  json["zh3h_per_map"] = zh3hMaps;
+
   // Baked probes: each representation against the float L2 it was made from (exact over the sphere).
   std::string volumeTable;
   if (!opt.volumeProbes.empty()) {
@@ -294,6 +324,7 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   table += fmt::format("float baselines (E rmse vs true): l1 {:.2f}%  zh3h {:.2f}%  zh3 {:.2f}%  l2 {:.2f}%\n",
                        100 * baselines["l1"].get<double>(), 100 * baselines["zh3h"].get<double>(),
                        100 * baselines["zh3"].get<double>(), 100 * baselines["l2"].get<double>());
+  table += zh3hTable;
   table += volumeTable;
   if (!temporal.empty()) {
     table += fmt::format("\ntemporal ({} frames, 1024 probes, 1% noise): {:<6} {:>4} {:>14} {:>14}\n", opt.frames,

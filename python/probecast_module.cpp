@@ -219,8 +219,9 @@ PYBIND11_MODULE(probecast, m) {
         return out;
       },
       py::arg("records"), py::arg("repr"), py::arg("zh3_per_pixel") = false, py::arg("out") = py::none(),
-      "Decodes records (N, record_size(repr)) uint8 into probes (N, 27) float32. For zh3h, zh3_per_pixel=True "
-      "gives L1 with a zero L2 band (a renderer hallucinating per pixel), False the per-probe hallucinated L2. "
+      "Decodes records (N, record_size(repr)) uint8 into probes (N, 27) float32. For zh3h, zh3_per_pixel=False "
+      "gives each probe as the encoder chose it (hallucinated L2 band, or plain L1), True the form of a renderer "
+      "that hallucinates per pixel (L1, and an L2 band of 0 or minus the probe's own hallucination). "
       "Raises ValueError for fp16 records holding Inf or NaN. out: an (N, 27) float32 C-contiguous array to write "
       "into (reused, no allocation).");
 

@@ -139,8 +139,10 @@ bool probeCoefficientsVisible(vec3 p, vec3 ng, vec3 wo, out float c[28]) {
   return true;
 }
 
-// zh3PerPixel (zh3h, interpolate then hallucinate): the L2 band from the interpolated L1 alone, as
-// zh3HallucinateInPlace in codec/zh3.h (same axis, curve and expansion).
+// zh3PerPixel (zh3h, interpolate then hallucinate): adds the L2 band hallucinated from the
+// interpolated L1 alone, as zh3HallucinateInPlace in codec/zh3.h (same axis, curve and expansion),
+// to the interpolated band (0 at probes that hallucinate, minus their own band at probes the
+// encoder kept at plain L1: ProbeVolume::zh3PerPixel).
 void hallucinateZh3(inout float c[28]) {
   const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
   vec3 d[3];
@@ -159,7 +161,7 @@ void hallucinateZh3(inout float c[28]) {
       float r = abs(dot(d[k], a)) / c00;
       zonal = c00 * (0.08 * r + 0.6 * r * r) * sqrt(4.0 * PI / 5.0);
     }
-    for (int m = 0; m < 5; ++m) c[(4 + m) * 3 + k] = zonal * y2[m];
+    for (int m = 0; m < 5; ++m) c[(4 + m) * 3 + k] += zonal * y2[m];
   }
 }
 

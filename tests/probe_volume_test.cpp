@@ -150,16 +150,17 @@ TEST(ProbeVolume, StreamLayoutOfAHugeGridIsInvalidNotWrapped) {
 TEST(ProbeVolume, DecodeAsZh3hChoosesPerPixelOrPerProbeHallucination) {
   ProbeVolume v = makeProbeVolume(ProbeGrid{{1, 1, 1}, {{0, 0, 0}, {0, 0, 0}}});
   std::mt19937 rng(5);
-  const test::Probe probe = test::randomNonNegativeProbe(rng, 3, 0.2f);
+  const test::Probe probe = test::randomNonNegativeProbe(rng, 1, 0.2f);
   std::copy(probe.begin(), probe.end(), v.probes.begin());
   const ProbeVolume perPixel = decodeAs(v, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true);
   EXPECT_TRUE(perPixel.zh3PerPixel);
   ASSERT_TRUE(perPixel.decodedFrom.has_value());
   EXPECT_EQ(*perPixel.decodedFrom, Representation::Zh3Hallucinated);
-  for (int k = 12; k < kProbeFloats; ++k) EXPECT_EQ(perPixel.probes[k], 0.0f) << k;  // L2 band left to the shader
+  for (int k = 12; k < kProbeFloats; ++k) EXPECT_EQ(perPixel.probes[k], 0.0f) << k;  // hallucinates: band left to the shader
   const ProbeVolume perProbe = decodeAs(v, Representation::Zh3Hallucinated, false);
   EXPECT_FALSE(perProbe.zh3PerPixel);
-  // Per probe: the hallucinated L2 band of the decoded L1, exactly as zh3.h makes it.
+  // Per probe: the hallucinated L2 band of the decoded L1, exactly as zh3.h makes it (this probe,
+  // one lobe, is one the encoder lets hallucinate; record.h).
   std::vector<float> expected(perPixel.probes);
   zh3HallucinateInPlace(expected.data());
   for (int k = 0; k < kProbeFloats; ++k) EXPECT_EQ(perProbe.probes[k], expected[k]) << k;

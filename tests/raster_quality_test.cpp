@@ -3,7 +3,10 @@
 // and the built-in Cornell box against the reference path tracer (probes inside walls: stability_test).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <vector>
 
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/renderer/probe_updater.h"
@@ -98,11 +101,65 @@ TEST(RasterQuality, L2AndStoredZh3AreCloserToTheFloatRenderThanL1) {
   EXPECT_LT(l2, 0.5 * l1);
   EXPECT_NE(zh3h, l1);  // the per-pixel hallucination did something
   EXPECT_GT(l1, 0.0);
-  // zh3h decodes L1 only and leaves the L2 band to the shader.
-  const ProbeVolume h = decodeAs(volume, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true);
-  EXPECT_TRUE(h.zh3PerPixel);
-  for (size_t p = 0; p < h.probes.size(); p += 27)
-    for (int k = 12; k < 27; ++k) ASSERT_EQ(h.probes[p + k], 0.0f);
+  EXPECT_TRUE(decodeAs(volume, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true).zh3PerPixel);
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
+// A probe of unit deltas: `ring` lights around the horizon (y = 0) and one from straight up of
+// weight `up`. With a strong ring L1 points up while the true L2 band is a negative zonal (the
+// ring), so the zh3h encoder keeps plain L1; a lone light up is what hallucination models.
+std::vector<float> ringAndPoleProbe(int ring, float up) {
+  std::vector<float> p(kProbeFloats, 0.0f);
+  const auto add = [&p](float x, float y, float z, float w) {
+    float basis[kShCoeffs];
+    shEvalBasis(x, y, z, basis);
+    for (int i = 0; i < kShCoeffs; ++i)
+      for (int c = 0; c < 3; ++c) p[i * 3 + c] += w * basis[i];
+  };
+  for (int k = 0; k < ring; ++k) {
+    const float phi = 6.2831853f * static_cast<float>(k) / static_cast<float>(ring);
+    add(std::cos(phi), 0.0f, std::sin(phi), 1.0f);
+  }
+  add(0.0f, 1.0f, 0.0f, up);
+  return p;
+}
+
+// zh3h per pixel (ProbeVolume::zh3PerPixel): with every probe alike, interpolation changes
+// nothing, so the shader's per-pixel result must equal the per-probe decoding, both for probes the
+// encoder kept at plain L1 (their stored band cancels the shader's hallucination) and for probes
+// that hallucinate. Drawing the kept probes without their band (hallucinating, as format 1 did)
+// must differ.
+TEST(RasterQuality, Zh3hPerPixelEqualsPerProbeWhereEveryProbeIsAlike) {
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
+  RasterRenderer raster(context, s, 48, 36);
+  const CameraView cam = CameraView::fromScene(s);
+  const auto renderAs = [&](const ProbeVolume& v) {
+    raster.setProbes(v);
+    return raster.render(raster.viewProjection(cam), cam.position);
+  };
+  double meanValue = 0.0;
+  for (const auto& [ring, up, keepsL1] : {std::tuple{12, 3.0f, true}, std::tuple{0, 1.0f, false}}) {
+    ProbeVolume v = makeProbeVolume(sceneGrid(s, {3, 3, 3}));
+    const std::vector<float> probe = ringAndPoleProbe(ring, up);
+    for (uint32_t p = 0; p < v.count(); ++p) std::copy(probe.begin(), probe.end(), v.probes.begin() + p * kProbeFloats);
+    const ProbeVolume perPixel = decodeAs(v, Representation::Zh3Hallucinated, /*zh3PerPixel=*/true);
+    const ProbeVolume perProbe = decodeAs(v, Representation::Zh3Hallucinated, /*zh3PerPixel=*/false);
+    double band = 0.0;
+    for (int k = 12; k < kProbeFloats; ++k) band += std::fabs(perPixel.probes[k]);
+    EXPECT_EQ(band > 0.0, keepsL1) << "ring " << ring;  // the kept probe carries minus its hallucination
+    const Image a = renderAs(perPixel), b = renderAs(perProbe);
+    meanValue = 0.0;
+    for (float x : b.rgb) meanValue += x / static_cast<double>(b.rgb.size());
+    ASSERT_GT(meanValue, 0.01);
+    EXPECT_LT(rmse(a, b), 1e-4 * meanValue) << "ring " << ring;
+    if (keepsL1) {
+      ProbeVolume hallucinating = perPixel;
+      for (uint32_t p = 0; p < v.count(); ++p)
+        std::fill_n(hallucinating.probes.begin() + p * kProbeFloats + 12, kProbeFloats - 12, 0.0f);
+      EXPECT_GT(rmse(renderAs(hallucinating), b), 1e-2 * meanValue);
+    }
+  }
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 

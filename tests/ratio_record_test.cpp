@@ -1,6 +1,7 @@
 // Records: sizes, RGB9E5 and half known answers, ratio bounds, idempotence, bad values.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -132,7 +133,8 @@ TEST(RatioBounds, NonNegativeMixturesNeverBreakThem) {
 class RecordRoundTrip : public ::testing::TestWithParam<Representation> {};
 
 TEST_P(RecordRoundTrip, EncodeDecodeEncodeIsEncode) {
-  // CODEC.md §8.6: encode∘decode∘encode = encode.
+  // CODEC.md §8.6: encode∘decode∘encode = encode, decoding to the probe's function (for zh3h the
+  // per-probe form: the per-pixel form's band is a correction, not the function).
   const Representation repr = GetParam();
   std::mt19937 rng(13);
   for (int trial = 0; trial < 2000; ++trial) {
@@ -141,7 +143,7 @@ TEST_P(RecordRoundTrip, EncodeDecodeEncodeIsEncode) {
     uint8_t a[kMaxRecordBytes], b[kMaxRecordBytes];
     encodeProbeRecord(repr, p.data(), a);
     Probe q{};
-    ASSERT_TRUE(decodeProbeRecord(repr, a, q.data(), /*zh3PerPixel=*/true));
+    ASSERT_TRUE(decodeProbeRecord(repr, a, q.data(), /*zh3PerPixel=*/false));
     encodeProbeRecord(repr, q.data(), b);
     ASSERT_EQ(0, std::memcmp(a, b, recordSize(repr))) << "trial " << trial;
   }
@@ -259,6 +261,102 @@ TEST(Record, QuantisedL2IrradianceWithinOnePercentOfFloat) {
     }
   }
   EXPECT_LT(std::sqrt(num / den), 0.01);
+}
+
+
+// The irradiance norm the zh3h choice minimises: SH is orthonormal, so the squared error of
+// irradiance over the sphere is Σ Â_l² (Δc_lm)², summed over RGB (CODEC.md §1).
+double irradianceDistance(const float* a, const float* b) {
+  double e = 0;
+  for (int i = 0; i < kShCoeffs; ++i) {
+    const double band = kCosineBand[i == 0 ? 0 : (i < 4 ? 1 : 2)];
+    for (int c = 0; c < 3; ++c) e += band * band * (a[i * 3 + c] - b[i * 3 + c]) * (a[i * 3 + c] - b[i * 3 + c]);
+  }
+  return std::sqrt(e);
+}
+
+// A bright ring around the equator and a weaker light at the pole: L1 points at the pole, where
+// hallucinated ZH3 adds a peak, while the true L2 band is a negative zonal (the ring): plain L1
+// is the better decoding of such a probe.
+Probe ringProbe(std::mt19937& rng) {
+  Probe p{};
+  std::uniform_real_distribution<float> u(0.5f, 1.5f);
+  const float white[3] = {1.0f, 1.0f, 1.0f};
+  for (int k = 0; k < 12; ++k) {
+    const float phi = 2.0f * kPi * static_cast<float>(k) / 12.0f;
+    const Probe d = test::deltaProbe(std::cos(phi), std::sin(phi), 0.0f, white);
+    const float w = u(rng);
+    for (int i = 0; i < kProbeFloats; ++i) p[i] += w * d[i];
+  }
+  const float pole[3] = {u(rng) * 4.0f, u(rng) * 4.0f, u(rng) * 4.0f};
+  const Probe d = test::deltaProbe(0.0f, 0.0f, 1.0f, pole);
+  for (int i = 0; i < kProbeFloats; ++i) p[i] += d[i];
+  return p;
+}
+
+// zh3h per probe (record.h): the decoder's result is hallucinated ZH3 or plain L1, whichever the
+// encoder found nearer the probe's L2. Against the l1 record of the same probe it can only lose
+// the one step the parity may cost: |zh3h − L2| ≤ |l1 − L2| + |one step| (triangle inequality),
+// where a step of an L1 ratio is Â_1 · c00 · √3 / 127. Both choices occur on this mix, and over
+// all probes zh3h is nearer than both l1 and every-probe hallucination (format 1).
+TEST(Zh3hChoice, NeverFartherThanL1ByMoreThanOneStepAndBetterThanBoth) {
+  std::mt19937 rng(11);
+  int keptL1 = 0, hallucinated = 0;
+  double sumChoice = 0, sumL1 = 0, sumAlways = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Probe p = trial % 2 ? ringProbe(rng) : test::randomNonNegativeProbe(rng, 1 + trial % 3, 0.1f);
+    uint8_t zh3h[13], l1[13];
+    encodeProbeRecord(Representation::Zh3Hallucinated, p.data(), zh3h);
+    encodeProbeRecord(Representation::L1, p.data(), l1);
+    float choice[kProbeFloats], plain[kProbeFloats];
+    ASSERT_TRUE(decodeProbeRecord(Representation::Zh3Hallucinated, zh3h, choice));
+    ASSERT_TRUE(decodeProbeRecord(Representation::L1, l1, plain));
+    Probe always;  // format 1: every probe hallucinates from the l1 record's L1
+    std::copy(plain, plain + kProbeFloats, always.begin());
+    zh3HallucinateInPlace(always.data());
+    float maxDc = 0;
+    for (int c = 0; c < 3; ++c) maxDc = std::max(maxDc, plain[c]);
+    const double step = kCosineBand[1] * maxDc * kBoundL1 / 127.0;
+    const double eChoice = irradianceDistance(choice, p.data()), eL1 = irradianceDistance(plain, p.data());
+    EXPECT_LE(eChoice, eL1 + step * 1.0001 + 1e-6) << "probe " << trial;
+    bool band = false;
+    for (int k = 12; k < kProbeFloats; ++k) band |= choice[k] != 0.0f;
+    (band ? hallucinated : keptL1)++;
+    sumChoice += eChoice;
+    sumL1 += eL1;
+    sumAlways += irradianceDistance(always.data(), p.data());
+  }
+  EXPECT_GT(keptL1, 40);
+  EXPECT_GT(hallucinated, 40);
+  EXPECT_LT(sumChoice, 0.95 * sumL1);
+  EXPECT_LT(sumChoice, 0.95 * sumAlways);
+}
+
+// The choice travels in the parity of the L1 ratio bytes: odd decodes plain L1 (a zero L2 band),
+// even hallucinates; the per-pixel form holds L1 and a band that, added to the renderer's
+// hallucination of that L1, gives the per-probe result.
+TEST(Zh3hChoice, ParityOfTheL1BytesChoosesAndThePerPixelFormAddsUp) {
+  std::mt19937 rng(12);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Probe p = trial % 2 ? ringProbe(rng) : test::randomNonNegativeProbe(rng, 2, 0.05f);
+    uint8_t record[13];
+    encodeProbeRecord(Representation::Zh3Hallucinated, p.data(), record);
+    unsigned sum = 0;
+    for (int j = 4; j < 13; ++j) sum += record[j];
+    float perProbe[kProbeFloats], perPixel[kProbeFloats];
+    ASSERT_TRUE(decodeProbeRecord(Representation::Zh3Hallucinated, record, perProbe, false));
+    ASSERT_TRUE(decodeProbeRecord(Representation::Zh3Hallucinated, record, perPixel, true));
+    Probe l1(p);
+    std::copy(perPixel, perPixel + 12, l1.begin());
+    for (int k = 12; k < kProbeFloats; ++k) l1[k] = 0.0f;
+    Probe hallucinatedL1 = l1;
+    zh3HallucinateInPlace(hallucinatedL1.data());
+    for (int k = 0; k < 12; ++k) ASSERT_EQ(perProbe[k], perPixel[k]) << k;
+    for (int k = 12; k < kProbeFloats; ++k) {
+      EXPECT_EQ(perProbe[k], sum % 2 ? 0.0f : hallucinatedL1[k]) << "probe " << trial << ", coefficient " << k;
+      EXPECT_NEAR(perPixel[k] + hallucinatedL1[k], perProbe[k], 1e-6f * (1.0f + std::fabs(hallucinatedL1[k])));
+    }
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "probecast/codec/crc32c.h"
 #include "probecast/codec/stream.h"
+#include "probecast/codec/zh3.h"
 #include "test_probes.h"
 
 namespace probecast {
@@ -87,6 +88,7 @@ INSTANTIATE_TEST_SUITE_P(RepresentationsAndDeadzones, DriftFree,
                          ::testing::Values(DriftCase{Representation::L1, 0}, DriftCase{Representation::Zh3, 0},
                                            DriftCase{Representation::Zh3, 3}, DriftCase{Representation::L2, 0},
                                            DriftCase{Representation::L2, 2}, DriftCase{Representation::Fp16, 0},
+                                           DriftCase{Representation::Zh3Hallucinated, 0},
                                            DriftCase{Representation::Zh3Hallucinated, 1}),
                          [](const auto& p) {
                            return std::string(representationName(p.param.repr)) + "_dz" +
@@ -196,9 +198,10 @@ TEST(Stream, GoldenBytes) {
   std::vector<uint8_t> frame;
   enc.update(goldenProbes(0).data(), active);
   enc.writeKeyframeFrame(frame);
-  EXPECT_EQ(hex(frame),
-            "50524243" "01" "01" "02" "00" "0200" "0200" "0100" "0000"  // magic, version, l1, brick 2, grid
-            "01000000" "01000000" "3e000000" "596bfa2e"                 // frame 1, 1 section, 62 bytes, CRC
+  const std::string keyframe = hex(frame);
+  EXPECT_EQ(keyframe,
+            "50524243" "02" "01" "02" "00" "0200" "0200" "0100" "0000"  // magic, version, l1, brick 2, grid
+            "01000000" "01000000" "3e000000" "3a5ac6e5"                 // frame 1, 1 section, 62 bytes, CRC
             "00000000" "01000000" "01" "00" "28000000" "28000000" "5a83f9fe"  // brick 0 v1 keyframe raw
             "07"                                                        // active mask: probes 0, 1, 2
             "004080" "010101" "010101" "818181"                         // RGB9E5 bytes 0..3, one plane each
@@ -211,13 +214,77 @@ TEST(Stream, GoldenBytes) {
   enc.writeChangedFrame(frame);
   ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
   // Delta: probe 2's G c10 ratio goes 0.2/0.5 → 0.1/0.5, symbol 29 → 15, zig-zag(−14) = 27 = 0x1b.
-  EXPECT_EQ(hex(frame),
-            "50524243" "01" "01" "02" "00" "0200" "0200" "0100" "0000"
-            "02000000" "01000000" "27000000" "6a6f0dbf"
+  const std::string delta = hex(frame);
+  EXPECT_EQ(delta,
+            "50524243" "02" "01" "02" "00" "0200" "0200" "0100" "0000"
+            "02000000" "01000000" "27000000" "095e3174"
             "00000000" "02000000" "02" "00" "11000000" "11000000" "33b2653c"  // brick 0 v2 delta raw
             "07" "04"                                                   // active mask, changed mask
             "0000" "0000" "0000"                                        // DC code deltas (lo, hi planes)
             "000000" "00" "1b" "00" "000000");                          // ratio deltas
+  // The same two frames as format 1 wrote them (pinned when it was current; only the version byte
+  // and the header CRC differ, l1 being unchanged by format 2) still decode, to the same state.
+  const auto bytes = [](const std::string& h) {
+    std::vector<uint8_t> out;
+    for (size_t i = 0; i + 1 < h.size(); i += 2) out.push_back(static_cast<uint8_t>(std::stoi(h.substr(i, 2), nullptr, 16)));
+    return out;
+  };
+  const std::vector<uint8_t> v1Keyframe = bytes(
+      "5052424301010200020002000100000001000000010000003e000000596bfa2e0000000001000000010028000000280000005a83f9fe07"
+      "0040800101010101018181810000000000000000000000001d1d1d00000016120f000000000000");
+  const std::vector<uint8_t> v1Delta = bytes(
+      "505242430101020002000200010000000200000001000000270000006a6f0dbf00000000020000000200110000001100000033b2653c07"
+      "04000000000000000000001b00000000");
+  EXPECT_EQ(hex(v1Keyframe).substr(10), keyframe.substr(10, 46) + hex(v1Keyframe).substr(56, 8) + keyframe.substr(64));
+  StreamDecoder old(layout);
+  ASSERT_EQ(old.apply(v1Keyframe.data(), v1Keyframe.size()), CodecStatus::Ok);
+  ASSERT_EQ(old.apply(v1Delta.data(), v1Delta.size()), CodecStatus::Ok);
+  expectSameState(enc, old, "format 1 frames");
+}
+
+// Format 1 zh3h frames decode as format 1 meant them: every probe hallucinates, whatever the
+// parity of its L1 bytes; the same sections under a format 2 header decode per probe as chosen.
+// Versions outside 1..2 are refused.
+TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::Zh3Hallucinated);
+  std::mt19937 rng(21);
+  std::vector<float> probes;
+  for (int p = 0; p < 64; ++p) {
+    const test::Probe q = test::randomNonNegativeProbe(rng, 1 + p % 3, 0.05f);
+    probes.insert(probes.end(), q.begin(), q.end());
+  }
+  StreamEncoder enc(layout);
+  enc.update(probes.data(), nullptr);
+  std::vector<uint8_t> frame;
+  enc.writeKeyframeFrame(frame);
+  StreamDecoder current(layout);
+  ASSERT_EQ(current.apply(frame.data(), frame.size()), CodecStatus::Ok);
+  expectSameState(enc, current, "format 2");
+  const auto withVersion = [&frame](uint8_t version) {
+    std::vector<uint8_t> f = frame;
+    f[4] = version;
+    const uint32_t crc = crc32c(f.data(), 28);
+    for (int b = 0; b < 4; ++b) f[28 + b] = static_cast<uint8_t>(crc >> (8 * b));
+    return f;
+  };
+  const std::vector<uint8_t> v1 = withVersion(1);
+  StreamDecoder old(layout);
+  ASSERT_EQ(old.apply(v1.data(), v1.size()), CodecStatus::Ok);
+  int plainL1 = 0;
+  for (int p = 0; p < 64; ++p) {
+    std::vector<float> expected(current.probes() + p * kProbeFloats, current.probes() + (p + 1) * kProbeFloats);
+    bool band = false;
+    for (int k = 12; k < kProbeFloats; ++k) band |= expected[k] != 0.0f;
+    plainL1 += band ? 0 : 1;
+    zh3HallucinateInPlace(expected.data());  // from the same L1
+    for (int k = 0; k < kProbeFloats; ++k) ASSERT_EQ(old.probes()[p * kProbeFloats + k], expected[k]) << p << "," << k;
+  }
+  EXPECT_GT(plainL1, 0);  // format 2 kept some probes at plain L1, which format 1 hallucinates
+  for (uint8_t version : {uint8_t{0}, uint8_t{3}}) {
+    const std::vector<uint8_t> f = withVersion(version);
+    StreamDecoder dec(layout);
+    EXPECT_EQ(dec.apply(f.data(), f.size()), CodecStatus::UnsupportedVersion) << int(version);
+  }
 }
 
 TEST(Stream, InactiveProbesAreNeverEncoded) {

@@ -146,10 +146,11 @@ void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<co
 CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* header) {
   if (size < kFrameHeaderSize) return CodecStatus::Truncated;
   if (std::memcmp(data, kMagic, 4) != 0) return CodecStatus::BadMagic;
-  if (data[4] != kFormatVersion) return CodecStatus::UnsupportedVersion;
+  if (data[4] < kOldestFormatVersion || data[4] > kFormatVersion) return CodecStatus::UnsupportedVersion;
   if (crc32c(data, 28) != getU32(data + 28)) return CodecStatus::HeaderChecksum;
   if (!isValidRepresentation(data[5])) return CodecStatus::BadRepresentation;
   FrameHeader h;
+  h.formatVersion = data[4];
   h.layout.repr = static_cast<Representation>(data[5]);
   h.layout.brickDim = data[6];
   for (int a = 0; a < 3; ++a) h.layout.grid[a] = getU16(data + 8 + 2 * a);

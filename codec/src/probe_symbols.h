@@ -32,11 +32,17 @@ bool narrowIsSigned(Representation repr, int j);
 // Quantises a probe. With `previous`, a DC triple whose codes all moved by at most `deadzone`
 // keeps the previous codes, and each ratio symbol within `deadzone` steps keeps its previous
 // value; ratios are always quantised against the DC the decoder will hold (closed loop).
+// zh3h: also chooses per probe between hallucinated ZH3 and plain L1, whichever is nearer the
+// input's L2 in irradiance, and tells the choice by the parity of the L1 symbols (record.h),
+// moving one symbol by a step where needed.
 void quantizeProbe(Representation repr, const float probe[kProbeFloats], const ProbeSymbols* previous, int deadzone,
                    ProbeSymbols* out);
 
-// Reconstructs the probe. Returns false if a symbol is outside its domain.
-bool dequantizeProbe(Representation repr, const ProbeSymbols& symbols, float probe[kProbeFloats], bool zh3PerPixel);
+// Reconstructs the probe. Returns false if a symbol is outside its domain. zh3hPerProbeChoice:
+// zh3h symbols carry the per-probe choice (codec format 2 on, the default); false reads them as
+// format 1 did (every probe hallucinates).
+bool dequantizeProbe(Representation repr, const ProbeSymbols& symbols, float probe[kProbeFloats], bool zh3PerPixel,
+                     bool zh3hPerProbeChoice = true);
 
 void symbolsToRecord(Representation repr, const ProbeSymbols& symbols, uint8_t* record);
 void recordToSymbols(Representation repr, const uint8_t* record, ProbeSymbols* symbols);

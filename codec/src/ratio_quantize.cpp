@@ -86,6 +86,76 @@ float zonalRatioR(const float probe[kProbeFloats], const float axis[3], int c) {
   return dc > 0.0f ? dot / dc : 0.0f;
 }
 
+// zh3h: whether the decoder keeps plain L1 (odd) or hallucinates the L2 band (even), told by the
+// parity of the nine L1 ratio symbols' sum (as sign data hiding in HEVC hides a sign in the parity
+// of a block's levels): no byte is spent on it.
+bool zh3hKeepsL1(const ProbeSymbols& s) {
+  unsigned sum = 0;
+  for (int j = 0; j < 9; ++j) sum += s.narrow[j];  // two's complement bytes: same parity as the signed sum
+  return (sum & 1u) != 0;
+}
+
+// The probe a zh3h decoder reconstructs from symbols (decodeL1 done): L1 + hallucinated L2 band,
+// or plain L1 when the symbols say so. perPixel: the L2 band is what the renderer adds to its own
+// per-pixel hallucination (0, or minus this probe's hallucination to cancel it).
+void finishZh3h(const ProbeSymbols& s, float probe[kProbeFloats], bool perPixel) {
+  const bool keepL1 = zh3hKeepsL1(s);
+  if (!perPixel) {
+    if (!keepL1) zh3HallucinateInPlace(probe);
+    return;
+  }
+  if (!keepL1) return;
+  zh3HallucinateInPlace(probe);
+  for (int k = 4 * 3; k < kProbeFloats; ++k) probe[k] = -probe[k];
+}
+
+// Squared irradiance error of `decoded` against `reference` over the sphere, summed over RGB
+// (orthonormal SH: the cosine lobe scales band l by Â_l, CODEC.md §1).
+float irradianceError2(const float decoded[kProbeFloats], const float reference[kProbeFloats]) {
+  float e = 0.0f;
+  for (int i = 0; i < kShCoeffs; ++i) {
+    const float a = kCosineBand[i == 0 ? 0 : (i < 4 ? 1 : 2)];
+    for (int c = 0; c < 3; ++c) {
+      const float d = decoded[i * 3 + c] - reference[i * 3 + c];
+      e += a * a * d * d;
+    }
+  }
+  return e;
+}
+
+// zh3h per probe: the symbols as quantised (candidate A) tell one choice by their parity; the
+// other choice needs one L1 symbol moved by a step (candidate B), the one whose move adds the least
+// squared error. The candidate with the smaller irradiance error against the input's L2 wins; with
+// `previous` (a stream), B must be better by a tenth, so that noise does not flip probes (and cost
+// a delta) every frame. Rounds symbols toward the ratio the encoder saw: `ratio127[j]` is each
+// ratio in symbol steps (ratio / bound × 127, unclamped).
+void chooseZh3h(const float probe[kProbeFloats], const float ratio127[9], const float dc[3], bool stream,
+                ProbeSymbols* out) {
+  float decoded[kProbeFloats];
+  const auto errorOf = [&](const ProbeSymbols& s) {
+    std::fill(decoded, decoded + kProbeFloats, 0.0f);
+    decodeL1(s, decoded);
+    finishZh3h(s, decoded, /*perPixel=*/false);
+    return irradianceError2(decoded, probe);
+  };
+  int best = -1, bestTo = 0;
+  float bestCost = 0.0f;
+  for (int j = 0; j < 9; ++j) {
+    const int q = static_cast<int8_t>(out->narrow[j]);
+    const float x = std::clamp(ratio127[j], -127.0f, 127.0f);
+    int to = x > static_cast<float>(q) ? q + 1 : q - 1;
+    if (to > 127 || to < -127) to = 2 * q - to;  // at the end of the range: the other way
+    const float scale = dc[j % 3] * kBoundL1 / 127.0f;  // one step of this coefficient, in radiance
+    const float moved = static_cast<float>(to) - x, now = static_cast<float>(q) - x;
+    const float cost = scale * scale * (moved * moved - now * now);
+    if (best < 0 || cost < bestCost) best = j, bestTo = to, bestCost = cost;
+  }
+  ProbeSymbols other = *out;
+  other.narrow[best] = static_cast<uint8_t>(static_cast<int8_t>(bestTo));
+  const float a = errorOf(*out), b = errorOf(other);
+  if (stream ? b < 0.9f * a : b < a) *out = other;
+}
+
 void quantizeFp16(const float probe[kProbeFloats], const ProbeSymbols* previous, int deadzone, ProbeSymbols* out) {
   for (int i = 0; i < kProbeFloats; ++i) {
     const uint16_t half = floatToHalf(probe[i]);
@@ -142,12 +212,15 @@ void quantizeProbe(Representation repr, const float input[kProbeFloats], const P
 
   // Ratios against the decoded DC.
   const int coefficientBytes = repr == Representation::L2 ? 24 : 9;
+  float ratio127[9];
   for (int j = 0; j < coefficientBytes; ++j) {
     const int c = j % 3;
     const Bound b = coefficientBound(j);
     const float ratio = dc[c] > 0.0f ? probe[3 + j] / dc[c] : 0.0f;
+    if (j < 9) ratio127[j] = std::isfinite(ratio) ? std::clamp(ratio / b.hi * 127.0f, -1e6f, 1e6f) : 0.0f;
     out->narrow[j] = toByte(b, applyDeadzone(quantize(b, ratio), previous, b, j, deadzone));
   }
+  if (repr == Representation::Zh3Hallucinated) chooseZh3h(probe, ratio127, dc, previous != nullptr, out);
 
   if (repr == Representation::Zh3) {
     // Zonal coefficient around the axis of the *decoded* L1, bounded by its decoded r.
@@ -166,7 +239,8 @@ void quantizeProbe(Representation repr, const float input[kProbeFloats], const P
   }
 }
 
-bool dequantizeProbe(Representation repr, const ProbeSymbols& s, float probe[kProbeFloats], bool zh3PerPixel) {
+bool dequantizeProbe(Representation repr, const ProbeSymbols& s, float probe[kProbeFloats], bool zh3PerPixel,
+                     bool zh3hPerProbeChoice) {
   std::fill(probe, probe + kProbeFloats, 0.0f);
   if (repr == Representation::Fp16) {
     for (int i = 0; i < kProbeFloats; ++i) {
@@ -184,7 +258,8 @@ bool dequantizeProbe(Representation repr, const ProbeSymbols& s, float probe[kPr
   switch (repr) {
     case Representation::L1: break;
     case Representation::Zh3Hallucinated:
-      if (!zh3PerPixel) zh3HallucinateInPlace(probe);
+      if (zh3hPerProbeChoice) finishZh3h(s, probe, zh3PerPixel);
+      else if (!zh3PerPixel) zh3HallucinateInPlace(probe);  // codec format 1: every probe hallucinates
       break;
     case Representation::Zh3: {
       float axis[3];

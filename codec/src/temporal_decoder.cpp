@@ -67,7 +67,8 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
     s.stamp = 1;
   }
   s.staged.clear();
-  const CodecStatus parsed = forEachSection(s.layout, data, header, [&s](const SectionView& view) {
+  const bool zh3hChoice = header.formatVersion >= 2;  // format 1: every zh3h probe hallucinates
+  const CodecStatus parsed = forEachSection(s.layout, data, header, [&s, zh3hChoice](const SectionView& view) {
     if (s.seenInFrame[view.brick] == s.stamp) return CodecStatus::DuplicateBrick;
     s.seenInFrame[view.brick] = s.stamp;
 
@@ -103,7 +104,7 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
     st.probes.assign(static_cast<size_t>(n) * kProbeFloats, 0.0f);
     for (uint32_t k = 0; k < n; ++k)
       if (st.active[k] && !dequantizeProbe(s.layout.repr, st.symbols[k], st.probes.data() + k * kProbeFloats,
-                                           s.zh3PerPixel))
+                                           s.zh3PerPixel, zh3hChoice))
         return CodecStatus::BadSymbol;
     s.staged.push_back(std::move(st));
     return CodecStatus::Ok;

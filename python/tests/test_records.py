@@ -39,15 +39,22 @@ def test_round_trip_is_close_and_deterministic(rng, repr_):
     assert dc_err.max() < 1.0 / 256
 
 
-def test_zh3h_per_pixel_decodes_l1_with_zero_l2(rng):
+def test_zh3h_chooses_per_probe_and_the_per_pixel_band_adds_up(rng):
     from conftest import random_probes
 
-    rec = probecast.encode(random_probes(rng, 10), "zh3h")
+    rec = probecast.encode(random_probes(rng, 50), "zh3h")
     per_pixel = probecast.decode(rec, "zh3h", zh3_per_pixel=True)
     per_probe = probecast.decode(rec, "zh3h")
-    assert np.all(per_pixel[:, 12:] == 0)
-    assert np.any(per_probe[:, 12:] != 0)
     np.testing.assert_array_equal(per_pixel[:, :12], per_probe[:, :12])
+    hallucinated = np.any(per_probe[:, 12:] != 0, axis=1)
+    assert hallucinated.any()
+    # The choice is the parity of the nine L1 ratio bytes: odd keeps plain L1.
+    odd = rec[:, 4:13].astype(np.int64).sum(axis=1) % 2 == 1
+    np.testing.assert_array_equal(odd, ~hallucinated)
+    # Per pixel, a probe that hallucinates leaves the band to the renderer (0); one kept at plain L1
+    # carries minus its hallucination, so that the renderer's cancels at the probe.
+    assert np.all(per_pixel[hallucinated, 12:] == 0)
+    assert np.all(np.any(per_pixel[~hallucinated, 12:] != 0, axis=1))
 
 
 def test_empty_batch():

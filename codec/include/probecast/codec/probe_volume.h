@@ -58,10 +58,12 @@ struct ProbeVolume {
   // What the samples are: float L2 as traced (nullopt), or what records of this representation
   // decode to (decodeAs, a stream decoder).
   std::optional<Representation> decodedFrom;
-  // zh3h only: the samples hold L1 with a zero L2 band, and the renderer hallucinates ZH3 per
-  // pixel after interpolating (interpolate, then hallucinate). False: the L2 band holds what the
-  // codec decoded (for zh3h, hallucinated per probe). Same name and meaning in ClientConfig,
-  // StreamDecoder and decodeProbeRecord.
+  // zh3h only: the renderer hallucinates ZH3 per pixel after interpolating (interpolate, then
+  // hallucinate) and adds it to the interpolated L2 band, which holds 0 for a probe that
+  // hallucinates and minus its own hallucinated band for one the encoder kept at plain L1 (so at
+  // the probe the two cancel). False: the L2 band holds what the codec decoded (for zh3h,
+  // hallucinated per probe or plain L1). Same name and meaning in ClientConfig, StreamDecoder and
+  // decodeProbeRecord.
   bool zh3PerPixel = false;
   uint32_t updates = 0;          // updates accumulated into the samples (0 = unknown)
   uint32_t samplesPerProbe = 0;  // paths per probe per update (0 = unknown)
@@ -92,7 +94,8 @@ bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back
 // (inactive probes too, as the raster client fills them from neighbours anyway). For zh3h,
-// `zh3PerPixel` chooses L1 only (true, as the raster client draws zh3h) or per-probe hallucination.
+// `zh3PerPixel` chooses the renderer's per-pixel form (true, as the raster client draws zh3h) or
+// the per-probe result.
 ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel);
 
 }  // namespace probecast

@@ -6,7 +6,8 @@
 //
 //   representation  record bytes  content
 //   l1              13            DC + 9 L1 ratios
-//   zh3h            13            as l1; the decoder hallucinates the zonal L2 (zh3.h)
+//   zh3h            13            as l1; per probe the decoder hallucinates the zonal L2
+//                                 (zh3.h) or keeps plain L1, as the encoder chose (below)
 //   zh3             16            as l1 + 3 zonal ratios around the axis of the decoded L1
 //   l2              28            DC + 9 L1 + 15 L2 ratios
 //   fp16            56            27 IEEE half floats + 1 zero pad half (DDISH-GI baseline,
@@ -15,6 +16,12 @@
 // Byte order: DC as little-endian uint32 (R bits 0-8, G 9-17, B 18-26, exponent 27-31), then the
 // ratio bytes in coefficient order i = 1..8 (l1/zh3h/zh3: i = 1..3), channels R, G, B within
 // each coefficient; zh3 appends the zonal bytes R, G, B.
+//
+// zh3h per-probe choice (codec format 2): the encoder, which sees the probe's L2, decodes it both
+// ways and keeps whichever is nearer in irradiance; an even sum of the nine L1 ratio bytes means
+// hallucinate, odd means plain L1. Where its parity tells the other choice, the encoder moves the
+// one L1 ratio whose move by a step costs least (at most one step on one coefficient per probe),
+// so zh3h stays 13 bytes and is never worse than l1 by more than that step.
 //
 // Untrusted values (documented behaviour, tested):
 // - NaN becomes 0; +Inf becomes the largest finite value of the field; -Inf the smallest.
@@ -63,9 +70,10 @@ constexpr float kBoundL2ZeroHi = 2.2360680f;   // √5, m = 0 and ZH3 zonal uppe
 // Closed loop: ratios are taken against the DC the decoder will reconstruct.
 void encodeProbeRecord(Representation repr, const float probe[kProbeFloats], uint8_t* out);
 
-// Decodes one record into 27 floats. For zh3h, `zh3PerPixel` chooses between the hallucinated
-// L2 band (false) and plain L1 with a zero L2 band (true, for a renderer that interpolates first
-// and hallucinates per pixel; ProbeVolume::zh3PerPixel).
+// Decodes one record into 27 floats. For zh3h, `zh3PerPixel` chooses between the probe as chosen
+// (false: hallucinated L2 band or plain L1) and the form of a renderer that interpolates first and
+// hallucinates per pixel (true: L1 and a band that is 0, or cancels the hallucination;
+// ProbeVolume::zh3PerPixel).
 // Returns false only for fp16 records holding Inf or NaN (ratio records always decode).
 bool decodeProbeRecord(Representation repr, const uint8_t* in, float probe[kProbeFloats], bool zh3PerPixel = false);
 

@@ -14,7 +14,7 @@
 // decoding is bit-identical to the encoder's reconstruction after every frame.
 //
 // Wire format, little-endian. Frame = header (32 bytes) + sections:
-//   header:  magic "PRBC" | u8 formatVersion (1) | u8 representation | u8 brickDim | u8 flags (0)
+//   header:  magic "PRBC" | u8 formatVersion (2; 1 is read) | u8 representation | u8 brickDim | u8 flags (0)
 //            | u16 nx, ny, nz | u16 reserved (0) | u32 frameSequence | u32 sectionCount
 //            | u32 sectionBytes | u32 CRC-32C of the preceding 28 bytes
 //   section: u32 brick | u32 version | u8 kind (1 keyframe, 2 delta) | u8 compression (0 raw,
@@ -22,6 +22,9 @@
 //            the data | data[storedSize]
 // A section is encoded once per brick version; frames for different subscribers reuse the same
 // section bytes and differ only in their header.
+// Format 2 differs from format 1 only in what zh3h symbols mean: the parity of each probe's L1
+// ratio symbols chooses hallucinated ZH3 or plain L1 (record.h). A format 1 frame still decodes,
+// every zh3h probe hallucinating as before; every other representation is byte-identical.
 #pragma once
 
 #include <cstddef>
@@ -36,7 +39,8 @@
 
 namespace probecast {
 
-constexpr uint8_t kFormatVersion = 1;
+constexpr uint8_t kFormatVersion = 2;        // what encoders write
+constexpr uint8_t kOldestFormatVersion = 1;  // the oldest a decoder reads
 constexpr size_t kFrameHeaderSize = 32;
 constexpr size_t kSectionHeaderSize = 22;
 constexpr int kMaxGridDim = 1024;
@@ -80,6 +84,7 @@ struct EncoderOptions {
 };
 
 struct FrameHeader {
+  uint8_t formatVersion = kFormatVersion;  // kOldestFormatVersion..kFormatVersion
   StreamLayout layout;
   uint32_t frameSequence = 0;
   uint32_t sectionCount = 0;
