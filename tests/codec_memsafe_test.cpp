@@ -130,10 +130,12 @@ TEST(MemorySafety, TrailingBytesAndWrongVersionAreRejected) {
   std::vector<uint8_t> longer = s.keyframe;
   longer.push_back(0);
   EXPECT_EQ(dec.apply(longer.data(), longer.size()), CodecStatus::TrailingBytes);
-  std::vector<uint8_t> v2 = s.keyframe;
-  v2[4] = 2;
-  repairChecksums(v2);
-  EXPECT_EQ(dec.apply(v2.data(), v2.size()), CodecStatus::UnsupportedVersion);
+  for (uint8_t version : {uint8_t{0}, static_cast<uint8_t>(kFormatVersion + 1)}) {
+    std::vector<uint8_t> other = s.keyframe;
+    other[4] = version;
+    repairChecksums(other);
+    EXPECT_EQ(dec.apply(other.data(), other.size()), CodecStatus::UnsupportedVersion) << int(version);
+  }
   std::vector<uint8_t> magic = s.keyframe;
   magic[0] = 'X';
   EXPECT_EQ(dec.apply(magic.data(), magic.size()), CodecStatus::BadMagic);

@@ -79,10 +79,11 @@ def test_python_errors_equal_the_cpp_bench(tmp_path):
             assert ours[r][name] == pytest.approx(value, rel=1e-12, abs=0), (r, name)
 
 
-# `probecast bench codec --envmaps tests/data/envmaps` (2048 normals): per_map_irradiance_rmse_rel.
+# `probecast bench codec --envmaps tests/data/envmaps` (2048 normals): per_map_irradiance_rmse_rel
+# (zh3h as codec format 2 encodes it: on kiara one L1 byte moved for the per-probe choice's parity).
 KNOWN = {
     "l1": {"kiara_1_dawn_1k.hdr": 0.17086110047798164, "venice_sunset_1k.hdr": 0.1162678239612263},
-    "zh3h": {"kiara_1_dawn_1k.hdr": 0.0923862619443808, "venice_sunset_1k.hdr": 0.09236450378906506},
+    "zh3h": {"kiara_1_dawn_1k.hdr": 0.09264238394962258, "venice_sunset_1k.hdr": 0.09236450378906506},
     "zh3": {"kiara_1_dawn_1k.hdr": 0.07876957109943045, "venice_sunset_1k.hdr": 0.08978154161729807},
     "l2": {"kiara_1_dawn_1k.hdr": 0.026105489760556228, "venice_sunset_1k.hdr": 0.015375238555912251},
     "fp16": {"kiara_1_dawn_1k.hdr": 0.02561588582857264, "venice_sunset_1k.hdr": 0.014279387213960144},
