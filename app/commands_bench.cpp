@@ -405,10 +405,12 @@ void addBenchAdaptive(CLI::App* bench) {
       "adaptive", "history rejection and the noise-aware stream: bytes still/moving, flicker, lag, PSNR loss");
   struct AdaptiveOptions {
     std::string json, chart, repr = "zh3";
+    GridOptions grid{{4, 4, 4}, {}};
     bench::AdaptiveBenchOptions bench;
   };
   auto ao = std::make_shared<AdaptiveOptions>();
   adaptive->add_option("--scene", ao->bench.sceneSpec, "an animated scene (t moves its light)");
+  ao->grid.add(adaptive, /*withBounds=*/false, 2, 64);
   adaptive->add_option("--spp", ao->bench.samplesPerProbe, "paths per probe per update")->check(CLI::Range(1u, 1u << 16));
   adaptive->add_option("--still", ao->bench.stillUpdates, "updates of each still phase")->check(CLI::Range(8u, 100000u));
   adaptive->add_option("--moving", ao->bench.movingUpdates, "updates with the light moving")->check(CLI::Range(1u, 100000u));
@@ -428,6 +430,7 @@ void addBenchAdaptive(CLI::App* bench) {
                      "measure only the re-convergence of the ray budget against brute force");
   adaptive->callback([ao] {
     bench::AdaptiveBenchOptions o = ao->bench;
+    o.dims = {ao->grid.dims[0], ao->grid.dims[1], ao->grid.dims[2]};
     o.repr = *parseRepresentation(ao->repr);
     o.command = commandLine();
     o.progress = progressLine;
