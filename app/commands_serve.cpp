@@ -148,7 +148,7 @@ void addSubscribeCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("subscribe", "subscribe to a probe stream; report and save the volume");
   struct SubOptions {
     ConnectOptions connection;
-    std::string out;
+    std::string out, repr;
     uint64_t budget = 0;
     double seconds = 5.0;
   };
@@ -157,9 +157,11 @@ void addSubscribeCommand(CLI::App& app) {
   sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
   sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
   sub->add_option("--out", so->out, "write the received volume here (probe volume file)");
+  addRepresentationOption(sub, so->repr, "representation wanted (default: the server's; a coarser one is transcoded)");
   sub->callback([so] {
     service::ClientConfig cc = so->connection.client("probecast-subscribe");
     cc.budgetBytesPerSecond = so->budget;
+    if (!so->repr.empty()) cc.representation = session::parseRepresentationOrThrow(so->repr);
     service::ProbeClient client(cc);
     client.start();
     const auto start = std::chrono::steady_clock::now();

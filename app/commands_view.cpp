@@ -57,6 +57,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   vc.raster = ro;
   vc.client = o.connection.client("probecast-view");
   vc.client.zh3PerPixel = true;
+  if (o.repr != "float") vc.client.representation = session::parseRepresentationOrThrow(o.repr);  // transcoded
   if (o.areaLights.mode != "auto") vc.areaLights = o.areaLights.mode == "on";
   session::Viewer viewer(context, s, views, vc);
   viewer.start();
@@ -70,7 +71,6 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   if (!viewer.snapshot(held))
     throw std::runtime_error("no probe volume from " + o.connection.connect + ": " + st.lastError);
   fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o.connection.connect);
-  if (o.repr != "float") throw std::runtime_error("--repr applies to local probes; the server chooses for --connect");
   o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
   printAreaLights(viewer.areaLightRule(), viewer.areaLights());
@@ -155,7 +155,10 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
-  addRepresentationOption(cmd, o->repr, "local probes: pass them through the codec first (float = as traced)", true);
+  addRepresentationOption(cmd, o->repr,
+                          "local probes: pass them through the codec first (float = as traced); --connect: ask the "
+                          "server for this representation (float = the server's; a coarser one is transcoded)",
+                          true);
   cmd->add_option("--passes", o->passes, "per-view (one pass per view) or multiview (chunks of views per pass)")
       ->check(CLI::IsMember({"per-view", "multiview"}));
   cmd->add_option("--shadow-map", o->shadowMap, "shadow map texels per side")->check(CLI::Range(16, 8192));

@@ -34,6 +34,27 @@ rel = (num / den) ** 0.5
 print("relative coefficient error %.4f" % rel)
 assert rel < 0.02, rel
 PY
+# A coarser representation is transcoded by the server; a finer one is refused.
+"$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1 --repr l1 --out "$work/received-l1.pcpv"
+if "$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1 --repr fp16 2>"$work/finer.log"; then
+  echo "a finer representation than the stream's was served"; exit 1
+fi
+grep -q "transcodes it only to coarser ones" "$work/finer.log"
+python3 - "$work/served.pcpv" "$work/received.pcpv" "$work/received-l1.pcpv" <<'PY'
+import struct, sys
+def load(p):
+    b = open(p, 'rb').read()
+    n = struct.unpack_from('<3I', b, 8)
+    count = n[0] * n[1] * n[2]
+    return struct.unpack_from('<%df' % (count * 27), b, 52)
+served, l2, l1 = (load(p) for p in sys.argv[1:])
+# l1 holds no L2 band (coefficients 4..8 of every probe are 0) and keeps the DC as l2 does.
+band = max(abs(v) for p in range(len(l1) // 27) for v in l1[p * 27 + 12: p * 27 + 27])
+assert band == 0.0, band
+dc = max(abs(a - b) for p in range(len(l1) // 27) for a, b in zip(l1[p * 27: p * 27 + 3], l2[p * 27: p * 27 + 3]))
+assert dc < 1e-3 * max(served), dc
+print("transcoded l1: no L2 band, DC as the l2 stream's")
+PY
 # The raster client fed by the stream.
 "$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views stereo --size 24x16 --out "$work/view" \
   | grep -q "2 views"

@@ -94,6 +94,30 @@ TEST(EdgeHub, ServesBitForBitWhatTheProducerMadeWithItsEpoch) {
   EXPECT_TRUE(same(p.hub.reconstruction(), dec.probes(), floats));
 }
 
+// An edge transcodes too: a subscriber asking it for l1 follows the bus versions as they arrive
+// and ends holding the edge's l1 stream, which is the producer's volume through l1, bit for bit;
+// its epoch is the edge's own, so held l1 versions never pass for the producer's numbers.
+TEST(EdgeHub, TranscodesFromTheBusVersionsAsTheyArrive) {
+  Producer p;
+  ProbeHub edge(gridConfig(), FromBus{});
+  p.publish();
+  feedAll(edge, p.messages);
+  const uint64_t id = edge.addSubscriber(0, 0, {}, nullptr, Representation::L1);
+  EXPECT_NE(edge.volumeFor(id).epoch, edge.epoch());
+  StreamDecoder dec(edge.volumeFor(id).layout);
+  drain(edge, id, dec);
+  for (int f = 0; f < 3; ++f) {
+    const size_t from = p.messages.size();
+    p.publish();
+    feedAll(edge, p.messages, from);
+    drain(edge, id, dec);
+  }
+  const size_t floats = 256 * kProbeFloats;
+  EXPECT_TRUE(same(edge.reconstruction(Representation::L1), dec.probes(), floats));
+  const ProbeVolume through = decodeAs(p.hub.reconstruction(), Representation::L1, false);
+  EXPECT_TRUE(same(through, dec.probes(), floats));
+}
+
 TEST(EdgeHub, ProbeOffsetsComeOnceInTheVolumeMessageAndTheEdgeWaitsForThem) {
   Producer p;
   const ProbeGrid g = gridOf(p.hub.layout(), p.hub.bounds());

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
 #include <random>
 
 #include "probecast/service/probe_hub.h"
@@ -176,6 +177,125 @@ TEST(ProbeHub, ResumeSendsOnlyWhatIsLacking) {
   // A wrong epoch voids the held versions.
   const uint64_t other = hub.addSubscriber(0, hub.epoch() + 1, held, nullptr);
   EXPECT_EQ(hub.nextFrame(other)->keyframes, 4u);
+}
+
+
+// A subscriber may ask for less than the stream carries: the hub encodes the volume it holds once
+// more in that representation, shared by every subscriber that asks for it, as a stream of its own
+// epoch. What such a subscriber decodes is bit for bit the hub's reconstruction of that stream, and
+// with no dead-zone every active probe is exactly the stream's reconstruction through that codec.
+TEST(ProbeHub, ACoarserRepresentationIsTranscodedOnceWithItsOwnEpoch) {
+  ProbeHub hub(rowConfig());  // l2
+  std::mt19937 rng(5);
+  hub.publish(test::movingLightFrame(256, 0, 0.02f, rng).data(), nullptr);
+  const uint64_t full = hub.addSubscriber(0, 0, {}, nullptr);
+  struct Sub {
+    Representation repr;
+    uint64_t id;
+    std::unique_ptr<StreamDecoder> dec;
+    size_t bytes = 0;
+  };
+  std::vector<Sub> subs;
+  for (Representation r : {Representation::Zh3, Representation::L1, Representation::Zh3Hallucinated, Representation::L1}) {
+    const uint64_t id = hub.addSubscriber(0, 0, {}, nullptr, r);
+    const bus::Volume v = hub.volumeFor(id);
+    EXPECT_EQ(v.layout.repr, r);
+    EXPECT_NE(v.epoch, hub.epoch());  // its versions are this hub's own
+    subs.push_back({r, id, std::make_unique<StreamDecoder>(v.layout)});
+  }
+  EXPECT_EQ(hub.volumeFor(full).epoch, hub.epoch());
+  EXPECT_EQ(hub.volumeFor(subs[1].id).epoch, hub.volumeFor(subs[3].id).epoch);  // one l1 stream
+  StreamDecoder fullDec(hub.layout());
+  size_t fullBytes = 0;
+  for (int f = 1; f <= 6; ++f) {
+    if (auto frame = hub.nextFrame(full)) {
+      fullBytes += frame->payload.size();
+      ASSERT_EQ(fullDec.apply(frame->payload.data(), frame->payload.size()), CodecStatus::Ok);
+    }
+    std::vector<uint8_t> l1Frames[2];
+    for (size_t k = 0; k < subs.size(); ++k)
+      if (auto frame = hub.nextFrame(subs[k].id)) {
+        subs[k].bytes += frame->payload.size();
+        ASSERT_EQ(subs[k].dec->apply(frame->payload.data(), frame->payload.size()), CodecStatus::Ok) << f << "," << k;
+        if (subs[k].repr == Representation::L1) l1Frames[k == 1 ? 0 : 1] = frame->payload;
+      }
+    // Encoded once: the two l1 subscribers got the same sections (frames differ only in the header).
+    ASSERT_EQ(l1Frames[0].size(), l1Frames[1].size());
+    if (!l1Frames[0].empty()) {
+      EXPECT_TRUE(std::equal(l1Frames[0].begin() + kFrameHeaderSize, l1Frames[0].end(),
+                             l1Frames[1].begin() + kFrameHeaderSize));
+    }
+    hub.publish(test::movingLightFrame(256, f, 0.02f, rng).data(), nullptr);
+  }
+  for (const Sub& sub : subs) {
+    while (auto frame = hub.nextFrame(sub.id)) {
+      ASSERT_EQ(sub.dec->apply(frame->payload.data(), frame->payload.size()), CodecStatus::Ok);
+    }
+    const ProbeVolume held = hub.reconstruction(sub.repr);
+    ASSERT_EQ(0, std::memcmp(held.probes.data(), sub.dec->probes(), held.probes.size() * sizeof(float)))
+        << representationName(sub.repr);
+    EXPECT_LT(sub.bytes, fullBytes) << representationName(sub.repr);
+  }
+  while (auto frame = hub.nextFrame(full)) {
+    ASSERT_EQ(fullDec.apply(frame->payload.data(), frame->payload.size()), CodecStatus::Ok);
+  }
+  const ProbeVolume primary = hub.reconstruction();
+  for (Representation r : {Representation::Zh3, Representation::L1}) {
+    const ProbeVolume through = decodeAs(primary, r, /*zh3PerPixel=*/false), transcoded = hub.reconstruction(r);
+    for (uint32_t p = 0; p < primary.count(); ++p) {
+      if (!primary.active[p]) continue;
+      for (int i = 0; i < kProbeFloats; ++i)
+        ASSERT_EQ(transcoded.probes[p * kProbeFloats + i], through.probes[p * kProbeFloats + i])
+            << representationName(r) << " probe " << p;
+    }
+  }
+  EXPECT_THROW(hub.reconstruction(Representation::Fp16), std::invalid_argument);  // nobody asked for it
+}
+
+// Transcoding never invents what the stream lacks: only coarser representations are made, and a
+// subscriber asking for a finer one is refused before it is added.
+TEST(ProbeHub, AFinerRepresentationIsRefused) {
+  EXPECT_TRUE(canTranscode(Representation::Zh3, Representation::Zh3));
+  EXPECT_TRUE(canTranscode(Representation::Fp16, Representation::L2));
+  EXPECT_TRUE(canTranscode(Representation::Zh3, Representation::Zh3Hallucinated));
+  EXPECT_TRUE(canTranscode(Representation::Zh3Hallucinated, Representation::L1));
+  EXPECT_FALSE(canTranscode(Representation::L1, Representation::Zh3Hallucinated));
+  EXPECT_FALSE(canTranscode(Representation::Zh3Hallucinated, Representation::Zh3));
+  EXPECT_FALSE(canTranscode(Representation::Zh3, Representation::L2));
+  HubConfig c = rowConfig();
+  c.layout.repr = Representation::Zh3;
+  ProbeHub hub(c);
+  std::mt19937 rng(6);
+  hub.publish(test::movingLightFrame(256, 0, 0.0f, rng).data(), nullptr);
+  EXPECT_THROW(hub.addSubscriber(0, 0, {}, nullptr, Representation::L2), std::invalid_argument);
+  EXPECT_THROW(hub.addSubscriber(0, 0, {}, nullptr, Representation::Fp16), std::invalid_argument);
+  EXPECT_EQ(hub.subscriberCount(), 0u);
+  EXPECT_NO_THROW(hub.addSubscriber(0, 0, {}, nullptr, Representation::Zh3));
+}
+
+// A transcoded subscriber resumes with what it holds when it comes back with its stream's epoch;
+// held versions under the primary's epoch (another stream's numbers) are void.
+TEST(ProbeHub, ATranscodedSubscriberResumesOnlyUnderItsStreamsEpoch) {
+  ProbeHub hub(rowConfig());
+  std::mt19937 rng(7);
+  hub.publish(test::movingLightFrame(256, 0, 0.0f, rng).data(), nullptr);
+  const uint64_t first = hub.addSubscriber(0, 0, {}, nullptr, Representation::L1);
+  const uint64_t epoch = hub.volumeFor(first).epoch;
+  StreamDecoder dec(hub.volumeFor(first).layout);
+  bricksIn(*hub.nextFrame(first), dec);
+  hub.removeSubscriber(first);
+  hub.publish(test::movingLightFrame(256, 10, 0.0f, rng).data(), nullptr);  // one version on
+  std::vector<HeldBrick> held;
+  for (uint32_t b = 0; b < 4; ++b) held.push_back({b, dec.brickVersion(b)});
+  const uint64_t resumed = hub.addSubscriber(0, epoch, held, nullptr, Representation::L1);
+  const auto r = hub.nextFrame(resumed);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->deltas, 4u);
+  EXPECT_EQ(r->keyframes, 0u);
+  bricksIn(*r, dec);
+  EXPECT_EQ(0, std::memcmp(hub.reconstruction(Representation::L1).probes.data(), dec.probes(), 256 * kProbeFloats * sizeof(float)));
+  const uint64_t wrongEpoch = hub.addSubscriber(0, hub.epoch(), held, nullptr, Representation::L1);
+  EXPECT_EQ(hub.nextFrame(wrongEpoch)->keyframes, 4u);
 }
 
 }  // namespace

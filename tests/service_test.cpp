@@ -232,13 +232,50 @@ TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {
   EXPECT_EQ(ackStatus.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_NE(ackStatus.error_message().find("ack of frame"), std::string::npos);
 
-  pb::ClientMessage wrongRepr = hello;
-  wrongRepr.mutable_hello()->set_representation(pb::REPRESENTATION_L1);
-  EXPECT_EQ(statusAfter(*stub, wrongRepr).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  pb::ClientMessage wrongRepr = hello;  // finer than the zh3 served: nothing to make it from
+  wrongRepr.mutable_hello()->set_representation(pb::REPRESENTATION_L2);
+  const grpc::Status reprStatus = statusAfter(*stub, wrongRepr);
+  EXPECT_EQ(reprStatus.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(reprStatus.error_message().find("transcodes it only to coarser ones"), std::string::npos)
+      << reprStatus.error_message();
 
   ASSERT_TRUE(waitFor([&] { return producer.published() == 30; }, 10s));
   EXPECT_TRUE(waitFor([&] { return matchesServer(good, hub); }, 10s));
   EXPECT_EQ(good.stats().connects, 1u);
+}
+
+// A client may ask for less than the server streams: over real gRPC it is told its own
+// representation and epoch, and ends holding the hub's transcoded volume bit for bit for fewer
+// bytes than a client of the stream itself, while that one converges as before. Asking for more
+// than the stream holds is refused for good.
+TEST(Service, AClientAskingForACoarserRepresentationGetsItTranscoded) {
+  ProbeHub hub(volumeConfig());  // zh3
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 30, 20ms);
+  ProbeClient full(clientFor(server.port()));
+  ClientConfig coarse = clientFor(server.port());
+  coarse.representation = Representation::L1;
+  ProbeClient l1(coarse);
+  coarse.representation = Representation::L2;
+  ProbeClient l2(coarse);
+  for (ProbeClient* c : {&full, &l1, &l2}) c->start();
+  ASSERT_TRUE(waitFor([&] { return producer.published() == 30; }, 10s));
+  EXPECT_TRUE(waitFor([&] { return matchesServer(full, hub); }, 20s));
+  const auto holdsL1 = [&] {
+    VolumeSnapshot snap;
+    if (!l1.snapshot(snap) || snap.layout.repr != Representation::L1) return false;
+    const ProbeVolume made = hub.reconstruction(Representation::L1);
+    return snap.volume.probes.size() == made.probes.size() &&
+           std::memcmp(snap.volume.probes.data(), made.probes.data(), made.probes.size() * sizeof(float)) == 0 &&
+           snap.volume.active == made.active;
+  };
+  EXPECT_TRUE(waitFor(holdsL1, 20s));
+  EXPECT_EQ(l1.stats().framesRejected, 0u);
+  EXPECT_LT(l1.stats().bytesReceived, full.stats().bytesReceived);
+  EXPECT_TRUE(waitFor([&] { return l2.stats().fatal; }, 10s));
+  EXPECT_NE(l2.stats().lastError.find("not served"), std::string::npos) << l2.stats().lastError;
+  VolumeSnapshot none;
+  EXPECT_FALSE(l2.snapshot(none));
 }
 
 std::string readFile(const std::string& path) {

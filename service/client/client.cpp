@@ -78,6 +78,11 @@ struct ProbeClient::Impl {
       stats.lastError = "bad volume description: " + why;
       return false;
     }
+    if (config.representation && l.repr != *config.representation) {
+      stats.lastError = std::string("the server streams ") + representationName(l.repr) + ", not the " +
+                        representationName(*config.representation) + " asked for";
+      return false;
+    }
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
     if (!same || v.stream_epoch() != epoch || !(r == areaLights)) {  // nothing held is valid
@@ -129,6 +134,7 @@ struct ProbeClient::Impl {
     h->set_protocol_version(kProtocolVersion);
     h->set_budget_bytes_per_second(config.budgetBytesPerSecond);
     h->set_client_name(config.name);
+    if (config.representation) h->set_representation(static_cast<pb::Representation>(*config.representation));
     std::lock_guard<std::mutex> lock(mutex);
     if (decoder) {
       h->set_stream_epoch(epoch);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "probecast/codec/probe_volume.h"
 #include "probecast/codec/stream.h"
 #include "probecast/service/bus_format.h"
 
@@ -28,7 +29,7 @@ class BrickSource {
 };
 
 // A producer's source: the hub's own encoder.
-class EncoderBricks final : public BrickSource {
+class EncoderBricks : public BrickSource {
  public:
   EncoderBricks(const StreamLayout& layout, const EncoderOptions& options) : encoder_(layout, options) {}
   uint32_t version(uint32_t brick) const override { return encoder_.brickVersion(brick); }
@@ -42,6 +43,26 @@ class EncoderBricks final : public BrickSource {
 
  private:
   StreamEncoder encoder_;
+};
+
+// A coarser representation of another source's volume (a subscriber asked for less than the
+// stream carries): the hub's own encoder of that representation, fed the volume a holder of every
+// current version of the primary decodes (follow). Its versions are its own, numbered by this
+// hub alone, so they come with an epoch of their own (a resume elsewhere starts from keyframes).
+class TranscodedBricks final : public EncoderBricks {
+ public:
+  TranscodedBricks(const StreamLayout& layout, const EncoderOptions& options, uint64_t epoch)
+      : EncoderBricks(layout, options), epoch_(epoch) {}
+  // Encodes the primary's current volume; returns the bricks given a new version.
+  uint32_t follow(const BrickSource& primary, const GridBounds& bounds) {
+    primary.copyVolume(bounds, volume_);
+    return encoder().update(volume_.probes.data(), volume_.active.data());
+  }
+  uint64_t epoch() const { return epoch_; }
+
+ private:
+  uint64_t epoch_;
+  ProbeVolume volume_;  // the primary's, reused
 };
 
 // An edge's source: the newest version of each brick as the bus delivered it. Every message's

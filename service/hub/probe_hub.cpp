@@ -32,6 +32,12 @@ bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBoun
 
 }  // namespace
 
+bool canTranscode(Representation served, Representation wanted) {
+  if (wanted == served) return true;
+  if (served == Representation::Zh3Hallucinated) return wanted == Representation::L1;
+  return recordSize(wanted) < recordSize(served);
+}
+
 bus::Brick busBrick(const BrickVersionBytes& v) {
   bus::Brick b;
   b.brick = v.brick;
@@ -127,6 +133,8 @@ void ProbeHub::describedAnew(std::vector<std::function<void()>>& wakes) {
   if (frame_ > 0 || !subscribers_.empty()) {  // what viewers were told no longer holds
     epoch_ = randomEpoch();
     endStreams(wakes);
+    transcoded_.clear();  // their epochs end with the stream's
+    transcodedBehind_ = false;
   }
 }
 
@@ -162,6 +170,7 @@ void ProbeHub::publish(const float* probes, const uint8_t* active, const float* 
     encoderSource("publish").encoder().update(probes, active, noise);
     ++frame_;
     publishedUs_ = nowUs();
+    transcodedBehind_ = !transcoded_.empty();
     const uint32_t bricks = brickCount(config_.layout);
     for (uint32_t b = 0; b < bricks; ++b) markStale(b);
     if (busOutput_) {
@@ -180,9 +189,31 @@ void ProbeHub::publish(const float* probes, const uint8_t* active, const float* 
 }
 
 void ProbeHub::markStale(uint32_t brick) {
-  const uint32_t current = source_->version(brick);
   for (auto& [id, s] : subscribers_)
-    if (!s.ended && s.held[brick] < current && s.staleSince[brick] == UINT32_MAX) s.staleSince[brick] = frame_;
+    if (!s.ended && s.held[brick] < s.source->version(brick) && s.staleSince[brick] == UINT32_MAX)
+      s.staleSince[brick] = frame_;
+}
+
+TranscodedBricks& ProbeHub::transcodedFor(Representation repr) {
+  std::unique_ptr<TranscodedBricks>& t = transcoded_[repr];
+  if (!t) {
+    StreamLayout layout = config_.layout;
+    layout.repr = repr;
+    EncoderOptions options = config_.encoder;
+    options.noiseScale = 0.0f;  // the primary's noise rule already held what noise explains
+    t = std::make_unique<TranscodedBricks>(layout, options, randomEpoch());
+    t->follow(*source_, config_.bounds);
+  }
+  return *t;
+}
+
+void ProbeHub::followTranscoded() {
+  if (!transcodedBehind_) return;
+  transcodedBehind_ = false;
+  bool changed = false;
+  for (auto& [repr, t] : transcoded_) changed = t->follow(*source_, config_.bounds) > 0 || changed;
+  if (changed)
+    for (uint32_t b = 0; b < brickCount(config_.layout); ++b) markStale(b);
 }
 
 BrickVersionBytes ProbeHub::versionBytes(uint32_t brick) {
@@ -226,15 +257,18 @@ void ProbeHub::startEpoch(const bus::Volume& volume, std::vector<std::function<v
   epoch_ = volume.epoch;
   auto source = std::make_unique<BusBricks>(volume.layout);
   bus_ = source.get();
+  endStreams(wakes);  // before the sources their subscribers point at go
+  transcoded_.clear();
+  transcodedBehind_ = false;
   source_ = std::move(source);
   frame_ = 0;
   publishedUs_ = 0;
-  endStreams(wakes);
 }
 
 void ProbeHub::endStreams(std::vector<std::function<void()>>& wakes) {
   for (auto& [id, s] : subscribers_) {  // what they hold is of another epoch: their streams end
     s.ended = true;
+    s.source = nullptr;
     s.waiting = false;
     if (s.wake) wakes.push_back(s.wake);
   }
@@ -264,6 +298,7 @@ ProbeHub::Received ProbeHub::receive(const bus::Message& m, bool wake, std::stri
         frame_ = std::max(frame_, m.brick.producerFrame);
         publishedUs_ = std::max(publishedUs_, m.volume.publishedUs);
         markStale(m.brick.brick);
+        transcodedBehind_ = !transcoded_.empty();
         if (result != Received::NewEpoch) result = Received::Applied;
       }
     }
@@ -301,28 +336,54 @@ uint32_t ProbeHub::serverFrame() const {
 }
 
 uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
-                                 std::function<void()> wake) {
+                                 std::function<void()> wake, std::optional<Representation> repr) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!source_) throw std::logic_error("addSubscriber before the hub has a volume (check ready())");
   const uint32_t bricks = brickCount(config_.layout);
   Subscriber s;
+  s.source = source_.get();
+  s.layout = config_.layout;
+  uint64_t streamEpoch = epoch_;
+  bool producer = !fromBus_;  // whether every version there is was made here
+  if (repr && *repr != config_.layout.repr) {
+    if (!canTranscode(config_.layout.repr, *repr))
+      throw std::invalid_argument(std::string("a ") + representationName(config_.layout.repr) +
+                                  " stream cannot be transcoded to " + representationName(*repr));
+    followTranscoded();
+    TranscodedBricks& t = transcodedFor(*repr);
+    s.source = &t;
+    s.layout.repr = *repr;
+    streamEpoch = t.epoch();
+    producer = true;
+  }
   s.budget = budgetBytesPerSecond;
   s.tokens = static_cast<double>(budgetBytesPerSecond) * config_.burstSeconds;
   s.refilled = Clock::now();
   s.held.assign(bricks, 0);
   s.staleSince.assign(bricks, UINT32_MAX);
-  if (epoch == epoch_)
+  if (epoch == streamEpoch)
     for (const HeldBrick& h : held)
       // On an edge a subscriber may come from a faster edge and hold versions this one has yet
       // to receive: it is sent nothing of those bricks until they move past what it holds. A
-      // producer has made every version there is, so a later one is nonsense there.
-      if (h.brick < bricks && (fromBus_ || h.version <= source_->version(h.brick))) s.held[h.brick] = h.version;
+      // producer (or a transcoded stream) has made every version there is, so a later one is
+      // nonsense there.
+      if (h.brick < bricks && (!producer || h.version <= s.source->version(h.brick))) s.held[h.brick] = h.version;
   for (uint32_t b = 0; b < bricks; ++b)
-    if (s.held[b] < source_->version(b)) s.staleSince[b] = frame_;
+    if (s.held[b] < s.source->version(b)) s.staleSince[b] = frame_;
   s.wake = std::move(wake);
   const uint64_t id = nextId_++;
   subscribers_.emplace(id, std::move(s));
   return id;
+}
+
+bus::Volume ProbeHub::volumeFor(uint64_t id) const {
+  bus::Volume v = volume();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = subscribers_.find(id);
+  if (it == subscribers_.end() || !it->second.source || it->second.layout.repr == v.layout.repr) return v;
+  v.layout.repr = it->second.layout.repr;
+  v.epoch = static_cast<const TranscodedBricks*>(it->second.source)->epoch();
+  return v;
 }
 
 void ProbeHub::removeSubscriber(uint64_t id) {
@@ -370,17 +431,19 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
   auto it = subscribers_.find(id);
   if (it == subscribers_.end() || it->second.ended) return std::nullopt;
   Subscriber& s = it->second;
+  if (s.source != source_.get()) followTranscoded();
+  BrickSource& source = *s.source;
   const uint32_t bricks = brickCount(config_.layout);
   candidates_.assign(bricks, BrickCandidate{});
   uint32_t behind = 0;
   for (uint32_t b = 0; b < bricks; ++b) {
-    const uint32_t current = source_->version(b);
+    const uint32_t current = source.version(b);
     if (s.held[b] >= current) continue;  // current, or ahead of a lagging edge
     ++behind;
     BrickCandidate& c = candidates_[b];
-    c.change = std::max(source_->changeSince(b, s.held[b]), 1e-3f);
+    c.change = std::max(source.changeSince(b, s.held[b]), 1e-3f);
     c.ageFrames = frame_ - std::min(frame_, s.staleSince[b]);
-    c.bytes = static_cast<uint32_t>(source_->sectionFor(b, s.held[b]).size());
+    c.bytes = static_cast<uint32_t>(source.sectionFor(b, s.held[b]).size());
   }
   s.stats.bricksBehind = behind;
   if (behind == 0) {
@@ -394,7 +457,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
     // matter, so the scoring (frustum tests per view and brick, a sort) is skipped.
     size_t n = 0;
     for (uint32_t b = 0; b < bricks; ++b)
-      if (s.held[b] < source_->version(b)) chosen_[n++] = b;
+      if (s.held[b] < source.version(b)) chosen_[n++] = b;
     return buildFrame(s, n, behind);
   }
   scores_.resize(bricks);
@@ -434,14 +497,14 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind) {
   for (size_t k = 0; k < n; ++k) {
     const uint32_t b = chosen_[k];
     bool delta = false;
-    sections.push_back(source_->sectionFor(b, s.held[b], &delta));
+    sections.push_back(s.source->sectionFor(b, s.held[b], &delta));
     (delta ? frame.deltas : frame.keyframes) += 1;
-    s.held[b] = source_->version(b);
+    s.held[b] = s.source->version(b);
     s.staleSince[b] = UINT32_MAX;
   }
   frame.sequence = ++s.sequence;
   frame.serverTimeUs = publishedUs_;
-  writeFrame(config_.layout, frame.sequence, sections, frame.payload);
+  writeFrame(s.layout, frame.sequence, sections, frame.payload);
   if (s.budget != 0) s.tokens -= static_cast<double>(frame.payload.size());
   s.unacked.emplace_back(frame.sequence, Clock::now());
   if (s.unacked.size() > 1024) s.unacked.pop_front();  // a client that never acks keeps a bounded record
@@ -485,12 +548,30 @@ SubscriberStats ProbeHub::stats(uint64_t id) const {
   return it == subscribers_.end() ? SubscriberStats{} : it->second.stats;
 }
 
+ProbeVolume ProbeHub::reconstruction(Representation repr) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!source_) throw std::logic_error("reconstruction before the hub has a volume (check ready())");
+  if (repr == config_.layout.repr) return reconstructionLocked(*source_);
+  auto it = transcoded_.find(repr);
+  if (it == transcoded_.end())
+    throw std::invalid_argument(std::string("no subscriber asked for ") + representationName(repr));
+  followTranscoded();
+  return reconstructionLocked(*it->second);
+}
+
 ProbeVolume ProbeHub::reconstruction() const {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (source_) return reconstructionLocked(*source_);
   ProbeVolume v;
-  if (source_) source_->copyVolume(config_.bounds, v);
+  v.areaLights = config_.areaLights;
+  return v;
+}
+
+ProbeVolume ProbeHub::reconstructionLocked(const BrickSource& source) const {
+  ProbeVolume v;
+  source.copyVolume(config_.bounds, v);
   std::string why;
-  if (source_ && !dequantizeProbeOffsets(v.grid, config_.offsets.data(), config_.offsets.size(), v.offsets, why))
+  if (!dequantizeProbeOffsets(v.grid, config_.offsets.data(), config_.offsets.size(), v.offsets, why))
     v.offsets.clear();  // never: offsets are checked when they arrive
   v.areaLights = config_.areaLights;
   return v;

@@ -242,9 +242,12 @@ class SubscribeReactor : public RawReactor {
     if (!pb::Representation_IsValid(wanted))
       return invalid("representation " + std::to_string(wanted) + " is not a known Representation");
     const int served = static_cast<int>(layout.repr);
-    if (wanted != pb::REPRESENTATION_UNSPECIFIED && wanted != served)
+    const Representation repr =
+        wanted == pb::REPRESENTATION_UNSPECIFIED ? layout.repr : static_cast<Representation>(wanted);
+    if (!canTranscode(layout.repr, repr))
       return invalid("representation " + pb::Representation_Name(h.representation()) + " is not served (this server "
-                     "streams " + pb::Representation_Name(static_cast<pb::Representation>(served)) + ")");
+                     "streams " + pb::Representation_Name(static_cast<pb::Representation>(served)) +
+                     " and transcodes it only to coarser ones)");
     const uint32_t bricks = brickCount(layout);
     if (static_cast<uint32_t>(h.held_size()) > bricks) return invalid("more held bricks than the volume has");
     std::vector<HeldBrick> held;
@@ -258,16 +261,19 @@ class SubscribeReactor : public RawReactor {
     }
     counted_ = true;
     std::weak_ptr<ReactorLink> weak = link_;
-    const uint64_t id = hub_.addSubscriber(h.budget_bytes_per_second(), h.stream_epoch(), held, [weak] {
-      if (auto link = weak.lock()) {
-        std::lock_guard<std::mutex> lock(link->mutex);
-        if (link->reactor) link->reactor->tryWriteLocked();
-      }
-    });
+    const uint64_t id = hub_.addSubscriber(
+        h.budget_bytes_per_second(), h.stream_epoch(), held,
+        [weak] {
+          if (auto link = weak.lock()) {
+            std::lock_guard<std::mutex> lock(link->mutex);
+            if (link->reactor) link->reactor->tryWriteLocked();
+          }
+        },
+        repr);
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
     out_.Clear();
-    volumeToWire(hub_.volume(), *out_.mutable_volume());
+    volumeToWire(hub_.volumeFor(id), *out_.mutable_volume());
     startWriteLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,10 @@ struct ClientConfig {
   // zh3h streams: decode L1 only (ProbeVolume::zh3PerPixel) so a renderer can interpolate first
   // and hallucinate per pixel; false: hallucinate per probe when decoding.
   bool zh3PerPixel = false;
+  // The representation wanted (none: the server's). A server transcodes its stream to a coarser
+  // one (canTranscode in probe_hub.h) and refuses a finer one (INVALID_ARGUMENT: fatal); a
+  // description of another representation is refused and the server tried again later.
+  std::optional<Representation> representation;
 };
 
 struct VolumeSnapshot {

@@ -45,6 +45,11 @@ struct HubConfig {
 // large for the stream format).
 HubConfig hubConfigFor(const ProbeGrid& grid, Representation repr, int brickDim = 4, int deadzone = 0);
 
+// Whether a hub streaming `served` can give a subscriber `wanted`: the same, or a coarser one it
+// makes from what it holds (fewer bytes per probe, or l1 from zh3h): transcoding never invents
+// what the stream lacks.
+bool canTranscode(Representation served, Representation wanted);
+
 // A brick's new version as the producer hands it to the bus (bytes owned).
 struct BrickVersionBytes {
   uint32_t brick = 0;
@@ -63,6 +68,7 @@ struct FromBus {};
 
 class BrickSource;
 class EncoderBricks;
+class TranscodedBricks;
 class BusBricks;
 
 struct HeldBrick {
@@ -138,9 +144,14 @@ class ProbeHub {
   uint32_t serverFrame() const;
 
   // `wake` is called (never under the hub's lock) when the subscriber may have a frame to take.
-  // `held` is honoured when `epoch` equals this hub's epoch (resume), ignored otherwise.
+  // `held` is honoured when `epoch` equals the epoch of the stream it subscribes to (resume),
+  // ignored otherwise. `repr`: the representation it wants (none: the stream's); another one
+  // (canTranscode, std::invalid_argument otherwise) is encoded by this hub from the volume it holds,
+  // once for every subscriber that wants it, as a stream of its own epoch (volumeFor).
   uint64_t addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
-                         std::function<void()> wake);
+                         std::function<void()> wake, std::optional<Representation> repr = std::nullopt);
+  // What a subscriber is told: volume(), with the representation and epoch of its stream.
+  bus::Volume volumeFor(uint64_t id) const;
   void removeSubscriber(uint64_t id);
   void setViews(uint64_t id, std::vector<View> views);
   // Every view of every subscriber, one after another (what anyone may look at: the producer's
@@ -162,9 +173,13 @@ class ProbeHub {
   // decoded bus versions; zh3h hallucinated per probe; offsets as subscribers reconstruct them),
   // for tests and tools.
   ProbeVolume reconstruction() const;
+  // The same for the subscribers of `repr` (std::invalid_argument when no subscriber asked for it).
+  ProbeVolume reconstruction(Representation repr);
 
  private:
   struct Subscriber {
+    BrickSource* source = nullptr;  // source_, or a transcoded one (null once its stream ended)
+    StreamLayout layout;            // of its stream
     uint64_t budget = 0;  // bytes per second, 0 = unlimited
     double tokens = 0;
     Clock::time_point refilled;
@@ -186,6 +201,11 @@ class ProbeHub {
   OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind);
   std::vector<std::function<void()>> collectWakes();
   void markStale(uint32_t brick);
+  ProbeVolume reconstructionLocked(const BrickSource& source) const;
+  // The transcoded stream of `repr`, made (following source_) on first use.
+  TranscodedBricks& transcodedFor(Representation repr);
+  // Brings every transcoded stream up to source_'s current volume (after publish or receive).
+  void followTranscoded();
   BrickVersionBytes versionBytes(uint32_t brick);
   EncoderBricks& encoderSource(const char* what) const;
   void startEpoch(const bus::Volume& volume, std::vector<std::function<void()>>& wakes);
@@ -202,6 +222,8 @@ class ProbeHub {
   std::unique_ptr<BrickSource> source_;
   EncoderBricks* encoder_ = nullptr;  // source_ of a producer's hub
   BusBricks* bus_ = nullptr;          // source_ of an edge's hub
+  std::map<Representation, std::unique_ptr<TranscodedBricks>> transcoded_;  // for this epoch
+  bool transcodedBehind_ = false;     // source_ moved since they followed it
   BusOutput busOutput_;
   std::vector<uint32_t> lastOutput_;  // version last handed to busOutput_, per brick
   uint32_t frame_ = 0;
