@@ -63,17 +63,21 @@ TEST(RasterClient, InactiveProbesAreFilledFromActiveNeighbours) {
   EXPECT_FLOAT_EQ(v.probes[0], 4.0f);  // filled across two steps
 }
 
+// n³ probes over the inner three quarters of the scene's bounds after one update of `spp` samples.
+ProbeVolume onceUpdatedProbes(VulkanContext& context, const scene::Scene& s, uint32_t n, uint32_t spp) {
+  const glm::vec3 lo = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
+  const glm::vec3 hi = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
+  UpdaterOptions uo;
+  uo.samplesPerProbe = spp;
+  ProbeUpdater updater(context, s, ProbeGrid{{n, n, n}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}}, uo);
+  updater.update();
+  return updater.volume();
+}
+
 TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
-  const glm::vec3 lo = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
-  const glm::vec3 hi = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
-  const ProbeGrid g{{4, 4, 4}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}};
-  UpdaterOptions uo;
-  uo.samplesPerProbe = 64;
-  ProbeUpdater updater(context, s, g, uo);
-  updater.update();
-  const ProbeVolume v = updater.volume();
+  const ProbeVolume v = onceUpdatedProbes(context, s, 4, 64);
   RasterRenderer raster(context, s, 48, 36);
   raster.setProbes(v);
   const CameraView cam = CameraView::fromScene(s);
@@ -133,13 +137,7 @@ TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
 TEST(RasterClient, SupersampledPixelsAreTheMeanOfTheirBlockAtNTimesTheSize) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);
-  const glm::vec3 lo = s.boundsMin + 0.125f * (s.boundsMax - s.boundsMin);
-  const glm::vec3 hi = s.boundsMax - 0.125f * (s.boundsMax - s.boundsMin);
-  const ProbeGrid g{{3, 3, 3}, {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}};
-  UpdaterOptions uo;
-  uo.samplesPerProbe = 16;
-  ProbeUpdater updater(context, s, g, uo);
-  updater.update();
+  const ProbeVolume probes = onceUpdatedProbes(context, s, 3, 16);
   constexpr uint32_t kW = 20, kH = 16, kN = 3;
   RasterOptions one, three;
   three.samplesPerSide = kN;
@@ -147,7 +145,7 @@ TEST(RasterClient, SupersampledPixelsAreTheMeanOfTheirBlockAtNTimesTheSize) {
       supersampled(context, s, kW, kH, three);
   const CameraView cam = CameraView::fromScene(s);
   const auto draw = [&](RasterRenderer& r) {
-    r.setProbes(updater.volume());
+    r.setProbes(probes);
     return r.render(r.viewProjection(cam), cam.position);
   };
   const Image a = draw(small), big = draw(large), ss = draw(supersampled);
