@@ -8,6 +8,7 @@
 #include <random>
 
 #include "probecast/codec/half_float.h"
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/record.h"
 #include "probecast/codec/rgb9e5.h"
 #include "probecast/codec/zh3.h"
@@ -264,15 +265,12 @@ TEST(Record, QuantisedL2IrradianceWithinOnePercentOfFloat) {
 }
 
 
-// The irradiance norm the zh3h choice minimises: SH is orthonormal, so the squared error of
-// irradiance over the sphere is Σ Â_l² (Δc_lm)², summed over RGB (CODEC.md §1).
+// The irradiance norm the zh3h choice minimises: ∫ |ΔE|² over the sphere, RGB pooled
+// (irradiance_error.h), square-rooted.
 double irradianceDistance(const float* a, const float* b) {
-  double e = 0;
-  for (int i = 0; i < kShCoeffs; ++i) {
-    const double band = kCosineBand[i == 0 ? 0 : (i < 4 ? 1 : 2)];
-    for (int c = 0; c < 3; ++c) e += band * band * (a[i * 3 + c] - b[i * 3 + c]) * (a[i * 3 + c] - b[i * 3 + c]);
-  }
-  return std::sqrt(e);
+  double err = 0, energy = 0;
+  irradianceErrorEnergy(a, b, err, energy);
+  return std::sqrt(err);
 }
 
 // A bright ring around the equator and a weaker light at the pole: L1 points at the pole, where

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "probecast/codec/crc32c.h"
+#include "probecast/codec/internal/frame_checksums.h"
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/stream.h"
 #include "probecast/codec/zh3.h"
 #include "test_probes.h"
@@ -36,6 +38,7 @@ void expectSameState(const StreamEncoder& enc, const StreamDecoder& dec, const s
 struct DriftCase {
   Representation repr;
   int deadzone;
+  float errorBound = 0.0f;  // per-brick representation
 };
 
 class DriftFree : public ::testing::TestWithParam<DriftCase> {};
@@ -43,21 +46,26 @@ class DriftFree : public ::testing::TestWithParam<DriftCase> {};
 TEST_P(DriftFree, DecoderMatchesEncoderOver1000NoisyFrames) {
   // 8×4×6 probes: 4 bricks, two of them cut at the z edge. Noise 3 % per coefficient, probes
   // switching between active and inactive, a subscriber joining late from keyframes.
-  const auto [repr, deadzone] = GetParam();
+  const auto [repr, deadzone, errorBound] = GetParam();
   const StreamLayout layout = makeLayout(8, 4, 6, repr);
   EncoderOptions options;
   options.deadzone = deadzone;
+  options.errorBound = errorBound;
   StreamEncoder enc(layout, options);
   StreamDecoder dec(layout);
   std::unique_ptr<StreamDecoder> late;
   const int count = static_cast<int>(probeCount(layout));
   std::mt19937 rng(1234);
   std::vector<uint8_t> active(count, 1), frame;
+  uint32_t switches = 0;  // versions that moved a brick to another representation (error bound)
   for (int f = 0; f < 1000; ++f) {
     if (f % 50 == 0)
       for (int p = 0; p < count; ++p) active[p] = (rng() % 10) != 0;
     const std::vector<float> probes = test::movingLightFrame(count, f, 0.03f, rng);
+    std::vector<uint32_t> before(brickCount(layout));
+    for (uint32_t b = 0; b < before.size(); ++b) before[b] = enc.brickVersion(b);
     enc.update(probes.data(), active.data());
+    for (uint32_t b = 0; b < before.size(); ++b) switches += enc.brickVersion(b) != before[b] && enc.deltaIsKeyframe(b);
     enc.writeChangedFrame(frame);
     ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok) << "frame " << f;
     expectSameState(enc, dec, "frame " + std::to_string(f));
@@ -70,6 +78,8 @@ TEST_P(DriftFree, DecoderMatchesEncoderOver1000NoisyFrames) {
     }
     if (late) expectSameState(enc, *late, "late joiner, frame " + std::to_string(f));
   }
+  if (errorBound > 0) EXPECT_GT(switches, 2u);  // the bound moved bricks between representations
+  else EXPECT_EQ(switches, 0u);
   // The reconstruction follows the input: DC within the dead-zone's reach of the last frame.
   const std::vector<float> last = test::movingLightFrame(count, 999, 0.0f, rng);
   double num = 0, den = 0;
@@ -89,10 +99,13 @@ INSTANTIATE_TEST_SUITE_P(RepresentationsAndDeadzones, DriftFree,
                                            DriftCase{Representation::Zh3, 3}, DriftCase{Representation::L2, 0},
                                            DriftCase{Representation::L2, 2}, DriftCase{Representation::Fp16, 0},
                                            DriftCase{Representation::Zh3Hallucinated, 0},
-                                           DriftCase{Representation::Zh3Hallucinated, 1}),
+                                           DriftCase{Representation::Zh3Hallucinated, 1},
+                                           DriftCase{Representation::L2, 1, 0.05f}, DriftCase{Representation::Zh3, 0, 0.1f}),
                          [](const auto& p) {
                            return std::string(representationName(p.param.repr)) + "_dz" +
-                                  std::to_string(p.param.deadzone);
+                                  std::to_string(p.param.deadzone) +
+                                  (p.param.errorBound > 0 ? "_bound" + std::to_string(static_cast<int>(100 * p.param.errorBound))
+                                                          : std::string());
                          });
 
 // Luminance of c00 (Rec. 709), the unit of the encoder's noise values.
@@ -285,6 +298,105 @@ TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
     StreamDecoder dec(layout);
     EXPECT_EQ(dec.apply(f.data(), f.size()), CodecStatus::UnsupportedVersion) << int(version);
   }
+}
+
+// An 8×4×4 l2 stream in two bricks: brick 0 under a uniform sky (L1 is exact there), brick 1 lit
+// by three small lights each (it needs the whole L2 band: one light alone is zonal, which zh3 holds). With an error bound each brick goes in the cheapest
+// representation that keeps every probe within it, in one stream one decoder reads; when brick 0's
+// light changes it moves up, its version a keyframe in the new representation.
+std::vector<float> twoKindsOfLight(std::mt19937& rng, bool litBrick0, float sky = 1.0f) {
+  std::vector<float> p(128 * kProbeFloats, 0.0f);
+  for (int i = 0; i < 128; ++i) {
+    const bool brick0 = (i % 8) < 4;  // x < 4
+    test::Probe q{};
+    if (brick0 && !litBrick0) {
+      for (int c = 0; c < 3; ++c) q[c] = 3.5449077f * sky * (0.5f + 0.1f * static_cast<float>(c));  // constant radiance
+    } else {
+      q = test::randomNonNegativeProbe(rng, 3, 0.02f);  // three lights: not zonal, so not zh3 either
+    }
+    std::copy(q.begin(), q.end(), p.begin() + i * kProbeFloats);
+  }
+  return p;
+}
+
+TEST(Stream, PerBrickRepresentationMeetsTheBoundInTheCheapestOne) {
+  const StreamLayout layout = makeLayout(8, 4, 4, Representation::L2);
+  std::mt19937 rng(31);
+  const std::vector<float> frame0 = twoKindsOfLight(rng, false);
+  EncoderOptions options;
+  options.errorBound = 0.05f;
+  options.compress = false;
+  StreamEncoder bounded(layout, options), full(layout, EncoderOptions{0, 3, false});
+  bounded.update(frame0.data(), nullptr);
+  full.update(frame0.data(), nullptr);
+  EXPECT_EQ(bounded.brickRepresentation(0), Representation::L1);
+  EXPECT_EQ(bounded.brickRepresentation(1), Representation::L2);
+  std::vector<uint8_t> a, b;
+  bounded.writeKeyframeFrame(a);
+  full.writeKeyframeFrame(b);
+  EXPECT_LT(a.size(), b.size() - 64 * (28 - 13) + 64);  // brick 0's 64 records at 13 B instead of 28
+  StreamDecoder dec(layout);
+  ASSERT_EQ(dec.apply(a.data(), a.size()), CodecStatus::Ok);
+  expectSameState(bounded, dec, "keyframes");
+  for (int i = 0; i < 128; ++i) {  // every probe within the bound
+    double err = 0, energy = 0;
+    irradianceErrorEnergy(dec.probes() + i * kProbeFloats, frame0.data() + i * kProbeFloats, err, energy);
+    EXPECT_LE(std::sqrt(err / energy), 0.05) << "probe " << i;
+  }
+  // Brick 0's light changes: it needs more than L1 now, and its new version is a keyframe.
+  const std::vector<float> frame1 = twoKindsOfLight(rng, true);
+  bounded.update(frame1.data(), nullptr);
+  EXPECT_NE(bounded.brickRepresentation(0), Representation::L1);
+  EXPECT_TRUE(bounded.deltaIsKeyframe(0));
+  bounded.writeChangedFrame(a);
+  ASSERT_EQ(dec.apply(a.data(), a.size()), CodecStatus::Ok);
+  expectSameState(bounded, dec, "after the switch");
+  // Without a bound the same stream never changes representation.
+  full.update(frame1.data(), nullptr);
+  EXPECT_EQ(full.brickRepresentation(0), Representation::L2);
+  EXPECT_FALSE(full.deltaIsKeyframe(0));
+}
+
+// A section's representation is one of the stream's cheaper ones, never its own spelled out, and a
+// delta must be in the representation its brick holds.
+TEST(Stream, SectionRepresentationsOutsideTheStreamsAreRefused) {
+  const StreamLayout layout = makeLayout(8, 4, 4, Representation::L2);
+  std::mt19937 rng(32);
+  const std::vector<float> frame0 = twoKindsOfLight(rng, false);
+  EncoderOptions options;
+  options.errorBound = 0.05f;
+  options.compress = false;
+  StreamEncoder enc(layout, options);
+  enc.update(frame0.data(), nullptr);
+  std::vector<uint8_t> key;
+  enc.writeKeyframeFrame(key);
+  // Brick 0's section comes first: its kind byte says keyframe (1) in l1 (1 << 4).
+  const size_t kindAt = kFrameHeaderSize + 8;
+  ASSERT_EQ(key[kindAt], 0x11);
+  const auto refused = [&](uint8_t kind) {
+    std::vector<uint8_t> f = key;
+    f[kindAt] = kind;
+    rewriteFrameChecksums(f);
+    StreamDecoder dec(layout);
+    return dec.apply(f.data(), f.size());
+  };
+  EXPECT_EQ(refused(0x41), CodecStatus::BadSectionKind);  // l2 spelled out in an l2 stream
+  EXPECT_EQ(refused(0x51), CodecStatus::BadSectionKind);  // fp16: not a brick representation
+  EXPECT_EQ(refused(0x21), CodecStatus::BadSectionKind);  // zh3h: not a brick representation
+  EXPECT_EQ(refused(0xf1), CodecStatus::BadSectionKind);
+  // A delta in l1 for a brick the decoder holds in l2 (as a format 1 stream or no bound would).
+  StreamEncoder plain(layout, EncoderOptions{0, 3, false});
+  plain.update(frame0.data(), nullptr);
+  std::vector<uint8_t> plainKey;
+  plain.writeKeyframeFrame(plainKey);
+  StreamDecoder dec(layout);
+  ASSERT_EQ(dec.apply(plainKey.data(), plainKey.size()), CodecStatus::Ok);
+  enc.update(twoKindsOfLight(rng, false, 1.5f).data(), nullptr);  // brick 0 brighter, still l1: an l1 delta
+  ASSERT_EQ(enc.brickRepresentation(0), Representation::L1);
+  ASSERT_FALSE(enc.deltaIsKeyframe(0));
+  std::vector<uint8_t> delta;
+  enc.writeChangedFrame(delta);
+  EXPECT_EQ(dec.apply(delta.data(), delta.size()), CodecStatus::BadSectionKind);
 }
 
 TEST(Stream, InactiveProbesAreNeverEncoded) {

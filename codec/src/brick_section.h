@@ -36,14 +36,17 @@ void buildKeyframePayload(Representation repr, uint32_t probes, const uint8_t* a
 void buildDeltaPayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* base,
                        const ProbeSymbols* next, std::vector<uint8_t>& out);
 
-// Appends section header + (possibly compressed) payload. `zstdContext` is a ZSTD_CCtx*, or null to store the payload raw.
-void writeSection(uint32_t brick, uint32_t version, SectionKind kind, const std::vector<uint8_t>& raw, int zstdLevel,
-                  void* zstdContext, std::vector<uint8_t>& out);
+// Appends section header + (possibly compressed) payload. `zstdContext` is a ZSTD_CCtx*, or null to
+// store the payload raw. `repr` is the brick's representation; it is written into the kind byte
+// when it differs from the stream's (`layoutRepr`).
+void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representation repr, Representation layoutRepr,
+                  const std::vector<uint8_t>& raw, int zstdLevel, void* zstdContext, std::vector<uint8_t>& out);
 
 struct SectionView {
   uint32_t brick = 0;
   uint32_t version = 0;
   SectionKind kind = SectionKind::Keyframe;
+  Representation repr = Representation::L1;  // of the brick's payload (the stream's unless the kind byte says)
   uint8_t compression = 0;
   uint32_t rawSize = 0;
   const uint8_t* data = nullptr;

@@ -209,12 +209,21 @@ size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick) {
   return 2u * maskBytes(probes) + probes * perProbe;
 }
 
-void writeSection(uint32_t brick, uint32_t version, SectionKind kind, const std::vector<uint8_t>& raw, int zstdLevel,
-                  void* zstdContext, std::vector<uint8_t>& out) {
+std::vector<Representation> brickRepresentations(Representation repr) {
+  switch (repr) {
+    case Representation::Zh3: return {Representation::L1, Representation::Zh3};
+    case Representation::L2: return {Representation::L1, Representation::Zh3, Representation::L2};
+    default: return {repr};
+  }
+}
+
+void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representation repr, Representation layoutRepr,
+                  const std::vector<uint8_t>& raw, int zstdLevel, void* zstdContext, std::vector<uint8_t>& out) {
   out.clear();
   putU32(out, brick);
   putU32(out, version);
-  out.push_back(static_cast<uint8_t>(kind));
+  const uint8_t reprBits = repr == layoutRepr ? 0 : static_cast<uint8_t>(static_cast<uint8_t>(repr) << 4);
+  out.push_back(static_cast<uint8_t>(static_cast<uint8_t>(kind) | reprBits));
   out.push_back(kCompressionRaw);
   putU32(out, static_cast<uint32_t>(raw.size()));
   putU32(out, 0);  // stored size, patched below
@@ -247,7 +256,7 @@ CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t
   SectionView v;
   v.brick = getU32(data);
   v.version = getU32(data + 4);
-  const uint8_t kind = data[8];
+  const uint8_t kind = data[8] & 0x0f, reprCode = data[8] >> 4;
   v.compression = data[9];
   v.rawSize = getU32(data + 10);
   v.storedSize = getU32(data + 14);
@@ -260,6 +269,14 @@ CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t
     return CodecStatus::BadSectionKind;
   if (v.compression != kCompressionRaw && v.compression != kCompressionZstd) return CodecStatus::BadSectionKind;
   v.kind = static_cast<SectionKind>(kind);
+  v.repr = layout.repr;
+  if (reprCode != 0) {  // one of the stream's cheaper brick representations, never its own spelled out
+    const std::vector<Representation> allowed = brickRepresentations(layout.repr);
+    if (reprCode == static_cast<uint8_t>(layout.repr) ||
+        std::find(allowed.begin(), allowed.end(), static_cast<Representation>(reprCode)) == allowed.end())
+      return CodecStatus::BadSectionKind;
+    v.repr = static_cast<Representation>(reprCode);
+  }
   if (v.rawSize > maxRawSectionSize(layout, v.brick)) return CodecStatus::SectionTooLarge;
   if (v.compression == kCompressionRaw && v.storedSize != v.rawSize) return CodecStatus::SizeMismatch;
   v.data = data + kSectionHeaderSize;

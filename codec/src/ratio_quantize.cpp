@@ -6,6 +6,7 @@
 
 #include "probe_symbols.h"
 #include "probecast/codec/half_float.h"
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/record.h"
 #include "probecast/codec/rgb9e5.h"
 #include "probecast/codec/zh3.h"
@@ -109,18 +110,11 @@ void finishZh3h(const ProbeSymbols& s, float probe[kProbeFloats], bool perPixel)
   for (int k = 4 * 3; k < kProbeFloats; ++k) probe[k] = -probe[k];
 }
 
-// Squared irradiance error of `decoded` against `reference` over the sphere, summed over RGB
-// (orthonormal SH: the cosine lobe scales band l by Â_l, CODEC.md §1).
-float irradianceError2(const float decoded[kProbeFloats], const float reference[kProbeFloats]) {
-  float e = 0.0f;
-  for (int i = 0; i < kShCoeffs; ++i) {
-    const float a = kCosineBand[i == 0 ? 0 : (i < 4 ? 1 : 2)];
-    for (int c = 0; c < 3; ++c) {
-      const float d = decoded[i * 3 + c] - reference[i * 3 + c];
-      e += a * a * d * d;
-    }
-  }
-  return e;
+// Squared irradiance error of `decoded` against `reference` over the sphere, RGB pooled.
+double irradianceError2(const float decoded[kProbeFloats], const float reference[kProbeFloats]) {
+  double err = 0.0, energy = 0.0;
+  irradianceErrorEnergy(decoded, reference, err, energy);
+  return err;
 }
 
 // zh3h per probe: the symbols as quantised (candidate A) tell one choice by their parity; the
@@ -152,8 +146,8 @@ void chooseZh3h(const float probe[kProbeFloats], const float ratio127[9], const 
   }
   ProbeSymbols other = *out;
   other.narrow[best] = static_cast<uint8_t>(static_cast<int8_t>(bestTo));
-  const float a = errorOf(*out), b = errorOf(other);
-  if (stream ? b < 0.9f * a : b < a) *out = other;
+  const double a = errorOf(*out), b = errorOf(other);
+  if (stream ? b < 0.9 * a : b < a) *out = other;
 }
 
 void quantizeFp16(const float probe[kProbeFloats], const ProbeSymbols* previous, int deadzone, ProbeSymbols* out) {

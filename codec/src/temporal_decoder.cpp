@@ -17,6 +17,7 @@ struct StreamDecoder::Impl {
   std::vector<uint8_t> active;
   std::vector<float> probes;
   std::vector<uint32_t> versions;
+  std::vector<Representation> brickRepr;  // of each brick's held version (the stream's until a section says)
   BrickTable table;
   std::vector<uint32_t> seenInFrame;  // frame stamp per brick, for duplicate detection
   uint32_t stamp = 0;
@@ -26,6 +27,7 @@ struct StreamDecoder::Impl {
   struct Staged {
     uint32_t brick;
     uint32_t version;
+    Representation repr;
     std::vector<uint8_t> active;
     std::vector<ProbeSymbols> symbols;
     std::vector<float> probes;
@@ -46,6 +48,7 @@ StreamDecoder::StreamDecoder(const StreamLayout& layout) : impl_(new Impl) {
   s.active.assign(probes, 0);
   s.probes.assign(static_cast<size_t>(probes) * kProbeFloats, 0.0f);
   s.versions.assign(bricks, 0);
+  s.brickRepr.assign(bricks, layout.repr);
   s.seenInFrame.assign(bricks, 0);
   s.table.build(layout);
   s.dctx = ZSTD_createDCtx();
@@ -75,6 +78,8 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
     const uint32_t held = s.versions[view.brick];
     if (view.kind == SectionKind::Delta && view.version != held + 1) return CodecStatus::BaseVersionMismatch;
     if (view.kind == SectionKind::Keyframe && view.version < held) return CodecStatus::BadVersion;
+    // A delta changes symbols of the representation held; another one starts from a keyframe.
+    if (view.kind == SectionKind::Delta && view.repr != s.brickRepr[view.brick]) return CodecStatus::BadSectionKind;
 
     const uint8_t* raw = view.data;
     if (view.compression == kCompressionZstd) {
@@ -91,19 +96,20 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
     Impl::Staged st;
     st.brick = view.brick;
     st.version = view.version;
+    st.repr = view.repr;
     st.active.resize(n);
     st.symbols.resize(n);
     for (uint32_t k = 0; k < n; ++k) {
       st.active[k] = s.active[s.table.probes[first + k]];
       st.symbols[k] = s.symbols[s.table.probes[first + k]];
     }
-    if (CodecStatus r = applyPayload(s.layout.repr, n, view.kind, raw, view.rawSize, st.active.data(),
+    if (CodecStatus r = applyPayload(view.repr, n, view.kind, raw, view.rawSize, st.active.data(),
                                      st.symbols.data());
         r != CodecStatus::Ok)
       return r;
     st.probes.assign(static_cast<size_t>(n) * kProbeFloats, 0.0f);
     for (uint32_t k = 0; k < n; ++k)
-      if (st.active[k] && !dequantizeProbe(s.layout.repr, st.symbols[k], st.probes.data() + k * kProbeFloats,
+      if (st.active[k] && !dequantizeProbe(view.repr, st.symbols[k], st.probes.data() + k * kProbeFloats,
                                            s.zh3PerPixel, zh3hChoice))
         return CodecStatus::BadSymbol;
     s.staged.push_back(std::move(st));
@@ -121,6 +127,7 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
                 s.probes.begin() + static_cast<size_t>(probe) * kProbeFloats);
     }
     s.versions[st.brick] = st.version;
+    s.brickRepr[st.brick] = st.repr;
   }
   s.lastFrame = header.frameSequence;
   return CodecStatus::Ok;

@@ -3,10 +3,12 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <zstd.h>
 
 #include "brick_section.h"
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/sh.h"
 #include "probecast/codec/stream.h"
 
@@ -21,6 +23,9 @@ struct StreamEncoder::Impl {
   std::vector<float> reconstruction;       // 27 floats per probe
   BrickTable table;                        // grid indices of each brick's probes
   std::vector<uint32_t> versions;
+  std::vector<Representation> brickRepr;   // of each brick's current version
+  std::vector<uint8_t> deltaIsKeyframe;    // per brick: its latest version changed representation
+  std::vector<Representation> choices;     // brickRepresentations(layout.repr) with an error bound, else the layout's
   std::vector<float> change;
   static constexpr uint32_t kHistory = 16;
   std::vector<float> changeHistory;        // kHistory per brick, indexed by version % kHistory
@@ -33,6 +38,11 @@ struct StreamEncoder::Impl {
   // Scratch, sized for one brick.
   std::vector<ProbeSymbols> base, next;
   std::vector<uint8_t> nextActive, raw;
+  std::vector<ProbeSymbols> candidates;  // per choice × brick probe, with an error bound
+
+  // The representation brick `b` is sent in this update (EncoderOptions::errorBound), its probes'
+  // symbols for each choice left in `candidates`.
+  Representation chooseRepresentation(uint32_t b, const float* probes, const uint8_t* activeIn);
 
   ~Impl() { ZSTD_freeCCtx(cctx); }
 };
@@ -49,6 +59,9 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
   s.reconstruction.assign(static_cast<size_t>(probes) * kProbeFloats, 0.0f);
   s.table.build(layout);
   s.versions.assign(bricks, 0);
+  s.brickRepr.assign(bricks, layout.repr);
+  s.deltaIsKeyframe.assign(bricks, 0);
+  s.choices = options.errorBound > 0.0f ? brickRepresentations(layout.repr) : std::vector<Representation>{layout.repr};
   s.change.assign(bricks, 0.0f);
   s.changeHistory.assign(static_cast<size_t>(bricks) * Impl::kHistory, 0.0f);
   s.deltas.resize(bricks);
@@ -89,9 +102,48 @@ bool withinNoise(const float candidate[kProbeFloats], const float held[kProbeFlo
 
 }  // namespace
 
+Representation StreamEncoder::Impl::chooseRepresentation(uint32_t b, const float* probes, const uint8_t* activeIn) {
+  const uint32_t first = table.first[b], n = table.first[b + 1] - first;
+  const size_t count = choices.size();
+  candidates.resize(count * n);
+  std::vector<double> worst(count, 0.0);
+  for (size_t c = 0; c < count; ++c)
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t p = table.probes[first + k];
+      ProbeSymbols& out = candidates[c * n + k];
+      if (activeIn != nullptr && activeIn[p] == 0) {
+        out = ProbeSymbols{};
+        continue;
+      }
+      // The brick's own representation keeps the dead-zone against what the decoder holds.
+      const ProbeSymbols* previous = active[p] && choices[c] == brickRepr[b] ? &symbols[p] : nullptr;
+      float input[kProbeFloats];
+      std::copy(probes + static_cast<size_t>(p) * kProbeFloats, probes + static_cast<size_t>(p + 1) * kProbeFloats, input);
+      sanitizeProbe(input);
+      quantizeProbe(choices[c], input, previous, options.deadzone, &out);
+      float decoded[kProbeFloats];
+      dequantizeProbe(choices[c], out, decoded, /*zh3PerPixel=*/false);
+      double err = 0.0, energy = 0.0;
+      irradianceErrorEnergy(decoded, input, err, energy);
+      if (energy > 0.0) worst[c] = std::max(worst[c], std::sqrt(err / energy));
+      else if (err > 0.0) worst[c] = std::numeric_limits<double>::infinity();
+    }
+  const double bound = options.errorBound;
+  size_t held = count - 1;
+  for (size_t c = 0; c < count; ++c)
+    if (choices[c] == brickRepr[b]) held = c;
+  size_t pick = count - 1;  // none within the bound: the stream's own
+  for (size_t c = 0; c < count; ++c)
+    // Cheaper than the brick's representation only with room to spare (0.8 of the bound).
+    if (worst[c] <= (c < held ? 0.8 * bound : bound)) {
+      pick = c;
+      break;
+    }
+  return choices[pick];
+}
+
 uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, const float* noise) {
   Impl& s = *impl_;
-  const Representation repr = s.layout.repr;
   const uint32_t bricks = brickCount(s.layout);
   s.changedThisFrame.clear();
   ++s.frame;
@@ -101,15 +153,20 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     s.base.resize(n);
     s.next.resize(n);
     s.nextActive.resize(n);
-    bool changed = false;
+    const Representation repr = s.choices.size() > 1 ? s.chooseRepresentation(b, probes, activeIn) : s.brickRepr[b];
+    const bool switched = repr != s.brickRepr[b];  // this version is a keyframe in `repr`
+    size_t choice = 0;
+    while (s.choices[choice] != repr) ++choice;
+    bool changed = switched;
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t p = s.table.probes[first + k];
       s.base[k] = s.symbols[p];
       const bool isActive = activeIn == nullptr || activeIn[p] != 0;
       s.nextActive[k] = isActive ? 1 : 0;
       if (isActive) {
-        const ProbeSymbols* previous = s.active[p] ? &s.symbols[p] : nullptr;
-        quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
+        const ProbeSymbols* previous = s.active[p] && !switched ? &s.symbols[p] : nullptr;
+        if (s.choices.size() > 1) s.next[k] = s.candidates[choice * n + k];
+        else quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
         // A change the input's own noise explains is not sent: keep what the decoder holds while
         // the would-be new version is within c·σ of it.
         const float sigma = noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f;
@@ -131,9 +188,14 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     }
     if (!changed) continue;
 
-    buildDeltaPayload(repr, n, s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
+    // A brick that changed representation starts again from a keyframe (no symbol differences across them).
+    if (switched) buildKeyframePayload(repr, n, s.nextActive.data(), s.next.data(), s.raw);
+    else buildDeltaPayload(repr, n, s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
     ++s.versions[b];
-    writeSection(b, s.versions[b], SectionKind::Delta, s.raw, s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);
+    writeSection(b, s.versions[b], switched ? SectionKind::Keyframe : SectionKind::Delta, repr, s.layout.repr, s.raw,
+                 s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);
+    s.brickRepr[b] = repr;
+    s.deltaIsKeyframe[b] = switched ? 1 : 0;
     s.keyframeValid[b] = 0;
     s.changedThisFrame.push_back(b);
 
@@ -178,6 +240,8 @@ float StreamEncoder::changeSince(uint32_t brick, uint32_t heldVersion) const {
 }
 
 std::span<const uint8_t> StreamEncoder::deltaSection(uint32_t brick) const { return impl_->deltas.at(brick); }
+bool StreamEncoder::deltaIsKeyframe(uint32_t brick) const { return impl_->deltaIsKeyframe.at(brick) != 0; }
+Representation StreamEncoder::brickRepresentation(uint32_t brick) const { return impl_->brickRepr.at(brick); }
 
 std::span<const uint8_t> StreamEncoder::keyframeSection(uint32_t brick) {
   Impl& s = *impl_;
@@ -191,9 +255,9 @@ std::span<const uint8_t> StreamEncoder::keyframeSection(uint32_t brick) {
       s.next[k] = s.symbols[p];
       s.nextActive[k] = s.active[p];
     }
-    buildKeyframePayload(s.layout.repr, n, s.nextActive.data(), s.next.data(), s.raw);
-    writeSection(brick, s.versions[brick], SectionKind::Keyframe, s.raw, s.options.zstdLevel, s.options.compress ? s.cctx : nullptr,
-                 s.keyframes[brick]);
+    buildKeyframePayload(s.brickRepr[brick], n, s.nextActive.data(), s.next.data(), s.raw);
+    writeSection(brick, s.versions[brick], SectionKind::Keyframe, s.brickRepr[brick], s.layout.repr, s.raw,
+                 s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.keyframes[brick]);
     s.keyframeValid[brick] = 1;
   }
   return s.keyframes[brick];

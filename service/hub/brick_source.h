@@ -35,7 +35,7 @@ class EncoderBricks : public BrickSource {
   uint32_t version(uint32_t brick) const override { return encoder_.brickVersion(brick); }
   float changeSince(uint32_t brick, uint32_t held) const override { return encoder_.changeSince(brick, held); }
   std::span<const uint8_t> sectionFor(uint32_t brick, uint32_t held, bool* delta = nullptr) override {
-    if (delta) *delta = held + 1 == encoder_.brickVersion(brick);
+    if (delta) *delta = held + 1 == encoder_.brickVersion(brick) && !encoder_.deltaIsKeyframe(brick);
     return encoder_.sectionFor(brick, held);
   }
   void copyVolume(const GridBounds& bounds, ProbeVolume& out) const override { encoder_.copyVolume(bounds, out); }
@@ -89,6 +89,7 @@ class BusBricks final : public BrickSource {
   struct Brick {
     uint32_t version = 0;
     std::vector<uint8_t> keyframe, delta;
+    bool deltaIsKeyframe = false;    // the version changed the brick's representation
     float change[kHistory] = {};     // change of version v at v % kHistory
     uint32_t knownSince = UINT32_MAX;  // the first version whose change is known here
   };

@@ -51,6 +51,9 @@ BusBricks::Accepted BusBricks::accept(const bus::Brick& b, std::string& why) {
   held.keyframe.assign(b.keyframe.begin(), b.keyframe.end());
   if (deltaOk) held.delta.assign(b.delta.begin(), b.delta.end());
   else held.delta.clear();
+  SectionInfo info;
+  held.deltaIsKeyframe = deltaOk && readSection(layout_, b.delta.data(), b.delta.size(), &info) == CodecStatus::Ok &&
+                         info.kind == SectionKind::Keyframe;
   held.change[b.version % kHistory] = b.change;
   return Accepted::Applied;
 }
@@ -67,7 +70,7 @@ float BusBricks::changeSince(uint32_t brick, uint32_t heldVersion) const {
 std::span<const uint8_t> BusBricks::sectionFor(uint32_t brick, uint32_t heldVersion, bool* delta) {
   const Brick& b = bricks_[brick];
   const bool useDelta = heldVersion + 1 == b.version && !b.delta.empty();
-  if (delta) *delta = useDelta;
+  if (delta) *delta = useDelta && !b.deltaIsKeyframe;
   if (heldVersion == b.version) return {};
   return useDelta ? std::span<const uint8_t>(b.delta) : std::span<const uint8_t>(b.keyframe);
 }

@@ -17,14 +17,18 @@
 //   header:  magic "PRBC" | u8 formatVersion (2; 1 is read) | u8 representation | u8 brickDim | u8 flags (0)
 //            | u16 nx, ny, nz | u16 reserved (0) | u32 frameSequence | u32 sectionCount
 //            | u32 sectionBytes | u32 CRC-32C of the preceding 28 bytes
-//   section: u32 brick | u32 version | u8 kind (1 keyframe, 2 delta) | u8 compression (0 raw,
+//   section: u32 brick | u32 version | u8 kind (bits 0-3: 1 keyframe, 2 delta; bits 4-7: the
+//            brick's representation when it is not the stream's, else 0) | u8 compression (0 raw,
 //            1 zstd) | u32 rawSize | u32 storedSize | u32 CRC-32C of the preceding 18 bytes and
 //            the data | data[storedSize]
 // A section is encoded once per brick version; frames for different subscribers reuse the same
 // section bytes and differ only in their header.
-// Format 2 differs from format 1 only in what zh3h symbols mean: the parity of each probe's L1
-// ratio symbols chooses hallucinated ZH3 or plain L1 (record.h). A format 1 frame still decodes,
-// every zh3h probe hallucinating as before; every other representation is byte-identical.
+// Format 2 differs from format 1 in what zh3h symbols mean: the parity of each probe's L1 ratio
+// symbols chooses hallucinated ZH3 or plain L1 (record.h); and a brick of a zh3 or l2 stream may be
+// sent in a cheaper representation (brickRepresentations, EncoderOptions::errorBound), said in its
+// sections' kind byte. A version in another representation than the brick's last is a keyframe
+// (a delta in another representation is refused). A format 1 frame still decodes, every zh3h probe
+// hallucinating as before; a stream without an error bound is otherwise byte-identical.
 #pragma once
 
 #include <cstddef>
@@ -81,7 +85,16 @@ struct EncoderOptions {
   // Compared against the decoder's reconstruction, never against the last input, so skipped
   // changes cannot add up past the threshold. 0 = off.
   float noiseScale = 0.0f;
+  // Per-brick representation: > 0 sends each brick in the cheapest of brickRepresentations(repr)
+  // whose worst active probe stays within this relative irradiance error of the input (exact over
+  // the sphere, RGB pooled: irradiance_error.h), the stream's own when none does; a brick moves to
+  // a cheaper one only when it keeps within 0.8 of the bound, so noise does not flip it. 0 = off.
+  float errorBound = 0.0f;
 };
+
+// The representations a brick of a stream of `repr` may be sent in, cheapest first: l1, zh3 for a
+// zh3 stream; l1, zh3, l2 for an l2 stream; `repr` alone for any other.
+std::vector<Representation> brickRepresentations(Representation repr);
 
 struct FrameHeader {
   uint8_t formatVersion = kFormatVersion;  // kOldestFormatVersion..kFormatVersion
@@ -142,8 +155,12 @@ class StreamEncoder {
   // brickChange() of the versions after `heldVersion` (remembered for the last 16 versions),
   // 1 when the holder has nothing or is further behind, 0 when current.
   float changeSince(uint32_t brick, uint32_t heldVersion) const;
-  // The section taking a holder of version-1 to the current version; empty at version 0.
+  // The section taking a holder of version-1 to the current version; empty at version 0. A keyframe
+  // when that version changed the brick's representation (deltaIsKeyframe).
   std::span<const uint8_t> deltaSection(uint32_t brick) const;
+  bool deltaIsKeyframe(uint32_t brick) const;
+  // The representation the brick's current version is in (the stream's without an error bound).
+  Representation brickRepresentation(uint32_t brick) const;
   // A keyframe section of the current version (encoded on first request, then cached).
   std::span<const uint8_t> keyframeSection(uint32_t brick);
   // What a holder of `heldVersion` needs: empty if current, the delta if one version behind,
