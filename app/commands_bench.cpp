@@ -53,6 +53,7 @@ void addBenchCodec(CLI::App* bench) {
   struct Options {
     std::string envmaps, probes, json, chart;
     std::vector<int> deadzones{0, 1, 2, 4, 8};
+    std::vector<float> errorBounds{0.02f, 0.05f, 0.1f};
     int frames = 60;
     int normals = 2048;
     int throughputProbes = 65536;
@@ -69,6 +70,10 @@ void addBenchCodec(CLI::App* bench) {
   codec->add_option("--deadzones", opt->deadzones, "dead-zones (quantisation steps) for the temporal part")
       ->delimiter(',')
       ->check(CLI::Range(0, 127));
+  codec->add_option("--error-bounds", opt->errorBounds,
+                    "per-brick representation bounds for the temporal part (an l2 stream at dead-zone 1 each)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0001f, 10.0f));
   codec->add_option("--frames", opt->frames, "frames of the moving-light sequence")->check(CLI::Range(2, 100000));
   codec->add_option("--normals", opt->normals, "directions for the brute-force irradiance")->check(CLI::Range(16, 1 << 20));
   codec->add_option("--throughput-probes", opt->throughputProbes, "probes encoded and decoded for the speed figures")
@@ -84,10 +89,12 @@ void addBenchCodec(CLI::App* bench) {
       std::string error;
       orThrow(readProbeFile(opt->probes, volume, error), error);
       options.volumeName = opt->probes;
+      options.volumeDims = {volume.grid.dims[0], volume.grid.dims[1], volume.grid.dims[2]};
       options.volumeProbes = std::move(volume.probes);
       options.volumeActive = std::move(volume.active);
     }
     options.deadzones = opt->deadzones;
+    options.errorBounds = opt->errorBounds;
     options.frames = opt->frames;
     options.normals = opt->normals;
     options.throughputProbes = opt->throughputProbes;

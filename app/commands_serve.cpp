@@ -25,7 +25,7 @@ struct ServeOptions {
   std::string probes, repr = "zh3";
   std::string publish, stream = "probes";
   int brick = 4, deadzone = 1;
-  float noiseScale = 0.0f;
+  float noiseScale = 0.0f, errorBound = 0.0f;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
 
@@ -56,6 +56,10 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     what = s.name;
   }
   hub.encoder.noiseScale = o.noiseScale;
+  hub.encoder.errorBound = o.errorBound;
+  if (o.errorBound > 0.0f && brickRepresentations(repr).size() < 2)
+    throw std::runtime_error(std::string("--error-bound chooses among cheaper representations per brick: --repr ") +
+                             representationName(repr) + " has none (use zh3 or l2)");
   if (!isValidLayout(hub.layout)) throw std::runtime_error("grid too large for the stream format");
   auto producer = std::make_unique<session::ProbeProducer>(hub);
   if (o.probes.empty()) {
@@ -86,6 +90,10 @@ void addServeCommand(CLI::App& app) {
                     "live: a probe is not re-sent while its change stays within this many standard errors of its "
                     "Monte Carlo noise (0 = off; bench adaptive measures 2)")
       ->check(CLI::Range(0.0f, 1000.0f));
+  serve->add_option("--error-bound", o->errorBound,
+                    "send each brick in the cheapest of l1, zh3, l2 (up to --repr) that keeps its probes within "
+                    "this relative irradiance error (0 = every brick as --repr)")
+      ->check(CLI::Range(0.0f, 10.0f));
   o->server.add(serve);
   CLI::Option* publish =
       serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");

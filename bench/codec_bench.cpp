@@ -216,6 +216,58 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
       volumeTable += fmt::format(" {} {:.2f}%", representationName(repr), 100 * rmse);
     }
     volumeTable += "\n";
+    // The whole volume as one keyframe of an l2 stream, each brick in the cheapest representation
+    // within each bound, against every brick as l1, zh3 and l2: bytes and worst probe.
+    StreamLayout layout;
+    for (int a = 0; a < 3; ++a) layout.grid[a] = static_cast<uint16_t>(opt.volumeDims[a]);
+    layout.brickDim = 4;
+    layout.repr = Representation::L2;
+    if (isValidLayout(layout) && probeCount(layout) == opt.volumeActive.size()) {
+      const auto keyframe = [&](Representation repr, float bound, nlohmann::json& row) {
+        layout.repr = repr;
+        EncoderOptions eo;
+        eo.errorBound = bound;
+        StreamEncoder encoder(layout, eo);
+        encoder.update(opt.volumeProbes.data(), opt.volumeActive.data());
+        std::vector<uint8_t> frame;
+        encoder.writeKeyframeFrame(frame);
+        double worst = 0, err = 0, energy = 0;
+        for (size_t p = 0; p < opt.volumeActive.size(); ++p) {
+          if (!opt.volumeActive[p]) continue;
+          double e = 0, n = 0;
+          irradianceErrorEnergy(encoder.reconstruction() + p * kProbeFloats, opt.volumeProbes.data() + p * kProbeFloats, e, n);
+          if (n > 0) worst = std::max(worst, std::sqrt(e / n));
+          err += e;
+          energy += n;
+        }
+        nlohmann::json bricks = nlohmann::json::object();
+        for (uint32_t b = 0; b < brickCount(layout); ++b) {
+          const std::string name = representationName(encoder.brickRepresentation(b));
+          bricks[name] = bricks.value(name, 0) + 1;
+        }
+        row = {{"representation", representationName(repr)},
+               {"error_bound", bound},
+               {"keyframe_bytes", frame.size()},
+               {"worst_probe_irradiance_rmse_rel", worst},
+               {"irradiance_rmse_rel", energy > 0 ? std::sqrt(err / energy) : 0.0},
+               {"bricks_by_representation", bricks}};
+        volumeTable += fmt::format("  {} stream{}: keyframe {} bytes, worst probe {:.2f}%, all {:.2f}%, bricks {}\n",
+                                   representationName(repr),
+                                   bound > 0 ? fmt::format(", error bound {:g}%", 100 * bound) : std::string(),
+                                   frame.size(), 100 * worst, 100 * row["irradiance_rmse_rel"].get<double>(),
+                                   bricks.dump());
+      };
+      for (Representation repr : {Representation::L1, Representation::Zh3, Representation::L2}) {
+        nlohmann::json row;
+        keyframe(repr, 0.0f, row);
+        vol["keyframes"].push_back(row);
+      }
+      for (float bound : opt.errorBounds) {
+        nlohmann::json row;
+        keyframe(Representation::L2, bound, row);
+        vol["keyframes"].push_back(row);
+      }
+    }
     json["probe_volume"] = vol;
   }
   json["timing"] = fmt::format("median of {} repeats, one thread", opt.repeats);
@@ -256,48 +308,65 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
         }
       }
     }
+    // One stream over the sequence: its bytes, its error against the clean input, drift.
+    const auto runStream = [&](Representation repr, int dz, float errorBound, imaging::ChartSeries& series) {
+      layout.repr = repr;
+      EncoderOptions eo;
+      eo.deadzone = dz;
+      eo.errorBound = errorBound;
+      StreamEncoder encoder(layout, eo);
+      StreamDecoder decoder(layout);
+      std::vector<uint8_t> frame;
+      size_t deltaBytes = 0, keyBytes = 0;
+      double err = 0, energy = 0;
+      bool driftFree = true;
+      for (int f = 0; f < opt.frames; ++f) {
+        const size_t at = static_cast<size_t>(f) * count * kProbeFloats;
+        encoder.update(noisy.data() + at, nullptr);
+        encoder.writeChangedFrame(frame);
+        driftFree = driftFree && decoder.apply(frame.data(), frame.size()) == CodecStatus::Ok;
+        if (f == 0) {
+          keyBytes = frame.size();
+          continue;
+        }
+        deltaBytes += frame.size();
+        for (uint32_t p = 0; p < count; ++p)
+          irradianceEnergy(decoder.probes() + static_cast<size_t>(p) * kProbeFloats,
+                           clean.data() + at + static_cast<size_t>(p) * kProbeFloats, err, energy);
+      }
+      driftFree = driftFree && std::memcmp(decoder.probes(), encoder.reconstruction(),
+                                           static_cast<size_t>(count) * kProbeFloats * sizeof(float)) == 0;
+      const double perProbeFrame = static_cast<double>(deltaBytes) / (static_cast<double>(opt.frames - 1) * count);
+      const double rmse = std::sqrt(err / energy);
+      nlohmann::json t = {{"representation", representationName(repr)},
+                          {"deadzone", dz},
+                          {"bytes_per_probe_per_frame", perProbeFrame},
+                          {"first_frame_bytes_per_probe", static_cast<double>(keyBytes) / count},
+                          {"irradiance_rmse_rel_vs_clean", rmse},
+                          {"drift_free", driftFree}};
+      if (errorBound > 0.0f) {
+        t["error_bound"] = errorBound;
+        nlohmann::json bricks = nlohmann::json::object();  // bricks per representation after the last frame
+        for (uint32_t b = 0; b < brickCount(layout); ++b)
+          bricks[representationName(encoder.brickRepresentation(b))] =
+              bricks.value(representationName(encoder.brickRepresentation(b)), 0) + 1;
+        t["bricks_by_representation"] = bricks;
+      }
+      temporal.push_back(t);
+      series.points.push_back(
+          {perProbeFrame, rmse, errorBound > 0.0f ? fmt::format("{:g}%", 100 * errorBound) : fmt::format("dz{}", dz)});
+    };
     for (Representation repr : kAllRepresentations) {
-      const std::string name = representationName(repr);
-      imaging::ChartSeries series{name + " stream", {}, true};
+      imaging::ChartSeries series{std::string(representationName(repr)) + " stream", {}, true};
       for (int dz : opt.deadzones) {
         if (repr == Representation::Fp16 && dz > 0) continue;  // fp16 steps are not ratio steps
-        layout.repr = repr;
-        EncoderOptions eo;
-        eo.deadzone = dz;
-        StreamEncoder encoder(layout, eo);
-        StreamDecoder decoder(layout);
-        std::vector<uint8_t> frame;
-        size_t deltaBytes = 0, keyBytes = 0;
-        double err = 0, energy = 0;
-        bool driftFree = true;
-        for (int f = 0; f < opt.frames; ++f) {
-          const size_t at = static_cast<size_t>(f) * count * kProbeFloats;
-          encoder.update(noisy.data() + at, nullptr);
-          encoder.writeChangedFrame(frame);
-          driftFree = driftFree && decoder.apply(frame.data(), frame.size()) == CodecStatus::Ok;
-          if (f == 0) {
-            keyBytes = frame.size();
-            continue;
-          }
-          deltaBytes += frame.size();
-          for (uint32_t p = 0; p < count; ++p)
-            irradianceEnergy(decoder.probes() + static_cast<size_t>(p) * kProbeFloats,
-                             clean.data() + at + static_cast<size_t>(p) * kProbeFloats, err, energy);
-        }
-        driftFree = driftFree && std::memcmp(decoder.probes(), encoder.reconstruction(),
-                                             static_cast<size_t>(count) * kProbeFloats * sizeof(float)) == 0;
-        const double perProbeFrame = static_cast<double>(deltaBytes) / (static_cast<double>(opt.frames - 1) * count);
-        const double rmse = std::sqrt(err / energy);
-        temporal.push_back({{"representation", name},
-                            {"deadzone", dz},
-                            {"bytes_per_probe_per_frame", perProbeFrame},
-                            {"first_frame_bytes_per_probe", static_cast<double>(keyBytes) / count},
-                            {"irradiance_rmse_rel_vs_clean", rmse},
-                            {"drift_free", driftFree}});
-        series.points.push_back({perProbeFrame, rmse, fmt::format("dz{}", dz)});
+        runStream(repr, dz, 0.0f, series);
       }
       temporalSeries.push_back(std::move(series));
     }
+    imaging::ChartSeries bounded{"l2 stream, per-brick representation (dz1)", {}, true};
+    for (float bound : opt.errorBounds) runStream(Representation::L2, 1, bound, bounded);
+    if (!bounded.points.empty()) temporalSeries.push_back(std::move(bounded));
     json["temporal"] = {{"grid", {16, 4, 16}},
                         {"brick", 4},
                         {"frames", opt.frames},
@@ -330,9 +399,15 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
     table += fmt::format("\ntemporal ({} frames, 1024 probes, 1% noise): {:<6} {:>4} {:>14} {:>14}\n", opt.frames,
                          "repr", "dz", "B/probe/frame", "E rmse (clean)");
     for (const auto& t : temporal)
-      table += fmt::format("{:>44} {:<6} {:>4} {:>14.3f} {:>13.2f}%{}\n", "", t["representation"].get<std::string>(),
+      table += fmt::format("{:>44} {:<6} {:>4} {:>14.3f} {:>13.2f}%{}{}\n", "", t["representation"].get<std::string>(),
                            t["deadzone"].get<int>(), t["bytes_per_probe_per_frame"].get<double>(),
                            100 * t["irradiance_rmse_rel_vs_clean"].get<double>(),
+                           t.contains("error_bound")
+                               ? fmt::format("  error bound {:g}%, first frame {:.2f} B/probe, bricks {}",
+                                             100 * t["error_bound"].get<double>(),
+                                             t["first_frame_bytes_per_probe"].get<double>(),
+                                             t["bricks_by_representation"].dump())
+                               : std::string(),
                            t["drift_free"].get<bool>() ? "" : "  DRIFT");
   }
 

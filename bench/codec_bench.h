@@ -2,6 +2,7 @@
 // and the temporal coder on a moving-light sequence for several dead-zones.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -18,7 +19,11 @@ struct CodecBenchOptions {
   std::string volumeName;
   std::vector<float> volumeProbes;   // 27 floats per probe
   std::vector<uint8_t> volumeActive;
+  std::array<uint32_t, 3> volumeDims{0, 0, 0};  // its grid (for the per-brick representation keyframes)
   std::vector<int> deadzones = {0, 1, 2, 4, 8};
+  // Per-brick representation (EncoderOptions::errorBound) on the temporal sequence: an l2 stream at
+  // dead-zone 1 with each bound.
+  std::vector<float> errorBounds = {0.02f, 0.05f, 0.1f};
   int frames = 60;         // temporal sequence length
   int normals = 2048;      // equal-area directions for the brute-force irradiance
   int throughputProbes = 65536;

@@ -47,7 +47,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     StreamDecoder dec(layout);
     if (mode == fuzz::kFrameOnBase) {
       std::vector<uint8_t> key, delta;
-      fuzz::baseFrames(repr, key, delta);
+      fuzz::baseFrames(repr, key, delta, (control & fuzz::kPerBrickFlag) != 0);
       require(dec.apply(key.data(), key.size()) == CodecStatus::Ok);
     }
     if (control & fuzz::kRepairFlag) fuzz::repairChecksums(body);
@@ -69,7 +69,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::memcpy(probes.data(), body.data(), floats * sizeof(float));
     std::vector<uint8_t> active(probeCount(layout));
     for (size_t i = 0; i < active.size(); ++i) active[i] = body.size() > floats * 4 + i ? body[floats * 4 + i] & 1 : 1;
-    StreamEncoder enc(layout);
+    EncoderOptions options;
+    options.errorBound = (control & fuzz::kPerBrickFlag) ? fuzz::kErrorBound : 0.0f;
+    StreamEncoder enc(layout, options);
     StreamDecoder dec(layout);
     std::vector<uint8_t> frame;
     for (int f = 0; f < 2; ++f) {

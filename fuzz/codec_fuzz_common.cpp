@@ -17,14 +17,16 @@ StreamLayout fuzzLayout(Representation repr) {
   return l;
 }
 
-void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector<uint8_t>& delta) {
+void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector<uint8_t>& delta, bool perBrick) {
   const StreamLayout layout = fuzzLayout(repr);
   const uint32_t n = probeCount(layout);
   std::vector<float> probes(n * kProbeFloats);
   std::vector<uint8_t> active(n, 1);
   active[3] = 0;
   for (uint32_t i = 0; i < probes.size(); ++i) probes[i] = 0.5f + 0.25f * std::sin(static_cast<float>(i));
-  StreamEncoder enc(layout);
+  EncoderOptions options;
+  options.errorBound = perBrick ? kErrorBound : 0.0f;
+  StreamEncoder enc(layout, options);
   enc.update(probes.data(), active.data());
   enc.writeKeyframeFrame(keyframe);
   for (uint32_t i = 0; i < probes.size(); i += 7) probes[i] *= 1.3f;

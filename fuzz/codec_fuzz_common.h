@@ -14,12 +14,16 @@ namespace probecast::fuzz {
 //   (checksums repaired first when bit 5 is set, so the payload parsers see the bytes);
 //   mode 2: record bytes; mode 3: floats for the encoder (round trip must be bit-exact).
 //   bit 6 set: the rest is a probe volume file (probe_file.h) instead.
+//   bit 7 set: frames and encoders use a per-brick representation (kErrorBound; a zh3 or l2
+//   stream then mixes l1, zh3 and l2 bricks).
 enum Mode : uint8_t { kFrameFresh = 0, kFrameOnBase = 1, kRecord = 2, kEncodeFloats = 3 };
 constexpr uint8_t kRepairFlag = 1u << 5;
+constexpr uint8_t kPerBrickFlag = 1u << 7;
+constexpr float kErrorBound = 0.05f;
 
 StreamLayout fuzzLayout(Representation repr);
-// The base keyframe (mode 1) and a delta that applies to it.
-void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector<uint8_t>& delta);
+// The base keyframe (mode 1) and a delta that applies to it; `perBrick`: with kErrorBound.
+void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector<uint8_t>& delta, bool perBrick = false);
 void repairChecksums(std::vector<uint8_t>& frame);
 
 }  // namespace probecast::fuzz

@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
       std::memcpy(raw.data() + i * sizeof(float), &v, sizeof v);
     }
     write(dir, name + "-floats", control(fuzz::kEncodeFloats, false), raw);
+    // The same with a per-brick representation (a zh3 or l2 stream mixes cheaper bricks in).
+    std::vector<uint8_t> mixedKey, mixedDelta;
+    fuzz::baseFrames(repr, mixedKey, mixedDelta, true);
+    write(dir, name + "-perbrick-keyframe", static_cast<uint8_t>(control(fuzz::kFrameFresh, false) | fuzz::kPerBrickFlag), mixedKey);
+    write(dir, name + "-perbrick-delta-repair", static_cast<uint8_t>(control(fuzz::kFrameOnBase, true) | fuzz::kPerBrickFlag), mixedDelta);
+    write(dir, name + "-perbrick-floats", static_cast<uint8_t>(control(fuzz::kEncodeFloats, false) | fuzz::kPerBrickFlag), raw);
   }
   ProbeVolume volume;
   volume.grid.dims[0] = 2;

@@ -55,6 +55,36 @@ dc = max(abs(a - b) for p in range(len(l1) // 27) for a, b in zip(l1[p * 27: p *
 assert dc < 1e-3 * max(served), dc
 print("transcoded l1: no L2 band, DC as the l2 stream's")
 PY
+# A per-brick representation: the same file served with an error bound; what the subscriber holds
+# is within the bound of what was served (relative irradiance error, exact over the sphere: every
+# brick is, so the whole volume is).
+port2=$((port + 1))
+"$probecast" serve --probes "$work/served.pcpv" --repr l2 --deadzone 0 --error-bound 0.1 --listen "127.0.0.1:$port2" \
+  --plaintext --no-auth --seconds 20 >"$work/serve2.log" 2>&1 &
+server2=$!
+trap 'kill $server $server2 2>/dev/null || true' EXIT
+for _ in $(seq 50); do grep -q "on port" "$work/serve2.log" && break; sleep 0.1; done
+"$probecast" subscribe --connect "127.0.0.1:$port2" --seconds 1 --out "$work/received-bound.pcpv"
+python3 - "$work/served.pcpv" "$work/received-bound.pcpv" <<'PY'
+import struct, sys, math
+def load(p):
+    b = open(p, 'rb').read()
+    n = struct.unpack_from('<3I', b, 8)
+    count = n[0] * n[1] * n[2]
+    return count, struct.unpack_from('<%df' % (count * 27), b, 52), b[52 + count * 108: 52 + count * 109]
+count, served, active = load(sys.argv[1])
+_, got, _ = load(sys.argv[2])
+band = [math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5
+err = energy = 0.0
+for p in range(count):
+    if not active[p]:
+        continue
+    err += sum(band[i] ** 2 * (got[p * 27 + i * 3 + c] - served[p * 27 + i * 3 + c]) ** 2 for i in range(9) for c in range(3))
+    energy += sum(band[i] ** 2 * served[p * 27 + i * 3 + c] ** 2 for i in range(9) for c in range(3))
+rel = (err / energy) ** 0.5
+print("error bound 0.1: volume error %.4f" % rel)
+assert rel <= 0.1 + 1e-4, rel
+PY
 # The raster client fed by the stream.
 "$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views stereo --size 24x16 --out "$work/view" \
   | grep -q "2 views"

@@ -3,7 +3,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
-#include <limits>
 
 #include <zstd.h>
 
@@ -106,7 +105,7 @@ Representation StreamEncoder::Impl::chooseRepresentation(uint32_t b, const float
   const uint32_t first = table.first[b], n = table.first[b + 1] - first;
   const size_t count = choices.size();
   candidates.resize(count * n);
-  std::vector<double> worst(count, 0.0);
+  std::vector<double> err(count, 0.0), energy(count, 0.0);
   for (size_t c = 0; c < count; ++c)
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t p = table.probes[first + k];
@@ -123,22 +122,22 @@ Representation StreamEncoder::Impl::chooseRepresentation(uint32_t b, const float
       quantizeProbe(choices[c], input, previous, options.deadzone, &out);
       float decoded[kProbeFloats];
       dequantizeProbe(choices[c], out, decoded, /*zh3PerPixel=*/false);
-      double err = 0.0, energy = 0.0;
-      irradianceErrorEnergy(decoded, input, err, energy);
-      if (energy > 0.0) worst[c] = std::max(worst[c], std::sqrt(err / energy));
-      else if (err > 0.0) worst[c] = std::numeric_limits<double>::infinity();
+      irradianceErrorEnergy(decoded, input, err[c], energy[c]);
     }
   const double bound = options.errorBound;
-  size_t held = count - 1;
-  for (size_t c = 0; c < count; ++c)
+  size_t held = 0;  // a brick with nothing sent yet takes the cheapest within the bound outright
+  for (size_t c = 0; c < count && versions[b] > 0; ++c)
     if (choices[c] == brickRepr[b]) held = c;
   size_t pick = count - 1;  // none within the bound: the stream's own
-  for (size_t c = 0; c < count; ++c)
-    // Cheaper than the brick's representation only with room to spare (0.8 of the bound).
-    if (worst[c] <= (c < held ? 0.8 * bound : bound)) {
+  for (size_t c = 0; c < count; ++c) {
+    // The brick's relative irradiance error; cheaper than its representation only with room to
+    // spare (0.8 of the bound). A brick of black or inactive probes takes the cheapest.
+    const double e = energy[c] > 0.0 ? std::sqrt(err[c] / energy[c]) : (err[c] > 0.0 ? 1e300 : 0.0);
+    if (e <= (c < held ? 0.8 * bound : bound)) {
       pick = c;
       break;
     }
+  }
   return choices[pick];
 }
 

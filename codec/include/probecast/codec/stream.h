@@ -86,9 +86,10 @@ struct EncoderOptions {
   // changes cannot add up past the threshold. 0 = off.
   float noiseScale = 0.0f;
   // Per-brick representation: > 0 sends each brick in the cheapest of brickRepresentations(repr)
-  // whose worst active probe stays within this relative irradiance error of the input (exact over
-  // the sphere, RGB pooled: irradiance_error.h), the stream's own when none does; a brick moves to
-  // a cheaper one only when it keeps within 0.8 of the bound, so noise does not flip it. 0 = off.
+  // whose relative irradiance error against the input, over the brick's active probes, stays within
+  // this bound (exact over the sphere, RGB pooled: irradiance_error.h), the stream's own when none
+  // does; a brick moves to a cheaper one only when it keeps within 0.8 of the bound, so noise does
+  // not flip it. 0 = off.
   float errorBound = 0.0f;
 };
 
