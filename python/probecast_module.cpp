@@ -119,8 +119,16 @@ struct PyStreamEncoder {
   StreamEncoder encoder;
   std::vector<uint8_t> frame;
   PyStreamEncoder(const std::array<int, 3>& grid, const std::string& repr, int brick, int deadzone, int zstdLevel,
-                  bool compress)
-      : encoder(layoutOf(grid, repr, brick), EncoderOptions{deadzone, zstdLevel, compress}) {}
+                  bool compress, float errorBound)
+      : encoder(layoutOf(grid, repr, brick), optionsFor(repr, deadzone, zstdLevel, compress, errorBound)) {}
+  static EncoderOptions optionsFor(const std::string& repr, int deadzone, int zstdLevel, bool compress, float errorBound) {
+    if (!(errorBound >= 0.0f && errorBound <= 10.0f)) throw py::value_error("error_bound: 0 (off) to 10");
+    if (errorBound > 0.0f && brickRepresentations(reprOf(repr)).size() < 2)
+      throw py::value_error("error_bound chooses among cheaper representations per brick: " + repr + " has none");
+    EncoderOptions o{deadzone, zstdLevel, compress};
+    o.errorBound = errorBound;
+    return o;
+  }
   uint32_t count() const { return probeCount(encoder.layout()); }
 };
 
@@ -374,11 +382,13 @@ PYBIND11_MODULE(probecast, m) {
   py::class_<PyStreamEncoder>(m, "StreamEncoder",
                               "Brick-based temporal encoder of a probe grid (probe (x, y, z) at index x + nx (y + ny z)). "
                               "Its reconstruction is bit-identical to what a StreamDecoder holds after the same frames.")
-      .def(py::init<const std::array<int, 3>&, const std::string&, int, int, int, bool>(), py::arg("grid"),
+      .def(py::init<const std::array<int, 3>&, const std::string&, int, int, int, bool, float>(), py::arg("grid"),
            py::arg("repr"), py::arg("brick") = 4, py::arg("deadzone") = 0, py::arg("zstd_level") = 3,
-           py::arg("compress") = true,
+           py::arg("compress") = true, py::arg("error_bound") = 0.0f,
            "grid = (nx, ny, nz) probes; repr l1/zh3h/zh3/l2/fp16; brick = probes per brick edge (1..8); deadzone = "
-           "changes of at most this many quantisation steps are not sent; compress=False stores sections raw.")
+           "changes of at most this many quantisation steps are not sent; compress=False stores sections raw; "
+           "error_bound > 0 (zh3 and l2 only) sends each brick in the cheapest of l1, zh3, l2 within that relative "
+           "irradiance error.")
       .def_property_readonly("count", &PyStreamEncoder::count, "Probes in the grid.")
       .def(
           "update",

@@ -109,3 +109,30 @@ def test_every_truncation_and_byte_flip_is_an_error_not_a_crash(rng):
             dec.apply(bytes(data))
     assert "Truncated" in statuses
     assert np.all(dec.probes() == 0)
+
+
+def test_error_bound_mixes_brick_representations_in_one_stream(rng):
+    # Two bricks along x: a uniform sky over one (L1 is exact there), three lights per probe over
+    # the other. With a bound the sky's brick goes as l1 in the l2 stream: a smaller keyframe,
+    # decoded bit for bit as the encoder reconstructs it.
+    grid = (8, 4, 4)
+    n = 128
+    probes = random_probes(rng, n)
+    sky = np.zeros(27, np.float32)
+    sky[:3] = 3.5449077 * np.array([0.5, 0.6, 0.7], np.float32)
+    x = np.arange(n) % 8
+    probes[x < 4] = sky
+    plain = probecast.StreamEncoder(grid, "l2", compress=False)
+    bounded = probecast.StreamEncoder(grid, "l2", compress=False, error_bound=0.05)
+    plain.update(probes)
+    bounded.update(probes)
+    key = bounded.keyframe_frame()
+    assert len(key) < len(plain.keyframe_frame()) - 64 * (28 - 13) + 64
+    dec = probecast.StreamDecoder(grid, "l2")
+    dec.apply(key)
+    assert dec.probes().tobytes() == bounded.reconstruction().tobytes()
+    np.testing.assert_array_equal(dec.probes()[x < 4, 12:], 0)  # the sky's brick holds no L2 band
+    with pytest.raises(ValueError, match="has none"):
+        probecast.StreamEncoder(grid, "l1", error_bound=0.05)
+    with pytest.raises(ValueError, match="error_bound"):
+        probecast.StreamEncoder(grid, "l2", error_bound=-1.0)
