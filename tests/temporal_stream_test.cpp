@@ -320,14 +320,19 @@ std::vector<float> twoKindsOfLight(std::mt19937& rng, bool litBrick0, float sky 
   return p;
 }
 
+// Sections stored raw (readable in a test), per-brick representation within `bound` (0: off).
+EncoderOptions rawSections(float bound) {
+  EncoderOptions options;
+  options.errorBound = bound;
+  options.compress = false;
+  return options;
+}
+
 TEST(Stream, PerBrickRepresentationMeetsTheBoundInTheCheapestOne) {
   const StreamLayout layout = makeLayout(8, 4, 4, Representation::L2);
   std::mt19937 rng(31);
   const std::vector<float> frame0 = twoKindsOfLight(rng, false);
-  EncoderOptions options;
-  options.errorBound = 0.05f;
-  options.compress = false;
-  StreamEncoder bounded(layout, options), full(layout, EncoderOptions{0, 3, false});
+  StreamEncoder bounded(layout, rawSections(0.05f)), full(layout, rawSections(0.0f));
   bounded.update(frame0.data(), nullptr);
   full.update(frame0.data(), nullptr);
   EXPECT_EQ(bounded.brickRepresentation(0), Representation::L1);
@@ -366,10 +371,7 @@ TEST(Stream, SectionRepresentationsOutsideTheStreamsAreRefused) {
   const StreamLayout layout = makeLayout(8, 4, 4, Representation::L2);
   std::mt19937 rng(32);
   const std::vector<float> frame0 = twoKindsOfLight(rng, false);
-  EncoderOptions options;
-  options.errorBound = 0.05f;
-  options.compress = false;
-  StreamEncoder enc(layout, options);
+  StreamEncoder enc(layout, rawSections(0.05f));
   enc.update(frame0.data(), nullptr);
   std::vector<uint8_t> key;
   enc.writeKeyframeFrame(key);
@@ -388,7 +390,7 @@ TEST(Stream, SectionRepresentationsOutsideTheStreamsAreRefused) {
   EXPECT_EQ(refused(0x21), CodecStatus::BadSectionKind);  // zh3h: not a brick representation
   EXPECT_EQ(refused(0xf1), CodecStatus::BadSectionKind);
   // A delta in l1 for a brick the decoder holds in l2 (as a format 1 stream or no bound would).
-  StreamEncoder plain(layout, EncoderOptions{0, 3, false});
+  StreamEncoder plain(layout, rawSections(0.0f));
   plain.update(frame0.data(), nullptr);
   std::vector<uint8_t> plainKey;
   plain.writeKeyframeFrame(plainKey);
