@@ -147,7 +147,8 @@ class ProbeHub {
   // `held` is honoured when `epoch` equals the epoch of the stream it subscribes to (resume),
   // ignored otherwise. `repr`: the representation it wants (none: the stream's); another one
   // (canTranscode, std::invalid_argument otherwise) is encoded by this hub from the volume it holds,
-  // once for every subscriber that wants it, as a stream of its own epoch (volumeFor).
+  // once for every subscriber that wants it, as a stream of its own epoch (volumeFor). It stays
+  // for the epoch (at most one per representation), so a subscriber that reconnects resumes.
   uint64_t addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
                          std::function<void()> wake, std::optional<Representation> repr = std::nullopt);
   // What a subscriber is told: volume(), with the representation and epoch of its stream.
