@@ -1,6 +1,8 @@
 #include "adaptive_bench.h"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -34,10 +36,11 @@ double mean(const std::vector<double>& v, size_t from, size_t to) {
          static_cast<double>(to - from);
 }
 
+// A phase's scored updates: its last ones, each image against a converged volume at that update's t.
 struct Moment {
   const char* name;
-  uint32_t frame;  // the update after which it is measured
-  float t;
+  uint32_t frame;  // the phase's last update
+  uint32_t first;  // its first scored update
 };
 
 }  // namespace
@@ -88,7 +91,6 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   const ProbeGrid grid = renderer::sceneGrid(first, o.dims);
   const uint32_t count = grid.count();
   const uint32_t frames = 2 * o.stillUpdates + o.movingUpdates;
-  const float movedT = o.lightStep * static_cast<float>(o.movingUpdates);
   const auto tAt = [&](uint32_t frame) {  // the light's t during update `frame` (0-based)
     if (frame < o.stillUpdates) return 0.0f;
     return o.lightStep * static_cast<float>(std::min(frame - o.stillUpdates + 1, o.movingUpdates));
@@ -96,28 +98,36 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   const StreamLayout layout = streamLayoutFor(grid, o.repr, 4);
 
   // Converged float volumes where images are scored: end of each phase.
-  const std::vector<Moment> moments = {{"still", o.stillUpdates - 1, 0.0f},
-                                       {"moving", o.stillUpdates + o.movingUpdates - 1, movedT},
-                                       {"still_again", frames - 1, movedT}};
+  const auto phaseEnd = [&](uint32_t last, uint32_t length) {
+    return Moment{nullptr, last, last + 1 - std::min(o.scoredUpdates, length)};
+  };
+  std::vector<Moment> moments = {phaseEnd(o.stillUpdates - 1, o.stillUpdates),
+                                 phaseEnd(o.stillUpdates + o.movingUpdates - 1, o.movingUpdates),
+                                 phaseEnd(frames - 1, o.stillUpdates)};
+  moments[0].name = "still";
+  moments[1].name = "moving";
+  moments[2].name = "still_again";
   const renderer::CameraView camera = renderer::CameraView::fromScene(first);
-  std::vector<ProbeVolume> converged;
-  for (const Moment& m : moments) {
-    say(fmt::format("adaptive bench: converged volume at t = {:g}", m.t));
-    renderer::UpdaterOptions ro;
-    ro.samplesPerProbe = 512;
-    ro.rejectSigmas = 0.0f;
-    ro.seed = 4242;
-    renderer::ProbeUpdater u(context, sceneAt(m.t), grid, ro);
-    for (int k = 0; k < 16; ++k) u.update();
-    converged.push_back(u.volume());
-  }
   const auto render = [&](const ProbeVolume& v, float t) {
     renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
     raster.setProbes(v);
     return raster.render(raster.viewProjection(camera), camera.position);
   };
-  std::vector<renderer::Image> truthImages;
-  for (size_t i = 0; i < moments.size(); ++i) truthImages.push_back(render(converged[i], moments[i].t));
+  // The truth at every t a scored update has: the view of a converged float volume.
+  std::map<float, renderer::Image> truthImages;
+  for (const Moment& m : moments)
+    for (uint32_t f = m.first; f <= m.frame; ++f) {
+      const float t = tAt(f);
+      if (truthImages.count(t)) continue;
+      say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
+      renderer::UpdaterOptions ro;
+      ro.samplesPerProbe = 512;
+      ro.rejectSigmas = 0.0f;
+      ro.seed = 4242;
+      renderer::ProbeUpdater u(context, sceneAt(t), grid, ro);
+      for (int k = 0; k < 16; ++k) u.update();
+      truthImages.emplace(t, render(u.volume(), t));
+    }
 
   AdaptiveBenchResult r;
   nlohmann::json& j = r.json;
@@ -167,7 +177,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     std::vector<uint32_t> restarts;
     std::vector<float> previous;
     nlohmann::json ruleJson = {{"rule", ruleName(rule)}, {"w_min", rule.wMin}, {"reject_sigmas", rule.rejectSigmas}};
-    std::vector<std::vector<double>> psnr(streams.size());
+    // psnr[stream][moment]: one value per scored update.
+    std::vector<std::vector<std::vector<double>>> psnr(streams.size(), std::vector<std::vector<double>>(moments.size()));
     std::vector<uint8_t> frame;
     for (uint32_t f = 0; f < frames; ++f) {
       if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) u.setScene(sceneAt(tAt(f)));
@@ -182,14 +193,14 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         s.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / count);
       }
       for (size_t m = 0; m < moments.size(); ++m) {
-        if (moments[m].frame != f) continue;
+        if (f < moments[m].first || f > moments[m].frame) continue;
         for (size_t k = 0; k < streams.size(); ++k) {
           ProbeVolume held;
           streams[k].encoder->copyVolume(grid.bounds, held);
-          const renderer::Image img = render(held, moments[m].t);
-          psnr[k].push_back(imaging::compareImages(img.rgb, truthImages[m].rgb, static_cast<int>(o.width),
-                                                   static_cast<int>(o.height))
-                                .psnrDb);
+          const renderer::Image img = render(held, tAt(f));
+          psnr[k][m].push_back(imaging::compareImages(img.rgb, truthImages.at(tAt(f)).rgb,
+                                                      static_cast<int>(o.width), static_cast<int>(o.height))
+                                   .psnrDb);
         }
       }
     }
@@ -208,12 +219,22 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                            {"first_still_bytes_per_probe_frame", mean(s.bytesPerProbe, a / 2, a)},
                            {"moving_bytes_per_probe_frame", mean(s.bytesPerProbe, a, b)},
                            {"bytes_per_probe_frame", s.bytesPerProbe}};
-      for (size_t m = 0; m < moments.size(); ++m) {
-        sj["psnr_db"][moments[m].name] = psnr[k][m];
-        sj["psnr_loss_db"][moments[m].name] = psnr[0][m] - psnr[k][m];
-      }
       double worstLoss = 0;
-      for (size_t m = 0; m < moments.size(); ++m) worstLoss = std::max(worstLoss, psnr[0][m] - psnr[k][m]);
+      for (size_t m = 0; m < moments.size(); ++m) {
+        // The loss is paired update by update against the stream that sends every change (same
+        // noise in the volume, same truth), then averaged; its standard error says what it resolves.
+        const std::vector<double>& mine = psnr[k][m];
+        std::vector<double> loss(mine.size());
+        for (size_t i = 0; i < mine.size(); ++i) loss[i] = psnr[0][m][i] - mine[i];
+        const double meanLoss = mean(loss, 0, loss.size());
+        double var = 0;
+        for (double x : loss) var += (x - meanLoss) * (x - meanLoss);
+        const double se = loss.size() > 1 ? std::sqrt(var / static_cast<double>(loss.size() - 1) / static_cast<double>(loss.size())) : 0.0;
+        sj["psnr_db"][moments[m].name] = mean(mine, 0, mine.size());
+        sj["psnr_loss_db"][moments[m].name] = meanLoss;
+        sj["psnr_loss_standard_error_db"][moments[m].name] = se;
+        worstLoss = std::max(worstLoss, meanLoss);
+      }
       sj["worst_psnr_loss_db"] = worstLoss;
       table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>8.3f} dB\n", ruleName(rule), s.name,
                            mean(s.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),

@@ -30,6 +30,10 @@ struct AdaptiveBenchOptions {
   Representation repr = Representation::Zh3;
   uint32_t jumpUpdates = 48;         // updates charted after the light jump
   uint32_t width = 160, height = 100;
+  // Images are scored at the last this many updates of each phase (each against a converged volume
+  // at that update's light), the loss paired update by update and averaged: one image alone varies
+  // by more than the 0.1 dB a noise-aware stream may lose.
+  uint32_t scoredUpdates = 8;
   // Re-convergence after a light jump, ray budget against brute force (reconvergence.h).
   uint64_t raysPerUpdate = 0;        // 0 = active probes × samplesPerProbe
   float viewYfov = 0.03f;            // the viewer whose probes are scored (builtin:cornell 4³: 16 of 64 probes)
