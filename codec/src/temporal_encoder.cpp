@@ -103,9 +103,9 @@ bool withinNoise(const float candidate[kProbeFloats], const float held[kProbeFlo
 
 Representation StreamEncoder::Impl::chooseRepresentation(uint32_t b, const float* probes, const uint8_t* activeIn) {
   const uint32_t first = table.first[b], n = table.first[b + 1] - first;
-  const size_t count = choices.size();
+  const size_t count = choices.size();  // at most 3 (brickRepresentations)
   candidates.resize(count * n);
-  std::vector<double> err(count, 0.0), energy(count, 0.0);
+  double err[3] = {}, energy[3] = {};
   for (size_t c = 0; c < count; ++c)
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t p = table.probes[first + k];
