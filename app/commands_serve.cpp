@@ -26,6 +26,7 @@ struct ServeOptions {
   std::string publish, stream = "probes";
   int brick = 4, deadzone = 1;
   float noiseScale = 0.0f, errorBound = 0.0f;
+  uint32_t refinementInterval = 0;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
 
@@ -56,6 +57,9 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     what = s.name;
   }
   hub.encoder.noiseScale = o.noiseScale;
+  hub.encoder.refinementInterval = o.refinementInterval;
+  if (o.refinementInterval > 0 && o.noiseScale <= 0.0f)
+    throw std::runtime_error("--refinement-interval holds back what --noise-scale calls refinements: give both");
   hub.encoder.errorBound = o.errorBound;
   if (o.errorBound > 0.0f && brickRepresentations(repr).size() < 2)
     throw std::runtime_error(std::string("--error-bound chooses among cheaper representations per brick: --repr ") +
@@ -90,6 +94,10 @@ void addServeCommand(CLI::App& app) {
                     "live: a probe is not re-sent while its change stays within this many standard errors of its "
                     "Monte Carlo noise (0 = off; bench adaptive measures 2)")
       ->check(CLI::Range(0.0f, 1000.0f));
+  serve->add_option("--refinement-interval", o->refinementInterval,
+                    "with --noise-scale: a brick's refinements (changes within twice the noise threshold) wait until "
+                    "its last version is this many updates old (0 = at once)")
+      ->check(CLI::Range(0u, 100000u));
   serve->add_option("--error-bound", o->errorBound,
                     "send each brick in the cheapest of l1, zh3, l2 (up to --repr) that keeps its probes within "
                     "this relative irradiance error (0 = every brick as --repr)")

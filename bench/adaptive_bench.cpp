@@ -141,6 +141,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["representation"] = representationName(o.repr);
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
+  j["refinement_interval"] = o.refinementInterval;
   j["metric"] = "flicker: median relative irradiance change per update over the last half of a still phase; PSNR of "
                 "the raster view against the one from a converged float volume (plain gamma 2.2)";
   std::string& table = r.table;
@@ -171,6 +172,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].name = "noise";
     streams[2].options.deadzone = o.deadzone;
     streams[2].options.noiseScale = o.noiseScale;
+    streams[2].options.refinementInterval = o.refinementInterval;
     streams[2].withNoise = true;
     for (Stream& s : streams) s.encoder = std::make_unique<StreamEncoder>(layout, s.options);
     std::vector<double> changes;

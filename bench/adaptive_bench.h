@@ -26,6 +26,7 @@ struct AdaptiveBenchOptions {
   float rejectSigmas = 4.0f;         // the adaptive rule (w_min = 0)
   std::vector<float> fixedWMins = {0.02f, 0.05f, 0.25f};  // the fixed rules compared
   float noiseScale = 2.0f;           // the noise-aware stream's c
+  uint32_t refinementInterval = 0;   // and its EncoderOptions::refinementInterval
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;
   uint32_t jumpUpdates = 48;         // updates charted after the light jump

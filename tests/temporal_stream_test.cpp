@@ -173,6 +173,50 @@ TEST(Stream, NoiseRuleStaysDriftFreeOver1000Frames) {
   EXPECT_LT(static_cast<double>(stillBytes) / 100.0 / count, 0.5);
 }
 
+// The noise rule with a refinement interval: a grey probe of c00 = 1 and σ = 0.01 (c = 2, so c·σ =
+// 0.02). A DC change d moves the irradiance-weighted RMS of withinNoise by d·√(3/7.9375) = 0.615 d
+// (DC weight 1 of 1 + 3·4/9 + 5/16 per channel): d = 0.05 (0.031) is a refinement, beyond c·σ and
+// within 2c·σ; d = 0.1 (0.061) is new light. A refinement waits until the brick's last version is 4
+// updates old; new light goes at once; without an interval both go at once.
+TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::Zh3);
+  const auto frameWith = [](float probe0, float probe1) {
+    std::vector<float> p(64 * kProbeFloats, 0.0f);
+    for (int i = 0; i < 64; ++i)
+      for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = i == 0 ? probe0 : (i == 1 ? probe1 : 1.0f);
+    return p;
+  };
+  const std::vector<float> noise(64, 0.01f);
+  for (uint32_t interval : {4u, 0u}) {
+    EncoderOptions options;
+    options.noiseScale = 2.0f;
+    options.refinementInterval = interval;
+    StreamEncoder enc(layout, options);
+    StreamDecoder dec(layout);
+    std::vector<uint8_t> frame;
+    const auto step = [&](float probe0, float probe1) {
+      enc.update(frameWith(probe0, probe1).data(), nullptr, noise.data());
+      enc.writeChangedFrame(frame);
+      EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+      expectSameState(enc, dec, "interval " + std::to_string(interval));
+      return enc.brickVersion(0);
+    };
+    EXPECT_EQ(step(1.0f, 1.0f), 1u);  // update 1: the first version
+    if (interval == 4) {
+      EXPECT_EQ(step(1.05f, 1.0f), 1u);  // update 2: a refinement waits
+      EXPECT_EQ(step(1.05f, 1.0f), 1u);
+      EXPECT_EQ(step(1.05f, 1.0f), 1u);  // update 4: 3 updates since the last version
+      EXPECT_EQ(step(1.05f, 1.0f), 2u);  // update 5: 4 updates, it goes
+      EXPECT_NEAR(dec.probes()[0], 1.05f, 0.005f);
+      EXPECT_EQ(step(1.05f, 1.1f), 3u);  // new light on probe 1 goes at once
+    } else {
+      EXPECT_EQ(step(1.05f, 1.0f), 2u);  // the refinement goes at once
+      EXPECT_EQ(step(1.05f, 1.1f), 3u);
+    }
+    EXPECT_NEAR(dec.probes()[kProbeFloats], 1.1f, 0.005f);
+  }
+}
+
 // Probes for the golden stream: deterministic, no randomness.
 std::vector<float> goldenProbes(int frame) {
   std::vector<float> p(4 * kProbeFloats, 0.0f);

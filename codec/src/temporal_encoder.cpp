@@ -24,6 +24,7 @@ struct StreamEncoder::Impl {
   std::vector<uint32_t> versions;
   std::vector<Representation> brickRepr;   // of each brick's current version
   std::vector<uint8_t> deltaIsKeyframe;    // per brick: its latest version changed representation
+  std::vector<uint32_t> lastVersionFrame;  // per brick: the update that made its latest version
   std::vector<Representation> choices;     // brickRepresentations(layout.repr) with an error bound, else the layout's
   std::vector<float> change;
   static constexpr uint32_t kHistory = 16;
@@ -60,6 +61,7 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
   s.versions.assign(bricks, 0);
   s.brickRepr.assign(bricks, layout.repr);
   s.deltaIsKeyframe.assign(bricks, 0);
+  s.lastVersionFrame.assign(bricks, 0);
   s.choices = options.errorBound > 0.0f ? brickRepresentations(layout.repr) : std::vector<Representation>{layout.repr};
   s.change.assign(bricks, 0.0f);
   s.changeHistory.assign(static_cast<size_t>(bricks) * Impl::kHistory, 0.0f);
@@ -157,6 +159,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     size_t choice = 0;
     while (s.choices[choice] != repr) ++choice;
     bool changed = switched;
+    bool urgent = switched;  // anything but refinements within 2c·σ (EncoderOptions::refinementInterval)
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t p = s.table.probes[first + k];
       s.base[k] = s.symbols[p];
@@ -169,22 +172,30 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
         // A change the input's own noise explains is not sent: keep what the decoder holds while
         // the would-be new version is within c·σ of it.
         const float sigma = noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f;
-        if (previous && sigma > 0.0f && s.options.noiseScale > 0.0f &&
-            std::memcmp(&s.next[k], previous, sizeof(ProbeSymbols)) != 0) {
+        const bool moved = !previous || std::memcmp(&s.next[k], previous, sizeof(ProbeSymbols)) != 0;
+        if (previous && sigma > 0.0f && s.options.noiseScale > 0.0f && moved) {
           float candidate[kProbeFloats];
           const bool ok = dequantizeProbe(repr, s.next[k], candidate, /*zh3PerPixel=*/false);
           assert(ok && "the encoder only makes valid symbols");
           (void)ok;
-          if (withinNoise(candidate, s.reconstruction.data() + static_cast<size_t>(p) * kProbeFloats,
-                          s.options.noiseScale * sigma))
-            s.next[k] = *previous;
+          const float* held = s.reconstruction.data() + static_cast<size_t>(p) * kProbeFloats;
+          if (withinNoise(candidate, held, s.options.noiseScale * sigma)) s.next[k] = *previous;
+          else urgent = urgent || !withinNoise(candidate, held, 2.0f * s.options.noiseScale * sigma);
+        } else if (moved) {
+          urgent = true;  // no noise to weigh it against, or newly active
         }
       } else {
         s.next[k] = ProbeSymbols{};
       }
+      urgent = urgent || s.nextActive[k] != s.active[p];
       changed = changed || s.nextActive[k] != s.active[p] ||
                 std::memcmp(&s.next[k], &s.base[k], sizeof(ProbeSymbols)) != 0;
     }
+    // Refinements alone (changes between c·σ and 2c·σ: the estimate converging, not new light) wait
+    // until the brick's last version is refinementInterval updates old, and then go together.
+    if (changed && !urgent && s.options.refinementInterval > 0 &&
+        s.frame - s.lastVersionFrame[b] < s.options.refinementInterval)
+      changed = false;
     if (!changed) continue;
 
     // A brick that changed representation starts again from a keyframe (no symbol differences across them).
@@ -195,6 +206,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
                  s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);
     s.brickRepr[b] = repr;
     s.deltaIsKeyframe[b] = switched ? 1 : 0;
+    s.lastVersionFrame[b] = s.frame;
     s.keyframeValid[b] = 0;
     s.changedThisFrame.push_back(b);
 
