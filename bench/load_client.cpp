@@ -58,7 +58,8 @@ struct Tally {
 
 class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerMessage> {
  public:
-  Subscriber(Tally& tally, uint32_t index, bool decodes) : tally_(tally), index_(index), decodes_(decodes) {}
+  Subscriber(Tally& tally, uint32_t index, bool decodes, uint32_t ackIntervalMs)
+      : tally_(tally), index_(index), decodes_(decodes), ackIntervalUs_(uint64_t{ackIntervalMs} * 1000) {}
 
   void start(pb::ProbeStream::Stub& stub, const std::string& token, uint64_t budget, const std::optional<View>& view) {
     if (!token.empty()) ctx_.AddMetadata("authorization", "Bearer " + token);
@@ -175,14 +176,16 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
     return true;
   }
 
-  // One write in flight: hello, then the view set, then the newest ack whenever one is due.
+  // One write in flight: hello, then the view set, then the newest ack whenever one is due (the
+  // first at once, then at most one per ackIntervalMs).
   void pumpLocked() {
     if (writing_) return;
     if (haveViews_) {
       haveViews_ = false;
       writing_ = true;
       StartWrite(&views_);
-    } else if (ackPending_ != 0) {
+    } else if (ackPending_ != 0 && (lastAckUs_ == 0 || systemNowUs() - lastAckUs_ >= ackIntervalUs_)) {
+      lastAckUs_ = systemNowUs();
       ack_.mutable_ack()->set_frame_sequence(ackPending_);
       ackPending_ = 0;
       writing_ = true;
@@ -193,6 +196,7 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
   Tally& tally_;
   const uint32_t index_;
   const bool decodes_;
+  const uint64_t ackIntervalUs_;
   std::atomic<bool> stopping_{false};
   grpc::ClientContext ctx_;
   pb::ClientMessage hello_, views_, ack_;
@@ -201,6 +205,7 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
   std::mutex writeMutex_;      // the write state below
   bool writing_ = false, haveViews_ = false;
   uint32_t ackPending_ = 0;
+  uint64_t lastAckUs_ = 0;  // 0: none yet
   std::mutex decoderMutex_;
   std::unique_ptr<StreamDecoder> decoder_;
 };
@@ -243,7 +248,7 @@ void LoadClient::start() {
   const size_t addresses = c.addresses.size();
   for (uint32_t i = 0; i < c.subscribers; ++i) {
     const uint32_t index = c.firstIndex + i;
-    s.subscribers.push_back(std::make_unique<Subscriber>(s.tally, index, index % c.sampleEvery == 0));
+    s.subscribers.push_back(std::make_unique<Subscriber>(s.tally, index, index % c.sampleEvery == 0, c.ackIntervalMs));
     const size_t a = index % addresses, channel = (index / addresses) % c.channelsPerAddress;
     std::optional<View> view;
     if (c.view) view = c.view(index);

@@ -75,6 +75,27 @@ TEST(Service, LateJoinerGetsKeyframesAndConverges) {
   EXPECT_TRUE(waitFor([&] { return matchesServer(late, hub); }, 10s));
 }
 
+// Acks feed the server's statistics only, so a client sends them at most every ackIntervalMs:
+// with an interval longer than the test, the server hears of the first frame alone; with 0, of
+// later ones too.
+TEST(Service, AcksGoAtMostOncePerIntervalAndEveryFrameWithout) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 1000000, 5ms);
+  ClientConfig rare = clientFor(server.port()), every = clientFor(server.port());
+  rare.ackIntervalMs = 3600 * 1000;
+  every.ackIntervalMs = 0;
+  ProbeClient rareClient(rare), everyClient(every);
+  rareClient.start();
+  everyClient.start();
+  // Stats come every 16 frames; by the third, the second frame's ack would long have arrived.
+  ASSERT_TRUE(waitFor([&] { return rareClient.stats().statsReceived >= 3 && everyClient.stats().statsReceived >= 3; },
+                      10s));
+  EXPECT_EQ(rareClient.stats().serverFramesAcked, 1u);
+  EXPECT_TRUE(waitFor([&] { return everyClient.stats().serverFramesAcked > 16; }, 5s))
+      << everyClient.stats().serverFramesAcked;
+}
+
 TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {
   ProbeHub hub(volumeConfig());
   auto server = std::make_unique<ProbeServer>(plaintextConfig(), hub);

@@ -122,25 +122,48 @@ void brickProbeIndices(const StreamLayout& layout, uint32_t brick, uint32_t* out
         out[k++] = (begin[0] + x) + layout.grid[0] * ((begin[1] + y) + layout.grid[1] * (begin[2] + z));
 }
 
+size_t frameSize(std::span<const std::span<const uint8_t>> sections) {
+  size_t size = kFrameHeaderSize;
+  for (const auto& s : sections) size += s.size();
+  return size;
+}
+
+void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
+                uint8_t* out) {
+  assert(isValidLayout(layout));
+  const size_t sectionBytes = frameSize(sections) - kFrameHeaderSize;
+  uint8_t* p = out;
+  const auto put16 = [&p](uint16_t v) {
+    p[0] = static_cast<uint8_t>(v);
+    p[1] = static_cast<uint8_t>(v >> 8);
+    p += 2;
+  };
+  const auto put32 = [&p](uint32_t v) {
+    setU32(p, v);
+    p += 4;
+  };
+  std::memcpy(p, kMagic, 4);
+  p += 4;
+  *p++ = kFormatVersion;
+  *p++ = static_cast<uint8_t>(layout.repr);
+  *p++ = layout.brickDim;
+  *p++ = 0;  // flags
+  for (uint16_t n : layout.grid) put16(n);
+  put16(0);  // reserved
+  put32(frameSequence);
+  put32(static_cast<uint32_t>(sections.size()));
+  put32(static_cast<uint32_t>(sectionBytes));
+  put32(crc32c(out, 28));
+  for (const auto& s : sections) {
+    if (!s.empty()) std::memcpy(p, s.data(), s.size());
+    p += s.size();
+  }
+}
+
 void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
                 std::vector<uint8_t>& out) {
-  assert(isValidLayout(layout));
-  size_t sectionBytes = 0;
-  for (const auto& s : sections) sectionBytes += s.size();
-  out.clear();
-  out.reserve(kFrameHeaderSize + sectionBytes);
-  out.insert(out.end(), kMagic, kMagic + 4);
-  out.push_back(kFormatVersion);
-  out.push_back(static_cast<uint8_t>(layout.repr));
-  out.push_back(layout.brickDim);
-  out.push_back(0);  // flags
-  for (uint16_t n : layout.grid) putU16(out, n);
-  putU16(out, 0);  // reserved
-  putU32(out, frameSequence);
-  putU32(out, static_cast<uint32_t>(sections.size()));
-  putU32(out, static_cast<uint32_t>(sectionBytes));
-  putU32(out, crc32c(out.data(), out.size()));
-  for (const auto& s : sections) out.insert(out.end(), s.begin(), s.end());
+  out.resize(frameSize(sections));
+  writeFrame(layout, frameSequence, sections, out.data());
 }
 
 CodecStatus readFrameHeader(const uint8_t* data, size_t size, FrameHeader* header) {

@@ -177,6 +177,8 @@ struct ProbeClient::Impl {
       pb::ServerMessage msg;
       bool gotVolume = false;
       bool dropped = false;  // by us, for a reason already in lastError
+      bool acked = false;    // on this connection
+      std::chrono::steady_clock::time_point lastAck;
       while (rw->Read(&msg)) {
         if (msg.has_volume()) {
           if (!onVolume(msg.volume(), servers[at])) {
@@ -200,9 +202,14 @@ struct ProbeClient::Impl {
             ctx.TryCancel();
             break;
           }
-          pb::ClientMessage ack;
-          ack.mutable_ack()->set_frame_sequence(msg.frame().sequence());
-          write(ack);
+          const auto now = std::chrono::steady_clock::now();
+          if (!acked || now - lastAck >= std::chrono::milliseconds(config.ackIntervalMs)) {
+            pb::ClientMessage ack;
+            ack.mutable_ack()->set_frame_sequence(msg.frame().sequence());
+            write(ack);
+            acked = true;
+            lastAck = now;
+          }
         }
       }
       {

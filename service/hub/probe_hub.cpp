@@ -426,8 +426,11 @@ void ProbeHub::refill(Subscriber& s, Clock::time_point now) const {
   s.tokens = std::min(cap, s.tokens + dt * static_cast<double>(s.budget));
 }
 
-std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
+std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) { return nextFrame(id, nullptr); }
+
+std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id, const FrameStorage& storage) {
   std::lock_guard<std::mutex> lock(mutex_);
+  const FrameStorage* to = storage ? &storage : nullptr;
   auto it = subscribers_.find(id);
   if (it == subscribers_.end() || it->second.ended) return std::nullopt;
   Subscriber& s = it->second;
@@ -458,7 +461,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
     size_t n = 0;
     for (uint32_t b = 0; b < bricks; ++b)
       if (s.held[b] < source.version(b)) chosen_[n++] = b;
-    return buildFrame(s, n, behind);
+    return buildFrame(s, n, behind, to);
   }
   scores_.resize(bricks);
   scoreBricks(config_.layout, config_.bounds, s.views, candidates_, config_.priority, scores_.data());
@@ -481,7 +484,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id) {
     s.waiting = true;  // the producer's tick refills and wakes it
     return std::nullopt;
   }
-  return buildFrame(s, n, behind);
+  return buildFrame(s, n, behind, to);
 }
 
 bool ProbeHub::everyStaleBrickScores() const {
@@ -490,7 +493,7 @@ bool ProbeHub::everyStaleBrickScores() const {
   return config_.priority.outOfViewWeight > 0.0f && config_.priority.ageWeight >= 0.0f;
 }
 
-OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind) {
+OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, const FrameStorage* storage) {
   OutgoingFrame frame;
   std::vector<std::span<const uint8_t>> sections;
   sections.reserve(n);
@@ -504,11 +507,15 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind) {
   }
   frame.sequence = ++s.sequence;
   frame.serverTimeUs = publishedUs_;
-  writeFrame(s.layout, frame.sequence, sections, frame.payload);
-  if (s.budget != 0) s.tokens -= static_cast<double>(frame.payload.size());
+  frame.payloadBytes = frameSize(sections);
+  if (storage)
+    writeFrame(s.layout, frame.sequence, sections, (*storage)(frame, frame.payloadBytes));
+  else
+    writeFrame(s.layout, frame.sequence, sections, frame.payload);
+  if (s.budget != 0) s.tokens -= static_cast<double>(frame.payloadBytes);
   s.unacked.emplace_back(frame.sequence, Clock::now());
   if (s.unacked.size() > 1024) s.unacked.pop_front();  // a client that never acks keeps a bounded record
-  s.stats.bytesSent += frame.payload.size();
+  s.stats.bytesSent += frame.payloadBytes;
   s.stats.framesSent += 1;
   s.stats.bricksBehind = behind - static_cast<uint32_t>(n);
   return frame;

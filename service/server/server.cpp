@@ -11,6 +11,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <grpc/slice.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
@@ -166,18 +167,27 @@ class SubscribeReactor : public RawReactor {
       startWriteLocked();
       return;
     }
-    std::optional<OutgoingFrame> frame = hub_.nextFrame(id_);
-    if (!frame) return;
-    out_.Clear();
-    pb::Frame* f = out_.mutable_frame();
-    f->set_sequence(frame->sequence);
-    f->set_server_time_us(frame->serverTimeUs);
-    f->set_payload(reinterpret_cast<const char*>(frame->payload.data()), frame->payload.size());
-    f->set_keyframes(frame->keyframes);
-    f->set_deltas(frame->deltas);
+    // The hub writes the payload straight into the message's one slice: its sections are copied
+    // once on their way to the transport.
+    grpc_slice slice = grpc_empty_slice();
+    const FrameStorage storage = [&slice](const OutgoingFrame& f, size_t payloadBytes) {
+      const FrameFields fields{f.sequence, f.serverTimeUs, payloadBytes, f.keyframes, f.deltas};
+      slice = grpc_slice_malloc(framePrefixBytes(fields) + payloadBytes + frameSuffixBytes(fields));
+      uint8_t* payload = writeFramePrefix(fields, GRPC_SLICE_START_PTR(slice));
+      writeFrameSuffix(fields, payload + payloadBytes);
+      return payload;
+    };
+    const std::optional<OutgoingFrame> frame = hub_.nextFrame(id_, storage);
+    if (!frame) {
+      grpc_slice_unref(slice);
+      return;
+    }
+    grpc::Slice message(slice, grpc::Slice::STEAL_REF);
+    outBytes_ = grpc::ByteBuffer(&message, 1);
     ++framesSinceStats_;
     frameServerTimeUs_ = frame->serverTimeUs;
-    startWriteLocked();
+    writing_ = true;
+    StartWrite(&outBytes_);
   }
 
  private:

@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/wire_format_lite.h>
+
 #include "probecast/codec/probe_offsets.h"
 
 namespace probecast::service {
@@ -107,6 +110,53 @@ void viewsToWire(const std::vector<View>& views, v1::ViewUpdate& out) {
     w->set_eye_y(v.eye[1]);
     w->set_eye_z(v.eye[2]);
   }
+}
+
+namespace {
+
+using google::protobuf::io::CodedOutputStream;
+using google::protobuf::internal::WireFormatLite;
+
+size_t varintFieldBytes(uint64_t v) { return v == 0 ? 0 : 1 + CodedOutputStream::VarintSize64(v); }
+
+uint8_t* putVarintField(int field, uint64_t v, uint8_t* out) {
+  if (v == 0) return out;  // proto3 leaves zero scalars out
+  out = CodedOutputStream::WriteTagToArray(WireFormatLite::MakeTag(field, WireFormatLite::WIRETYPE_VARINT), out);
+  return CodedOutputStream::WriteVarint64ToArray(v, out);
+}
+
+// The Frame message's own size (without the ServerMessage field that holds it).
+size_t frameMessageBytes(const FrameFields& f) {
+  const size_t payload = f.payloadBytes == 0 ? 0 : 1 + CodedOutputStream::VarintSize64(f.payloadBytes) + f.payloadBytes;
+  return varintFieldBytes(f.sequence) + varintFieldBytes(f.serverTimeUs) + payload + varintFieldBytes(f.keyframes) +
+         varintFieldBytes(f.deltas);
+}
+
+}  // namespace
+
+size_t framePrefixBytes(const FrameFields& f) {
+  const size_t frame = frameMessageBytes(f);
+  return 1 + CodedOutputStream::VarintSize64(frame) + varintFieldBytes(f.sequence) + varintFieldBytes(f.serverTimeUs) +
+         (f.payloadBytes == 0 ? 0 : 1 + CodedOutputStream::VarintSize64(f.payloadBytes));
+}
+
+size_t frameSuffixBytes(const FrameFields& f) { return varintFieldBytes(f.keyframes) + varintFieldBytes(f.deltas); }
+
+uint8_t* writeFramePrefix(const FrameFields& f, uint8_t* out) {
+  out = CodedOutputStream::WriteTagToArray(
+      WireFormatLite::MakeTag(v1::ServerMessage::kFrameFieldNumber, WireFormatLite::WIRETYPE_LENGTH_DELIMITED), out);
+  out = CodedOutputStream::WriteVarint64ToArray(frameMessageBytes(f), out);
+  out = putVarintField(v1::Frame::kSequenceFieldNumber, f.sequence, out);
+  out = putVarintField(v1::Frame::kServerTimeUsFieldNumber, f.serverTimeUs, out);
+  if (f.payloadBytes == 0) return out;
+  out = CodedOutputStream::WriteTagToArray(
+      WireFormatLite::MakeTag(v1::Frame::kPayloadFieldNumber, WireFormatLite::WIRETYPE_LENGTH_DELIMITED), out);
+  return CodedOutputStream::WriteVarint64ToArray(f.payloadBytes, out);
+}
+
+uint8_t* writeFrameSuffix(const FrameFields& f, uint8_t* out) {
+  out = putVarintField(v1::Frame::kKeyframesFieldNumber, f.keyframes, out);
+  return putVarintField(v1::Frame::kDeltasFieldNumber, f.deltas, out);
 }
 
 }  // namespace probecast::service

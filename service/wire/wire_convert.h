@@ -24,4 +24,21 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
 bool viewsFromWire(const v1::ViewUpdate& in, uint32_t maxViews, std::vector<View>& out, std::string& why);
 void viewsToWire(const std::vector<View>& views, v1::ViewUpdate& out);
 
+// A ServerMessage holding one Frame, written by hand around a payload the caller writes in place,
+// so that a frame's sections are copied once on their way to the transport. The bytes are those
+// protobuf writes for the same message (fields in number order, proto3 zeros left out).
+struct FrameFields {
+  uint32_t sequence = 0;
+  uint64_t serverTimeUs = 0;
+  size_t payloadBytes = 0;
+  uint32_t keyframes = 0;
+  uint32_t deltas = 0;
+};
+// Bytes before the payload and after it.
+size_t framePrefixBytes(const FrameFields& f);
+size_t frameSuffixBytes(const FrameFields& f);
+// Write them; each returns the end of what it wrote (writeFramePrefix: where the payload goes).
+uint8_t* writeFramePrefix(const FrameFields& f, uint8_t* out);
+uint8_t* writeFrameSuffix(const FrameFields& f, uint8_t* out);
+
 }  // namespace probecast::service

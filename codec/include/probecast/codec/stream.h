@@ -139,6 +139,11 @@ void copyStreamVolume(const StreamLayout& layout, const GridBounds& bounds, cons
 // Writes a frame: header plus the given sections (as produced by StreamEncoder) back to back.
 void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
                 std::vector<uint8_t>& out);
+// The same into storage the caller provides, of frameSize(sections) bytes (a transport's own
+// buffer, so that the sections are copied once on their way out).
+size_t frameSize(std::span<const std::span<const uint8_t>> sections);
+void writeFrame(const StreamLayout& layout, uint32_t frameSequence, std::span<const std::span<const uint8_t>> sections,
+                uint8_t* out);
 
 class StreamEncoder {
  public:

@@ -39,6 +39,11 @@ struct ClientConfig {
   // one (canTranscode in probe_hub.h) and refuses a finer one (INVALID_ARGUMENT: fatal); a
   // description of another representation is refused and the server tried again later.
   std::optional<Representation> representation;
+  // Acks (of the newest applied frame) go at most this often; 0: one per frame. The server reads
+  // them for its statistics (frames_acked, ack_rtt_us) and nothing else, and each is a message
+  // it must read: a thousand viewers acking every frame at 30 Hz would double its messages. While
+  // no frames come, the server's frames_acked may trail the last frame applied.
+  int ackIntervalMs = 100;
 };
 
 struct VolumeSnapshot {

@@ -79,10 +79,16 @@ struct HeldBrick {
 struct OutgoingFrame {
   uint32_t sequence = 0;
   uint64_t serverTimeUs = 0;  // when the newest lighting in it was published
-  std::vector<uint8_t> payload;  // codec frame
+  std::vector<uint8_t> payload;  // codec frame (empty when it was written to a FrameStorage)
+  size_t payloadBytes = 0;       // its size
   uint32_t keyframes = 0;
   uint32_t deltas = 0;
 };
+
+// Where nextFrame writes a frame's payload instead of OutgoingFrame::payload: called under the
+// hub's lock with the frame's other fields set and its payload's size, it returns storage for
+// that many bytes (a transport's send buffer), written before nextFrame returns.
+using FrameStorage = std::function<uint8_t*(const OutgoingFrame& frame, size_t payloadBytes)>;
 
 struct SubscriberStats {
   uint64_t bytesSent = 0;
@@ -163,6 +169,8 @@ class ProbeHub {
   // The next frame for this subscriber: the bricks it lacks, best first, within its budget.
   // nullopt when it holds everything or its budget is spent (it is woken later).
   std::optional<OutgoingFrame> nextFrame(uint64_t id);
+  // The same, its payload written to `storage` (the sections are copied once, into it).
+  std::optional<OutgoingFrame> nextFrame(uint64_t id, const FrameStorage& storage);
   // The subscriber's stream should end: the volume it subscribed to was replaced (a new epoch).
   bool streamEnded(uint64_t id) const;
   SubscriberStats stats(uint64_t id) const;
@@ -199,7 +207,8 @@ class ProbeHub {
   // Whether every brick a subscriber lacks scores above 0 (then an unlimited budget takes them all).
   bool everyStaleBrickScores() const;
   // The frame of the first `n` bricks of chosen_ for `s` (who lacked `behind`), its state updated.
-  OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind);
+  // The payload goes to `storage` when there is one.
+  OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind, const FrameStorage* storage);
   std::vector<std::function<void()>> collectWakes();
   void markStale(uint32_t brick);
   ProbeVolume reconstructionLocked(const BrickSource& source) const;
