@@ -366,6 +366,9 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--sample-every", so->bench.sampleEvery,
                      "1 in this many subscribers decodes in full and is checked bit for bit")
       ->check(CLI::Range(1, 5000));
+  stream->add_option("--ack-interval", so->bench.ackIntervalMs,
+                     "load clients ack the newest frame at most every this many ms, as ProbeClient does (0: every frame)")
+      ->check(CLI::Range(0, 60000));
   so->grid.add(stream, false, 2, 256);  // the benchmark volume, probes 1 m apart
   stream->add_option("--edges", so->bench.edges,
                      "0: subscribers connect to the producer; N: through a nats-server and N edges")

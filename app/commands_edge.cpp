@@ -22,6 +22,7 @@ void addEdgeCommand(CLI::App& app) {
   struct EdgeOptions {
     ServerOptions server;
     service::BusConfig bus;
+    BusOptions busLink;
     uint32_t maxSubscribers = 1024;
     double seconds = 0.0;
   };
@@ -29,16 +30,16 @@ void addEdgeCommand(CLI::App& app) {
   edge->add_option("--nats", o->bus.url, "NATS server(s) holding the stream: nats://host:port, comma-separated")
       ->required();
   edge->add_option("--stream", o->bus.stream, "the volume's name on the bus, as given to serve --stream");
+  o->busLink.add(edge);
   o->server.add(edge);
   edge->add_option("--max-subscribers", o->maxSubscribers, "subscribers served at once")->check(CLI::Range(1, 1000000));
   edge->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
   edge->callback([o] {
     service::EdgeConfig ec;
     ec.bus = o->bus;
+    o->busLink.apply(ec.bus);
     ec.server = o->server.config();
     ec.server.maxSubscribers = o->maxSubscribers;
-    std::string why;
-    if (!service::checkBusConfig(ec.bus, why)) throw std::runtime_error("--nats/--stream: " + why);
     service::EdgeServer server(ec);
     fmt::print("edge: stream {} from {} on port {} ({})\n", service::busStreamName(ec.bus.stream), ec.bus.url,
                server.port(), ec.server.tlsCertPem.empty() ? "plaintext" : "TLS");

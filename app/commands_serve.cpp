@@ -24,6 +24,7 @@ struct ServeOptions {
   ServerOptions server;
   std::string probes, repr = "zh3";
   std::string publish, stream = "probes";
+  BusOptions bus;
   int brick = 4, deadzone = 1;
   float noiseScale = 0.0f, errorBound = 0.0f;
   uint32_t refinementInterval = 0;
@@ -106,6 +107,7 @@ void addServeCommand(CLI::App& app) {
   CLI::Option* publish =
       serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
   serve->add_option("--stream", o->stream, "the volume's name on the bus (letters, digits, - and _)")->needs(publish);
+  o->bus.add(serve, publish);
   serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
   serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
@@ -114,8 +116,7 @@ void addServeCommand(CLI::App& app) {
     service::BusConfig bus;
     bus.url = o->publish;
     bus.stream = o->stream;
-    std::string why;
-    if (!o->publish.empty() && !service::checkBusConfig(bus, why)) throw std::runtime_error("--publish/--stream: " + why);
+    if (!o->publish.empty()) o->bus.apply(bus);
     ProbeVolume file;
     std::unique_ptr<renderer::VulkanContext> context;
     service::HubConfig hc;

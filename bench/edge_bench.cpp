@@ -89,9 +89,7 @@ EdgeBenchResult runEdgeBench(const EdgeBenchOptions& o) {
     if (o.progress) o.progress(s);
   };
   session::NatsServer nats;
-  service::BusConfig bus;
-  bus.url = nats.url();
-  bus.stream = "bench";
+  const service::BusConfig bus = nats.bus("bench");
   const int ports[2] = {session::freeLoopbackPort(), session::freeLoopbackPort()};
   const double killSeconds = 1.5;
   const double moving = 2 * (o.seconds + 1.0) + o.kills * killSeconds + 2.0, hold = 4.0;

@@ -307,8 +307,7 @@ Topology makeTopology(const StreamBenchOptions& o) {
   service::BusConfig bus;
   if (o.edges > 0) {
     t.nats = std::make_unique<session::NatsServer>();
-    bus.url = t.nats->url();
-    bus.stream = "bench";
+    bus = t.nats->bus("bench");
   }
   const service::BusConfig* busOrNull = o.edges > 0 ? &bus : nullptr;
   t.servers.push_back(std::make_unique<session::ChildProcess>(
@@ -376,8 +375,9 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   };
   for (int n : o.subscribers)
     if (n < 1) throw std::invalid_argument("subscriber counts must be positive");
-  if (o.subscribersPerLoadProcess < 1 || o.sampleEvery < 1)
-    throw std::invalid_argument("subscribers per load process and the sampling interval must be positive");
+  if (o.subscribersPerLoadProcess < 1 || o.sampleEvery < 1 || o.ackIntervalMs < 0)
+    throw std::invalid_argument(
+        "subscribers per load process and the sampling interval must be positive, the ack interval not negative");
   if (!isValidLayout(streamLayoutFor(session::unitGrid({o.grid[0], o.grid[1], o.grid[2]}), Representation::Zh3, 4)))
     throw std::invalid_argument(fmt::format("a {}x{}x{} grid cannot be streamed (too many probes for the stream format)",
                                             o.grid[0], o.grid[1], o.grid[2]));
@@ -409,6 +409,7 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
       lc.firstIndex = static_cast<uint32_t>(static_cast<int64_t>(n) * k / processes);
       lc.subscribers = static_cast<uint32_t>(static_cast<int64_t>(n) * (k + 1) / processes) - lc.firstIndex;
       lc.sampleEvery = static_cast<uint32_t>(o.sampleEvery);
+      lc.ackIntervalMs = static_cast<uint32_t>(o.ackIntervalMs);
       lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
       lc.view = [dims = o.grid](uint32_t i) { return randomView(i, dims); };
       loads.push_back(std::make_unique<session::ChildProcess>(
@@ -529,6 +530,7 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
             {"hz", o.hz},
             {"seconds", o.seconds},
             {"budget_bytes_per_s", o.budgetBytesPerSecond},
+            {"ack_interval_ms", o.ackIntervalMs},
             {"topology", o.edges > 0 ? fmt::format("nats: the producer publishes to a nats-server (JetStream); {} edge "
                                                    "processes serve the subscribers, split evenly; server figures sum "
                                                    "producer, edges and nats-server", o.edges)
@@ -540,7 +542,8 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
              "of its newest lighting) to its arrival at a load client, same system clock. publish → write: the same "
              "start to gRPC's write-done on the server. server_cpu_core_per_subscriber and rss_kb_per_subscriber are "
              "the increase over the server's baseline (publishing to nobody) divided by subscribers. Load clients check "
-             "sequence and CRCs of every frame; 1 in " +
+             "sequence and CRCs of every frame and ack the newest at most every " +
+                 std::to_string(o.ackIntervalMs) + " ms; 1 in " +
                  std::to_string(o.sampleEvery) + " subscribers decodes in full and is compared bit for bit with the "
                  "producer's reconstruction once the lighting stops."}};
   r.table = table;

@@ -27,8 +27,9 @@ struct StreamBenchOptions {
   // 0: subscribers connect to the producer's server. N > 0: the producer publishes to a
   // nats-server (JetStream, started for the run) and N edges serve the subscribers, split evenly.
   int edges = 0;
-  int sampleEvery = 50;
-  std::array<uint16_t, 3> grid = {kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]};  // probes per axis, 1 m apart  // 1 in this many subscribers decodes fully (subscriber 0 always does)
+  int sampleEvery = 50;  // 1 in this many subscribers decodes fully (subscriber 0 always does)
+  int ackIntervalMs = 100;  // load clients ack the newest frame at most this often (0: every frame)
+  std::array<uint16_t, 3> grid = {kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]};  // probes per axis, 1 m apart
   std::string command;
   std::function<void(const std::string&)> progress;
 };

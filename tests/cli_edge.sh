@@ -15,15 +15,19 @@ base=$((20000 + RANDOM % 20000))
 np=$base sp=$((base + 1)) ea=$((base + 2)) eb=$((base + 3)) dead=$((base + 4))
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done' EXIT
-"$nats" -a 127.0.0.1 -p "$np" -js -sd "$work/nats" >"$work/nats.log" 2>&1 &
+# The bus requires a token, as a deployment's should; it is in files, not on command lines.
+printf 'bus-%s\n' "$RANDOM$RANDOM" >"$work/bus-token"
+printf 'authorization { token: "%s" }\n' "$(cat "$work/bus-token")" >"$work/nats.conf"
+"$nats" -c "$work/nats.conf" -a 127.0.0.1 -p "$np" -js -sd "$work/nats" >"$work/nats.log" 2>&1 &
 pids+=($!)
+bus=(--nats-token-file "$work/bus-token" --nats-plaintext)
 "$probecast" bake --scene builtin:cornell --grid 6,6,6 --spp 32 --updates 1 --out "$work/served.pcpv" >/dev/null
 "$probecast" serve --probes "$work/served.pcpv" --listen "127.0.0.1:$sp" --plaintext --token t0k --seconds 30 \
-  --publish "nats://127.0.0.1:$np" --stream cli >"$work/serve.log" 2>&1 &
+  --publish "nats://127.0.0.1:$np" --stream cli "${bus[@]}" >"$work/serve.log" 2>&1 &
 pids+=($!)
 for port in $ea $eb; do
-  "$probecast" edge --nats "nats://127.0.0.1:$np" --stream cli --listen "127.0.0.1:$port" --plaintext --token t0k \
-    --seconds 30 >"$work/edge-$port.log" 2>&1 &
+  "$probecast" edge --nats "nats://127.0.0.1:$np" --stream cli "${bus[@]}" --listen "127.0.0.1:$port" --plaintext \
+    --token t0k --seconds 30 >"$work/edge-$port.log" 2>&1 &
   pids+=($!)
 done
 for log in serve "edge-$ea" "edge-$eb"; do

@@ -6,6 +6,7 @@
 #include <nats/nats.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <thread>
@@ -45,9 +46,16 @@ class Edge : public ::testing::Test {
         << "nats-server is a dependency of these tests (scripts/setup.sh installs it): not on PATH, in /usr/sbin "
            "or /usr/bin";
     nats = std::make_unique<session::NatsServer>();
-    bus.url = nats->url();
     static int tests = 0;
-    bus.stream = "edge-test-" + std::to_string(++tests);
+    bus = nats->bus("edge-test-" + std::to_string(++tests));
+  }
+
+  // A plain NATS connection to the test's server (as another program on the bus would make).
+  natsConnection* connectRaw() const {
+    natsConnection* nc = nullptr;
+    const std::string url = "nats://" + nats->token() + "@127.0.0.1:" + std::to_string(nats->port());
+    EXPECT_EQ(natsConnection_ConnectTo(&nc, url.c_str()), NATS_OK);
+    return nc;
   }
 
   EdgeConfig edgeConfig() const {
@@ -212,8 +220,8 @@ TEST_F(Edge, MalformedBusMessagesAreRefusedNotAppliedAndTheStreamGoesOn) {
   ASSERT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
   const uint64_t refusedBefore = edge.stats().refused;
   // Garbage, a valid message cut short, and one with a flipped byte, on a brick's subject.
-  natsConnection* nc = nullptr;
-  ASSERT_EQ(natsConnection_ConnectTo(&nc, bus.url.c_str()), NATS_OK);
+  natsConnection* nc = connectRaw();
+  ASSERT_NE(nc, nullptr);
   std::vector<uint8_t> valid;
   const ProbeHub& hub = producer.hub;
   bus::writeVolumeMessage(hub.volume(), 0, valid);
@@ -296,9 +304,9 @@ TEST_F(Edge, AProducerWhoseClaimIsTakenOverStopsPublishing) {
   first.publish(3);
   ASSERT_TRUE(first.caughtUp());
   // Another producer's claim, as one would publish it after taking over.
-  natsConnection* nc = nullptr;
+  natsConnection* nc = connectRaw();
+  ASSERT_NE(nc, nullptr);
   jsCtx* js = nullptr;
-  ASSERT_EQ(natsConnection_ConnectTo(&nc, bus.url.c_str()), NATS_OK);
   ASSERT_EQ(natsConnection_JetStream(&js, nc, nullptr), NATS_OK);
   const std::string other = "probecast producer elsewhere";
   jsPubAck* ack = nullptr;
@@ -315,6 +323,112 @@ TEST_F(Edge, AProducerWhoseClaimIsTakenOverStopsPublishing) {
   first.publish(3);
   std::this_thread::sleep_for(300ms);
   EXPECT_EQ(first.publisher.stats().messages, sent);
+}
+
+}  // namespace
+}  // namespace probecast::service
+
+namespace probecast::service {
+namespace {
+
+// A bus link is never open by accident: credentials and TLS, or their absence said outright.
+TEST(BusConfigCheck, CredentialsAndTlsOrTheirAbsenceSaidOutright) {
+  BusConfig c;
+  c.token = "t0k";
+  c.plaintext = true;
+  std::string why;
+  EXPECT_TRUE(checkBusConfig(c, why)) << why;
+  BusConfig open = c;
+  open.token.clear();
+  EXPECT_FALSE(checkBusConfig(open, why));
+  EXPECT_NE(why.find("no credentials"), std::string::npos) << why;
+  open.noAuth = true;
+  EXPECT_TRUE(checkBusConfig(open, why)) << why;
+  BusConfig both = c;
+  both.credsFile = "user.creds";
+  EXPECT_FALSE(checkBusConfig(both, why));
+  BusConfig contradiction = c;
+  contradiction.noAuth = true;
+  EXPECT_FALSE(checkBusConfig(contradiction, why));
+  BusConfig spaced = c;
+  spaced.token = "two words";
+  EXPECT_FALSE(checkBusConfig(spaced, why));
+  BusConfig clear = c;
+  clear.plaintext = false;
+  EXPECT_FALSE(checkBusConfig(clear, why));
+  EXPECT_NE(why.find("without TLS"), std::string::npos) << why;
+  clear.tls = true;
+  EXPECT_TRUE(checkBusConfig(clear, why)) << why;
+  clear.plaintext = true;
+  EXPECT_FALSE(checkBusConfig(clear, why));
+  BusConfig caAlone = c;
+  caAlone.caFile = "ca.pem";
+  EXPECT_FALSE(checkBusConfig(caAlone, why));
+  // The defaults ask for neither: a producer refuses them before touching the network.
+  ProbeHub hub(volumeConfig());
+  EXPECT_THROW(BusPublisher(BusConfig{}, hub), std::invalid_argument);
+}
+
+TEST_F(Edge, ALinkTheBusRefusesFailsAtOnceSayingWhyAndAnAbsentBusIsReported) {
+  BusConfig wrong = bus;
+  wrong.token = "not-the-token";
+  ProbeHub hub(volumeConfig());
+  try {
+    BusPublisher publisher(wrong, hub);
+    ADD_FAILURE() << "a producer with the wrong token started";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("Authorization Violation"), std::string::npos) << e.what();
+  }
+  EdgeConfig ec = edgeConfig();
+  ec.bus = wrong;
+  EXPECT_THROW(EdgeServer{ec}, std::runtime_error);
+  BusConfig clear = bus;  // this server speaks plaintext only
+  clear.plaintext = false;
+  clear.tls = true;
+  EXPECT_THROW(BusPublisher(clear, hub), std::runtime_error);
+  // No server at all is not a refusal: the link keeps trying, and its stats say why it is down.
+  BusConfig absent = bus;
+  absent.url = "nats://127.0.0.1:" + std::to_string(session::freeLoopbackPort());
+  BusPublisher waiting(absent, hub);
+  EXPECT_FALSE(waiting.stats().connected);
+  EXPECT_NE(waiting.stats().lastError.find("No server"), std::string::npos) << waiting.stats().lastError;
+}
+
+// The bus over TLS: a producer and an edge that trust the server's certificate carry the stream
+// bit for bit; a plaintext link, or one that does not trust the certificate, is refused.
+TEST(EdgeTls, ABusOverTlsCarriesTheStreamAndUntrustedOrPlaintextLinksAreRefused) {
+  std::string key, cert;
+  ASSERT_TRUE(makeTestCertificate(PROBECAST_TEST_TMP, "nats-tls", key, cert)) << "openssl could not make a test certificate";
+  session::NatsServerOptions no;
+  no.tlsCert = cert;
+  no.tlsKey = key;
+  session::NatsServer nats(no);
+  const BusConfig bus = nats.bus("edge-tls");
+  ASSERT_TRUE(bus.tls);
+  BusConfig plain = bus;
+  plain.tls = false;
+  plain.caFile.clear();
+  plain.plaintext = true;
+  ProbeHub hub(volumeConfig());
+  EXPECT_THROW(BusPublisher(plain, hub), std::runtime_error);
+  BusConfig untrusting = bus;
+  untrusting.caFile.clear();  // the system's roots do not know a self-signed certificate
+  EXPECT_THROW(BusPublisher(untrusting, hub), std::runtime_error);
+
+  BusProducer producer(bus);
+  EdgeConfig ec;
+  ec.bus = bus;
+  ec.server.listen = "127.0.0.1:0";
+  ec.server.token = kToken;
+  ec.server.plaintext = true;
+  EdgeServer edge(ec);
+  ClientConfig cc;
+  cc.address = "127.0.0.1:" + std::to_string(edge.port());
+  cc.token = kToken;
+  ProbeClient client(cc);
+  client.start();
+  producer.publish(5);
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, producer.hub); }, 10s));
 }
 
 }  // namespace

@@ -307,12 +307,8 @@ std::string readFile(const std::string& path) {
 }
 
 TEST(Service, TlsRoundTripAndNoAccidentalPlaintext) {
-  const std::string dir = PROBECAST_TEST_TMP;
-  const std::string key = dir + "/tls-key.pem", cert = dir + "/tls-cert.pem";
-  const std::string cmd = "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
-                          "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " + key + " -out " + cert +
-                          " >/dev/null 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << "openssl could not make a test certificate";
+  std::string key, cert;
+  ASSERT_TRUE(makeTestCertificate(PROBECAST_TEST_TMP, "tls", key, cert)) << "openssl could not make a test certificate";
   ProbeHub hub(volumeConfig());
   ServerConfig unsafe;
   unsafe.token = kToken;  // neither TLS nor plaintext asked for

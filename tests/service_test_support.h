@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
@@ -66,6 +67,18 @@ class Producer {
   std::atomic<int> published_{0};
   std::thread thread_;
 };
+
+// A self-signed certificate for localhost and 127.0.0.1, made with openssl into `dir` as
+// NAME-key.pem and NAME-cert.pem (its own root); false when openssl fails.
+inline bool makeTestCertificate(const std::string& dir, const std::string& name, std::string& keyFile,
+                                std::string& certFile) {
+  keyFile = dir + "/" + name + "-key.pem";
+  certFile = dir + "/" + name + "-cert.pem";
+  const std::string cmd = "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
+                          "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " + keyFile + " -out " + certFile +
+                          " >/dev/null 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
 
 inline ServerConfig plaintextConfig() {
   ServerConfig c;

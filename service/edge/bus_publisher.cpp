@@ -323,6 +323,7 @@ PublisherStats BusPublisher::stats() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   PublisherStats st = impl_->stats;
   st.connected = impl_->link->connected();
+  if (!st.connected && st.lastError.empty()) st.lastError = "bus: " + impl_->link->downReason();
   return st;
 }
 

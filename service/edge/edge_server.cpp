@@ -162,6 +162,7 @@ EdgeStats EdgeServer::stats() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   EdgeStats st = impl_->stats;
   st.busConnected = impl_->link && impl_->link->connected();
+  if (impl_->link && !st.busConnected && st.lastError.empty()) st.lastError = "bus: " + impl_->link->downReason();
   return st;
 }
 

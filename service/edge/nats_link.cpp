@@ -9,6 +9,19 @@ bool validStreamChar(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
 }
 
+// Where the bus is and how to reach it: URL, credentials, TLS, timeout.
+natsStatus configure(natsOptions* o, const BusConfig& config) {
+  natsStatus s = natsOptions_SetURL(o, config.url.c_str());
+  if (s == NATS_OK) s = natsOptions_SetTimeout(o, config.requestTimeoutMs);
+  if (s == NATS_OK && !config.token.empty()) s = natsOptions_SetToken(o, config.token.c_str());
+  if (s == NATS_OK && !config.credsFile.empty())
+    s = natsOptions_SetUserCredentialsFromFiles(o, config.credsFile.c_str(), nullptr);
+  if (s == NATS_OK && config.tls) s = natsOptions_SetSecure(o, true);
+  if (s == NATS_OK && config.tls && !config.caFile.empty())
+    s = natsOptions_LoadCATrustedCertificates(o, config.caFile.c_str());
+  return s;
+}
+
 }  // namespace
 
 bool checkBusConfig(const BusConfig& c, std::string& why) {
@@ -28,6 +41,19 @@ bool checkBusConfig(const BusConfig& c, std::string& why) {
   }
   if (c.reconnectWaitMs < 1 || c.requestTimeoutMs < 1 || c.claimRenewMs < 1)
     return why = "bus timeouts must be positive", false;
+  if (!c.token.empty() && !c.credsFile.empty()) return why = "a bus token and a credentials file contradict each other", false;
+  const bool credentials = !c.token.empty() || !c.credsFile.empty();
+  if (credentials && c.noAuth) return why = "bus credentials and no auth contradict each other", false;
+  if (!credentials && !c.noAuth)
+    return why = "no credentials for the bus: anyone who reaches it could light every viewer (give a token or a "
+                 "credentials file, or ask for no auth on a trusted network)",
+           false;
+  for (char ch : c.token)
+    if (ch <= 0x20 || ch > 0x7e) return why = "the bus token must be printable ASCII without spaces", false;
+  if (c.tls && c.plaintext) return why = "bus TLS and plaintext contradict each other", false;
+  if (!c.caFile.empty() && !c.tls) return why = "a CA file for the bus needs TLS", false;
+  if (!c.tls && !c.plaintext)
+    return why = "refusing a bus link without TLS (ask for TLS, or plaintext on a trusted network)", false;
   return true;
 }
 
@@ -51,11 +77,10 @@ NatsLink::NatsLink(const BusConfig& config, std::function<void()> onUp, std::fun
                    jsPubAckErrHandler onRefused, void* refusedClosure)
     : config_(config), onUp_(std::move(onUp)), onDown_(std::move(onDown)) {
   natsStatus s = natsOptions_Create(&options_);
-  if (s == NATS_OK) s = natsOptions_SetURL(options_, config.url.c_str());
+  if (s == NATS_OK) s = configure(options_, config);
   if (s == NATS_OK) s = natsOptions_SetMaxReconnect(options_, -1);
   if (s == NATS_OK) s = natsOptions_SetReconnectWait(options_, config.reconnectWaitMs);
   if (s == NATS_OK) s = natsOptions_SetReconnectJitter(options_, 0, 0);
-  if (s == NATS_OK) s = natsOptions_SetTimeout(options_, config.requestTimeoutMs);
   // A dead server is noticed within about two seconds, not the default minutes.
   if (s == NATS_OK) s = natsOptions_SetPingInterval(options_, 1000);
   if (s == NATS_OK) s = natsOptions_SetMaxPingsOut(options_, 2);
@@ -68,6 +93,7 @@ NatsLink::NatsLink(const BusConfig& config, std::function<void()> onUp, std::fun
     natsOptions_Destroy(options_);
     throw std::runtime_error("NATS options refused: " + why);
   }
+  refuseWhatTheBusRefuses(config);
   s = natsConnection_Connect(&nc_, options_);
   if (s == NATS_OK) {
     connected_ = true;
@@ -98,6 +124,36 @@ NatsLink::~NatsLink() {
   }
   natsConnection_Destroy(nc_);
   natsOptions_Destroy(options_);
+}
+
+void NatsLink::refuseWhatTheBusRefuses(const BusConfig& config) {
+  // One attempt first, without retrying: a bus that refuses our credentials or our TLS is a
+  // mistake to report now, where the background retries would only ever say "no server".
+  natsOptions* once = nullptr;
+  natsStatus s = natsOptions_Create(&once);
+  if (s == NATS_OK) s = configure(once, config);
+  if (s == NATS_OK) s = natsOptions_SetMaxReconnect(once, 0);
+  natsConnection* probe = nullptr;
+  if (s == NATS_OK) s = natsConnection_Connect(&probe, once);
+  const std::string why = s == NATS_OK ? std::string() : natsErrorText(s);
+  natsConnection_Destroy(probe);
+  natsOptions_Destroy(once);
+  const bool refused = s == NATS_CONNECTION_AUTH_FAILED || s == NATS_NOT_PERMITTED || s == NATS_SSL_ERROR ||
+                       s == NATS_SECURE_CONNECTION_REQUIRED || s == NATS_SECURE_CONNECTION_WANTED ||
+                       s == NATS_INVALID_ARG || s == NATS_ERR;
+  firstFailure_ = why;
+  if (!refused) return;  // connected, or no server yet: the link keeps trying in the background
+  natsOptions_Destroy(options_);
+  options_ = nullptr;
+  throw std::runtime_error("the bus at " + config.url + " refused the link: " + why);
+}
+
+std::string NatsLink::downReason() const {
+  if (connected_) return {};
+  const char* text = nullptr;
+  const natsStatus s = natsConnection_GetLastError(nc_, &text);
+  if (s == NATS_OK) return firstFailure_.empty() ? "not connected yet" : firstFailure_;
+  return std::string(natsStatus_GetText(s)) + (text && *text ? std::string(": ") + text : std::string());
 }
 
 jsOptions NatsLink::requestOptions() const {

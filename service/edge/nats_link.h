@@ -30,10 +30,15 @@ class NatsLink {
   natsConnection* connection() const { return nc_; }
   jsCtx* jetStream() const { return js_; }
   bool connected() const { return connected_; }
+  // Why the link is down (the last error of the connection: a refused token, a TLS failure, no
+  // server); empty while it is up.
+  std::string downReason() const;
   // JetStream request options with the configured timeout.
   jsOptions requestOptions() const;
 
  private:
+  // Throws std::runtime_error when one attempt to connect is refused (credentials, TLS).
+  void refuseWhatTheBusRefuses(const BusConfig& config);
   static void up(natsConnection*, void* self);
   static void down(natsConnection*, void* self);
   static void closed(natsConnection*, void* self);
@@ -47,6 +52,7 @@ class NatsLink {
   std::mutex closeMutex_;
   std::condition_variable closeWake_;
   bool closed_ = false;  // the library's last callback for this connection has run
+  std::string firstFailure_;  // why the first attempt to connect failed (empty: it did not)
 };
 
 }  // namespace probecast::service

@@ -11,7 +11,9 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -74,17 +76,35 @@ std::string NatsServer::findProgram() {
   return {};
 }
 
-NatsServer::NatsServer(const std::string& storeDir) : program_(findProgram()), store_(storeDir) {
+NatsServer::NatsServer(const NatsServerOptions& options)
+    : options_(options), program_(findProgram()), store_(options.storeDir) {
   if (program_.empty())
     throw std::runtime_error("nats-server not found on PATH, in /usr/sbin or /usr/bin (install it: scripts/setup.sh)");
+  if (options.tlsCert.empty() != options.tlsKey.empty())
+    throw std::invalid_argument("a nats-server's TLS needs both a certificate and a key");
   if (store_.empty()) {
     std::string pattern = (std::filesystem::temp_directory_path() / "probecast-nats-XXXXXX").string();
     if (!mkdtemp(pattern.data())) throw std::runtime_error("cannot make a temporary folder for the NATS store");
     store_ = pattern;
     temporary_ = true;
   }
+  std::random_device random;
+  std::ostringstream token;
+  for (int i = 0; i < 4; ++i) token << std::hex << std::setw(8) << std::setfill('0') << random();
+  token_ = token.str();
   port_ = freeLoopbackPort();
   start();
+}
+
+service::BusConfig NatsServer::bus(const std::string& stream) const {
+  service::BusConfig b;
+  b.url = url();
+  b.stream = stream;
+  b.token = token_;
+  b.tls = tls();
+  b.caFile = options_.tlsCert;  // self-signed: the certificate is its own root
+  b.plaintext = !tls();
+  return b;
 }
 
 NatsServer::~NatsServer() {
@@ -100,7 +120,16 @@ std::string NatsServer::url() const { return "nats://127.0.0.1:" + std::to_strin
 void NatsServer::start() {
   if (pid_ > 0) return;
   const std::string port = std::to_string(port_), log = store_ + "/nats-server.log";
-  std::vector<std::string> args = {program_, "-a", "127.0.0.1", "-p", port, "-js", "-sd", store_, "-l", log};
+  // Token and TLS in a configuration file of the owner's alone, not on the command line for all to see.
+  const std::string conf = store_ + "/nats-server.conf";
+  {
+    std::ofstream out(conf, std::ios::trunc);
+    out << "authorization { token: \"" << token_ << "\" }\n";
+    if (tls()) out << "tls { cert_file: \"" << options_.tlsCert << "\"\n key_file: \"" << options_.tlsKey << "\" }\n";
+    if (!out) throw std::runtime_error("cannot write " + conf);
+  }
+  std::filesystem::permissions(conf, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  std::vector<std::string> args = {program_, "-c", conf, "-a", "127.0.0.1", "-p", port, "-js", "-sd", store_, "-l", log};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

@@ -24,10 +24,21 @@ struct BusConfig {
   int reconnectWaitMs = 100;                  // between reconnect attempts (forever)
   int requestTimeoutMs = 2000;                // JetStream requests and publish acknowledgements
   int claimRenewMs = 1000;                    // a producer renews its claim on the stream this often
+  // Who may write the bus may light every viewer of the stream, so a link is never open by
+  // accident: a token (the nats-server's authorization token) or a credentials file (user JWT and
+  // NKey seed, NATS .creds), or noAuth said outright; and TLS (trusting caFile, else the system's
+  // roots) or plaintext said outright.
+  std::string token;
+  std::string credsFile;
+  bool noAuth = false;
+  bool tls = false;
+  std::string caFile;
+  bool plaintext = false;
 };
 
 // A stream name is part of subjects and of the JetStream name: letters, digits, '-' and '_', at
-// most 64. A URL is nats://host:port (or several, comma-separated). False with `why` otherwise.
+// most 64. A URL is nats://host:port (or several, comma-separated). Credentials and TLS as
+// BusConfig says (a token of printable ASCII without spaces). False with `why` otherwise.
 bool checkBusConfig(const BusConfig& config, std::string& why);
 std::string busStreamName(const std::string& stream);
 std::string busSubjects(const std::string& stream);  // probecast.<name>.>
