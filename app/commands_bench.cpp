@@ -426,6 +426,9 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_option("--moving", ao->bench.movingUpdates, "updates with the light moving")->check(CLI::Range(1u, 100000u));
   adaptive->add_option("--light-step", ao->bench.lightStep, "t the light moves per update")->check(CLI::Range(0.0f, 1.0f));
   adaptive->add_option("--reject-sigmas", ao->bench.rejectSigmas, "k of the adaptive rule")->check(CLI::Range(0.5f, 1000.0f));
+  adaptive->add_option("--neighbour-history", ao->bench.neighbourHistory,
+                       "adaptive rule: neighbours of a restarted probe keep at most this many updates of history (0 = off)")
+      ->check(CLI::Range(0.0f, 1e6f));
   adaptive->add_option("--w-mins", ao->bench.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
   adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
   adaptive->add_option("--deadzone", ao->bench.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
@@ -444,6 +447,9 @@ void addBenchAdaptive(CLI::App* bench) {
       ->check(CLI::Range(0.01f, 3.1f));
   adaptive->add_flag("--reconvergence-only", ao->bench.reconvergenceOnly,
                      "measure only the re-convergence of the ray budget against brute force");
+  adaptive->add_option("--reconvergence-updates", ao->bench.reconvergenceUpdates,
+                       "updates measured after the re-convergence jump")
+      ->check(CLI::Range(1u, 100000u));
   adaptive->callback([ao] {
     bench::AdaptiveBenchOptions o = ao->bench;
     o.dims = {ao->grid.dims[0], ao->grid.dims[1], ao->grid.dims[2]};

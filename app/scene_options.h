@@ -158,6 +158,7 @@ struct TracerOptions {
   uint32_t seed = 1;
   float wMin = 0.05f;
   float rejectSigmas = 4.0f;
+  float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;
   float clamp = 16.0f;
   bool relocate = true;
   uint64_t raysPerUpdate = 0;
@@ -173,6 +174,10 @@ struct TracerOptions {
     cmd->add_option("--reject-sigmas", rejectSigmas,
                     "restart a probe's history when new estimates differ by more than this many standard errors (0 = never)")
         ->check(CLI::Range(0.0f, 1000.0f));
+    cmd->add_option("--neighbour-history", neighbourHistory,
+                    "the neighbours of a probe whose history restarts keep at most this many updates of theirs (0 = "
+                    "off)")
+        ->check(CLI::Range(0.0f, 1e6f));
     cmd->add_option("--clamp", clamp, "max luminance of an indirect contribution (0 = off)")->check(CLI::Range(0.0f, 1e9f));
     cmd->add_flag("--relocate,!--no-relocate", relocate,
                   "move probes inside or too close to geometry (up to 45 % of a cell per axis) instead of only "
@@ -185,6 +190,7 @@ struct TracerOptions {
     o.seed = seed;
     o.minBlendWeight = wMin;
     o.rejectSigmas = rejectSigmas;
+    o.neighbourHistory = neighbourHistory;
     o.indirectClamp = clamp;
     o.relocate = relocate;
     o.raysPerUpdate = raysPerUpdate;

@@ -24,6 +24,7 @@ struct AdaptiveBenchOptions {
   uint32_t movingUpdates = 32;       // light moving by lightStep of t per update
   float lightStep = 0.004f;
   float rejectSigmas = 4.0f;         // the adaptive rule (w_min = 0)
+  float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;  // and its UpdaterOptions::neighbourHistory
   std::vector<float> fixedWMins = {0.02f, 0.05f, 0.25f};  // the fixed rules compared
   float noiseScale = 2.0f;           // the noise-aware stream's c
   uint32_t refinementInterval = 0;   // and its EncoderOptions::refinementInterval
@@ -39,6 +40,7 @@ struct AdaptiveBenchOptions {
   uint64_t raysPerUpdate = 0;        // 0 = active probes × samplesPerProbe
   float viewYfov = 0.03f;            // the viewer whose probes are scored (builtin:cornell 4³: 16 of 64 probes)
   bool reconvergenceOnly = false;    // measure only that
+  uint32_t reconvergenceUpdates = 72;  // updates measured after its jump
 
   renderer::ContextOptions context;
   std::string command;

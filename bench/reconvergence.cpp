@@ -38,6 +38,7 @@ nlohmann::json ReconvergenceResult::json() const {
           {"adaptive_updates", adaptiveUpdates},
           {"bruteforce_updates", bruteForceUpdates},
           {"reconvergence_vs_bruteforce", ratio},
+          {"reconvergence_vs_bruteforce_at_most", ratio >= 0 ? ratio : ratioAtMost},
           {"adaptive_error_after_jump", adaptiveError},
           {"bruteforce_error_after_jump", bruteForceError}};
 }
@@ -52,6 +53,7 @@ ReconvergenceResult measureReconvergence(renderer::VulkanContext& context, const
   bo.samplesPerProbe = o.samplesPerProbe;
   bo.minBlendWeight = 0.0f;
   bo.rejectSigmas = o.rejectSigmas;
+  bo.neighbourHistory = o.neighbourHistory;
   renderer::ProbeUpdater brute(context, before, grid, bo);
   ReconvergenceResult r;
   const ProbeVolume& bv = brute.volume();
@@ -97,6 +99,8 @@ ReconvergenceResult measureReconvergence(renderer::VulkanContext& context, const
   r.adaptiveUpdates = firstWithin(r.adaptiveError, r.threshold);
   r.bruteForceUpdates = firstWithin(r.bruteForceError, r.threshold);
   if (r.adaptiveUpdates > 0 && r.bruteForceUpdates > 0) r.ratio = static_cast<double>(r.adaptiveUpdates) / r.bruteForceUpdates;
+  else if (r.adaptiveUpdates > 0)
+    r.ratioAtMost = static_cast<double>(r.adaptiveUpdates) / static_cast<double>(o.afterUpdates + 1);
   return r;
 }
 

@@ -25,6 +25,7 @@ struct ReconvergenceOptions {
   uint32_t convergeUpdates = 24;   // light still at t = 0 before the jump
   uint32_t afterUpdates = 72;      // updates measured after the jump to t = 0.5
   float rejectSigmas = 4.0f;       // both (w_min 0)
+  float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;  // both
 };
 
 struct ReconvergenceResult {
@@ -34,6 +35,8 @@ struct ReconvergenceResult {
   std::vector<double> adaptiveError, bruteForceError;  // in view, against the t = 0.5 truth, per update after
   int adaptiveUpdates = -1, bruteForceUpdates = -1;    // first update after the jump within threshold (-1: never)
   double ratio = -1;  // adaptiveUpdates / bruteForceUpdates (-1 when either never got there)
+  // When only the budget got there: adaptiveUpdates / (updates measured + 1), above the ratio (-1 otherwise).
+  double ratioAtMost = -1;
   nlohmann::json json() const;
 };
 

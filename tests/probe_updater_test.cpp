@@ -355,6 +355,32 @@ TEST_F(Updater, HistoryRejectionFollowsALightJumpWithinTwoUpdates) {
   EXPECT_GT(restarted, active / 2);
 }
 
+TEST_F(Updater, RestartsShortenTheirNeighboursHistorySoTheVolumeFollowsAJumpSooner) {
+  // After a light jump, probes whose change is below what one update can tell from noise keep
+  // averaging the old light into the new; when restarts around them (not lone ones) cap their
+  // history (UpdaterOptions::neighbourHistory) they follow sooner. Same seeds, same rays: only
+  // the rule differs (4³ probes, 32 samples, w_min 0).
+  const Scene before = cornellAt(0.0f), after = cornellAt(0.5f);
+  const ProbeGrid g = sceneGrid(before, {4, 4, 4});
+  const std::vector<float> reference = convergedProbes(*context_, after, g);
+  std::vector<double> error;
+  for (float cap : {0.0f, 8.0f}) {
+    UpdaterOptions o;
+    o.samplesPerProbe = 32;
+    o.minBlendWeight = 0.0f;
+    o.neighbourHistory = cap;
+    ProbeUpdater u(*context_, before, g, o);
+    for (int k = 0; k < 24; ++k) u.update();
+    u.setScene(after);
+    for (int k = 0; k < 24; ++k) u.update();
+    error.push_back(bench::irradianceRmseRel(u.volume().probes.data(), reference.data(), u.volume().active.data(),
+                                             g.count()));
+  }
+  std::printf("irradiance error 24 updates after the jump: %.4f without, %.4f with neighbour history 8\n", error[0],
+              error[1]);
+  EXPECT_LT(error[1], 0.85 * error[0]);  // measured on lavapipe: 0.143 against 0.189
+}
+
 TEST_F(Updater, StillVolumeIsRarelyResent) {
   // The light still: what changes from update to update is noise the updater states, so an
   // encoder with a noise scale makes new brick versions only now and then, while one without

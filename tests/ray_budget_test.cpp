@@ -196,5 +196,29 @@ TEST(RayBudgetBlend, AnEstimateCountsAsItsSamplesOverTheNominal) {
   EXPECT_FLOAT_EQ(h.varianceFactor, 0.25f);
 }
 
+TEST(NeighbourHistory, AShortenedHistoryWeighsTheNextEstimateAsAfterNOfThem) {
+  // A plain mean of 100 estimates of 1, shortened to 8: an estimate of 10 then moves it by 1/9 of
+  // the way (w = 1/(8+1)); the history's stated variance is at least that of 8 estimates. One
+  // already shorter than the cap, and a cap of 0, leave it as it is.
+  ProbeHistory h;
+  float probe[27] = {}, one[27], ten[27];
+  for (int i = 0; i < 27; ++i) one[i] = 1.0f, ten[i] = 10.0f;
+  const float spread[kHistoryLuma] = {0.04f, 0.04f, 0.04f, 0.04f};
+  const HistoryOptions plain{0.0f, 0.0f};
+  for (int k = 0; k < 100; ++k) blendEstimate(h, probe, one, spread, plain, 1.0f);
+  EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f);
+  ProbeHistory same = h;
+  shortenHistory(same, 0.0f);
+  EXPECT_FLOAT_EQ(same.n, 100.0f);
+  shortenHistory(h, 8.0f);
+  EXPECT_FLOAT_EQ(h.n, 8.0f);
+  EXPECT_FLOAT_EQ(h.varianceFactor, 0.125f);
+  EXPECT_FLOAT_EQ(probe[0], 1.0f);  // its value stays
+  blendEstimate(h, probe, ten, spread, plain, 1.0f);
+  EXPECT_FLOAT_EQ(probe[0], 2.0f);  // 1 + (10 - 1) / 9
+  shortenHistory(h, 20.0f);
+  EXPECT_FLOAT_EQ(h.n, 9.0f);
+}
+
 }  // namespace
 }  // namespace probecast::renderer

@@ -100,6 +100,14 @@ float estimateVariance(const ProbeHistory& h, int k) {
   return (h.m2[k] + kSpreadDegrees * h.spreadVariance[k]) / (dof + kSpreadDegrees);
 }
 
+void shortenHistory(ProbeHistory& h, float n) {
+  if (!(n > 0.0f) || h.n <= n) return;
+  h.n = n;
+  h.varianceFactor = std::max(h.varianceFactor, 1.0f / n);  // at least as uncertain as n estimates
+  h.fastCount = std::min(h.fastCount, n);
+  h.fastFactor = std::max(h.fastFactor, 1.0f / h.fastCount);
+}
+
 float historyStandardError(const ProbeHistory& h) {
   return h.n == 0.0f ? 0.0f : std::sqrt(std::max(0.0f, estimateVariance(h, 0) * h.varianceFactor));
 }

@@ -57,6 +57,11 @@ BlendOutcome blendEstimate(ProbeHistory& history, float probe[27], const float e
                            const float spreadVariance[kHistoryLuma], const HistoryOptions& options,
                            float weight = 1.0f);
 
+// A neighbour restarted, so this probe's light has likely changed too: from now on its history
+// counts for at most `n` estimates (its value and statistics stay; new estimates weigh in as they
+// would after n of them). A held-back estimate stays held.
+void shortenHistory(ProbeHistory& history, float n);
+
 // σ² of one update's estimate of luminance `k` (0 = c00), as the history knows it.
 float estimateVariance(const ProbeHistory& history, int k);
 // Standard error of the luminance of the history's c00 (ProbeVolume::noise).

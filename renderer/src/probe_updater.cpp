@@ -103,6 +103,8 @@ struct ProbeUpdater::Impl {
   std::vector<uint32_t> activeList;
   ClassifyStats classifyStats;
   std::vector<ProbeHistory> history;  // per probe: blend count and noise statistics
+  std::vector<uint32_t> restarted;    // probes restarted by the update being blended
+  std::vector<uint32_t> strongRestarts;  // of those, the ones moved by over twice the rejection threshold
   // The ray budget: per probe its view weight (empty = all seen), updates since it was traced,
   // and the samples of the last update.
   std::vector<float> viewWeights;
@@ -271,6 +273,8 @@ struct ProbeUpdater::Impl {
   // Blends the estimates of the last trace dispatch (the probes of `list`, `traced[i]` samples each) into
   // the probes' histories.
   void blendTraced(const std::vector<uint32_t>& list, const std::vector<uint32_t>& traced, UpdateStats& stats);
+  // UpdaterOptions::neighbourHistory for the probes restarted by this update.
+  void shortenNeighbours();
   void setGeometry(const scene::Scene& s) {
     uploadGpuScene(*d, s, gpu);
     markClientLit(s);
@@ -427,11 +431,60 @@ void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const st
     }
     for (float& v : spread) v /= static_cast<float>(kLanes) * static_cast<float>(kLanes - 1);
     float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
+    // What a restart moved the probe by, against the noise of the history it replaced.
+    const ProbeHistory before = s.history[p];
+    const float lumBefore = coefficientLuminance(c, 0);
     const BlendOutcome outcome = blendEstimate(s.history[p], c, fresh, spread, blend, weight);
-    stats.restartedProbes +=
-        outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage ? 1u : 0u;
+    const bool restarted = outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage;
+    stats.restartedProbes += restarted ? 1u : 0u;
+    if (restarted) {
+      const float moved = coefficientLuminance(c, 0) - lumBefore;
+      const float noise = estimateVariance(before, 0) * (1.0f / weight + before.varianceFactor);
+      const float strong = 2.0f * s.options.rejectSigmas;
+      s.restarted.push_back(p);
+      if (moved * moved > strong * strong * noise) s.strongRestarts.push_back(p);
+    }
     s.volume.noise[p] = historyStandardError(s.history[p]);
   }
+  shortenNeighbours();
+}
+
+void ProbeUpdater::Impl::shortenNeighbours() {
+  Impl& s = *this;
+  if (s.options.neighbourHistory > 0.0f && s.options.rejectSigmas > 0.0f) {
+    const uint32_t* d = s.volume.grid.dims;
+    const uint32_t stride[3] = {1, d[0], d[0] * d[1]};
+    std::sort(s.restarted.begin(), s.restarted.end());
+    std::sort(s.strongRestarts.begin(), s.strongRestarts.end());
+    const auto restartedAt = [&](uint32_t q) { return std::binary_search(s.restarted.begin(), s.restarted.end(), q); };
+    for (uint32_t p : s.restarted) {
+      const uint32_t at[3] = {p % d[0], (p / d[0]) % d[1], p / (d[0] * d[1])};
+      // Only a restart that moved the probe by twice the rejection threshold, or one another
+      // nearby (its 3×3×3 block) agrees with: noise restarts a probe now and then, alone and
+      // barely past the threshold; a change of the light moves it further, or several together.
+      bool corroborated = false;
+      for (int dz = -1; dz <= 1 && !corroborated; ++dz)
+        for (int dy = -1; dy <= 1 && !corroborated; ++dy)
+          for (int dx = -1; dx <= 1 && !corroborated; ++dx) {
+            const int x = static_cast<int>(at[0]) + dx, y = static_cast<int>(at[1]) + dy, z = static_cast<int>(at[2]) + dz;
+            if ((dx == 0 && dy == 0 && dz == 0) || x < 0 || y < 0 || z < 0 || x >= static_cast<int>(d[0]) ||
+                y >= static_cast<int>(d[1]) || z >= static_cast<int>(d[2]))
+              continue;
+            corroborated = restartedAt(static_cast<uint32_t>(x) + d[0] * (static_cast<uint32_t>(y) + d[1] * static_cast<uint32_t>(z)));
+          }
+      if (!corroborated && !std::binary_search(s.strongRestarts.begin(), s.strongRestarts.end(), p)) continue;
+      for (int axis = 0; axis < 3; ++axis)
+        for (int side = -1; side <= 1; side += 2) {
+          if ((side < 0 && at[axis] == 0) || (side > 0 && at[axis] + 1 >= d[axis])) continue;
+          const uint32_t q = side < 0 ? p - stride[axis] : p + stride[axis];
+          if (!s.volume.active[q] || restartedAt(q)) continue;
+          shortenHistory(s.history[q], s.options.neighbourHistory);
+          s.volume.noise[q] = historyStandardError(s.history[q]);
+        }
+    }
+  }
+  s.restarted.clear();
+  s.strongRestarts.clear();
 }
 
 void ProbeUpdater::setViewWeights(std::vector<float> weights) {

@@ -41,6 +41,11 @@ struct UpdaterOptions {
   // History rejection: restart a probe whose new estimate (or short moving average) differs from
   // its history by more than this many standard errors of the difference; 0 = off (plain blend).
   float rejectSigmas = 4.0f;
+  // With rejection: when a probe restarts and the restart is no lone blip of noise (another probe
+  // of its 3×3×3 block restarts in the same update, or it moved by twice the rejection
+  // threshold), its grid neighbours (one step along an axis) keep at most this many updates'
+  // worth of history, so they follow a change they cannot yet tell from their own noise; 0 = off.
+  float neighbourHistory = 8.0f;
   uint32_t seed = 1;
   bool classify = true;            // mark probes inside geometry inactive
   uint32_t classifySamples = 64;
