@@ -40,7 +40,7 @@ struct AdaptiveBenchOptions {
   uint64_t raysPerUpdate = 0;        // 0 = active probes × samplesPerProbe
   float viewYfov = 0.03f;            // the viewer whose probes are scored (builtin:cornell 4³: 16 of 64 probes)
   bool reconvergenceOnly = false;    // measure only that
-  uint32_t reconvergenceUpdates = 72;  // updates measured after its jump
+  uint32_t reconvergenceUpdates = 160;  // updates measured after its jump (brute force needs over 100)
 
   renderer::ContextOptions context;
   std::string command;

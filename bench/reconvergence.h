@@ -23,7 +23,7 @@ struct ReconvergenceOptions {
   uint64_t raysPerUpdate = 0;      // both; 0 = active probes × samplesPerProbe
   float viewYfov = 0.03f;          // the viewer: the scene's camera with this field of view (radians)
   uint32_t convergeUpdates = 24;   // light still at t = 0 before the jump
-  uint32_t afterUpdates = 72;      // updates measured after the jump to t = 0.5
+  uint32_t afterUpdates = 160;     // updates measured after the jump to t = 0.5
   float rejectSigmas = 4.0f;       // both (w_min 0)
   float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;  // both
 };
