@@ -28,6 +28,8 @@ struct Stream {
   bool withNoise = false;
   std::unique_ptr<StreamEncoder> encoder;
   std::vector<double> bytesPerProbe;  // per frame
+  std::vector<float> held;            // what a subscriber holds after the frame before
+  std::vector<double> heldChanges;    // per frame: its relative irradiance change (what a viewer sees flicker)
 };
 
 double mean(const std::vector<double>& v, size_t from, size_t to) {
@@ -153,8 +155,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", first.name, o.dims[0],
                       o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
                       context.deviceName());
-  table += fmt::format("{:<14} {:<7} {:>9} {:>9} {:>9} {:>9} {:>11}\n", "rule", "stream", "still B", "moving B",
-                       "again B", "flicker", "PSNR loss");
+  table += fmt::format("{:<14} {:<7} {:>9} {:>9} {:>9} {:>9} {:>11} {:>11}\n", "rule", "stream", "still B", "moving B",
+                       "again B", "flicker", "held flick", "PSNR loss");
 
   std::vector<BlendRule> rules;
   for (float w : o.fixedWMins) rules.push_back({w, 0.0f});
@@ -199,6 +201,12 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         s.encoder->writeChangedFrame(frame);
         // Frame 0 is the keyframe; a frame that changes no brick is never sent.
         s.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / count);
+        ProbeVolume held;
+        s.encoder->copyVolume(grid.bounds, held);
+        s.heldChanges.push_back(s.held.empty() ? 0.0
+                                               : irradianceRmseRel(held.probes.data(), s.held.data(),
+                                                                   held.active.data(), count));
+        s.held = std::move(held.probes);
       }
       for (size_t m = 0; m < moments.size(); ++m) {
         if (f < moments[m].first || f > moments[m].frame) continue;
@@ -227,6 +235,11 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                            {"first_still_bytes_per_probe_frame", mean(s.bytesPerProbe, a / 2, a)},
                            {"moving_bytes_per_probe_frame", mean(s.bytesPerProbe, a, b)},
                            {"bytes_per_probe_frame", s.bytesPerProbe}};
+      // Flicker of what a subscriber holds, over the last half of the second still phase: the
+      // median as for the volume, and the mean, which counts the updates that change nothing.
+      const std::vector<double> heldTail(s.heldChanges.end() - o.stillUpdates / 2, s.heldChanges.end());
+      sj["held_flicker_rel_median"] = session::median(heldTail);
+      sj["held_flicker_rel_mean"] = mean(heldTail, 0, heldTail.size());
       double worstLoss = 0;
       for (size_t m = 0; m < moments.size(); ++m) {
         // The loss is paired update by update against the stream that sends every change (same
@@ -244,10 +257,10 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         worstLoss = std::max(worstLoss, meanLoss);
       }
       sj["worst_psnr_loss_db"] = worstLoss;
-      table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>8.3f} dB\n", ruleName(rule), s.name,
-                           mean(s.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),
+      table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>10.2f}% {:>8.3f} dB\n", ruleName(rule),
+                           s.name, mean(s.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),
                            sj["static_bytes_per_probe_frame"].get<double>(), 100 * ruleJson["flicker_rel"].get<double>(),
-                           worstLoss);
+                           100 * sj["held_flicker_rel_mean"].get<double>(), worstLoss);
       ruleJson["streams"].push_back(sj);
       if (s.name == "full") continue;
       const bool adaptiveNoise = rule.rejectSigmas > 0 && s.withNoise;

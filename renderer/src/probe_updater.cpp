@@ -435,9 +435,9 @@ void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const st
     const ProbeHistory before = s.history[p];
     const float lumBefore = coefficientLuminance(c, 0);
     const BlendOutcome outcome = blendEstimate(s.history[p], c, fresh, spread, blend, weight);
-    const bool restarted = outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage;
-    stats.restartedProbes += restarted ? 1u : 0u;
-    if (restarted) {
+    const bool restartedNow = outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage;
+    stats.restartedProbes += restartedNow ? 1u : 0u;
+    if (restartedNow) {
       const float moved = coefficientLuminance(c, 0) - lumBefore;
       const float noise = estimateVariance(before, 0) * (1.0f / weight + before.varianceFactor);
       const float strong = 2.0f * s.options.rejectSigmas;
@@ -452,13 +452,13 @@ void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const st
 void ProbeUpdater::Impl::shortenNeighbours() {
   Impl& s = *this;
   if (s.options.neighbourHistory > 0.0f && s.options.rejectSigmas > 0.0f) {
-    const uint32_t* d = s.volume.grid.dims;
-    const uint32_t stride[3] = {1, d[0], d[0] * d[1]};
+    const uint32_t* n = s.volume.grid.dims;
+    const uint32_t stride[3] = {1, n[0], n[0] * n[1]};
     std::sort(s.restarted.begin(), s.restarted.end());
     std::sort(s.strongRestarts.begin(), s.strongRestarts.end());
     const auto restartedAt = [&](uint32_t q) { return std::binary_search(s.restarted.begin(), s.restarted.end(), q); };
     for (uint32_t p : s.restarted) {
-      const uint32_t at[3] = {p % d[0], (p / d[0]) % d[1], p / (d[0] * d[1])};
+      const uint32_t at[3] = {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])};
       // Only a restart that moved the probe by twice the rejection threshold, or one another
       // nearby (its 3×3×3 block) agrees with: noise restarts a probe now and then, alone and
       // barely past the threshold; a change of the light moves it further, or several together.
@@ -467,15 +467,15 @@ void ProbeUpdater::Impl::shortenNeighbours() {
         for (int dy = -1; dy <= 1 && !corroborated; ++dy)
           for (int dx = -1; dx <= 1 && !corroborated; ++dx) {
             const int x = static_cast<int>(at[0]) + dx, y = static_cast<int>(at[1]) + dy, z = static_cast<int>(at[2]) + dz;
-            if ((dx == 0 && dy == 0 && dz == 0) || x < 0 || y < 0 || z < 0 || x >= static_cast<int>(d[0]) ||
-                y >= static_cast<int>(d[1]) || z >= static_cast<int>(d[2]))
+            if ((dx == 0 && dy == 0 && dz == 0) || x < 0 || y < 0 || z < 0 || x >= static_cast<int>(n[0]) ||
+                y >= static_cast<int>(n[1]) || z >= static_cast<int>(n[2]))
               continue;
-            corroborated = restartedAt(static_cast<uint32_t>(x) + d[0] * (static_cast<uint32_t>(y) + d[1] * static_cast<uint32_t>(z)));
+            corroborated = restartedAt(static_cast<uint32_t>(x) + n[0] * (static_cast<uint32_t>(y) + n[1] * static_cast<uint32_t>(z)));
           }
       if (!corroborated && !std::binary_search(s.strongRestarts.begin(), s.strongRestarts.end(), p)) continue;
       for (int axis = 0; axis < 3; ++axis)
         for (int side = -1; side <= 1; side += 2) {
-          if ((side < 0 && at[axis] == 0) || (side > 0 && at[axis] + 1 >= d[axis])) continue;
+          if ((side < 0 && at[axis] == 0) || (side > 0 && at[axis] + 1 >= n[axis])) continue;
           const uint32_t q = side < 0 ? p - stride[axis] : p + stride[axis];
           if (!s.volume.active[q] || restartedAt(q)) continue;
           shortenHistory(s.history[q], s.options.neighbourHistory);
