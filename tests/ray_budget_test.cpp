@@ -198,8 +198,9 @@ TEST(RayBudgetBlend, AnEstimateCountsAsItsSamplesOverTheNominal) {
 
 TEST(NeighbourHistory, AShortenedHistoryWeighsTheNextEstimateAsAfterNOfThem) {
   // A plain mean of 100 estimates of 1, shortened to 8: an estimate of 10 then moves it by 1/9 of
-  // the way (w = 1/(8+1)); the history's stated variance is at least that of 8 estimates. One
-  // already shorter than the cap, and a cap of 0, leave it as it is.
+  // the way (w = 1/(8+1)); the shortening itself leaves the value and its variance as they were
+  // (only the weights to come change). One already shorter than the cap, and a cap of 0, leave it
+  // as it is.
   ProbeHistory h;
   float probe[27] = {}, one[27], ten[27];
   for (int i = 0; i < 27; ++i) one[i] = 1.0f, ten[i] = 10.0f;
@@ -212,10 +213,11 @@ TEST(NeighbourHistory, AShortenedHistoryWeighsTheNextEstimateAsAfterNOfThem) {
   EXPECT_FLOAT_EQ(same.n, 100.0f);
   shortenHistory(h, 8.0f);
   EXPECT_FLOAT_EQ(h.n, 8.0f);
-  EXPECT_FLOAT_EQ(h.varianceFactor, 0.125f);
+  EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f);
   EXPECT_FLOAT_EQ(probe[0], 1.0f);  // its value stays
   blendEstimate(h, probe, ten, spread, plain, 1.0f);
   EXPECT_FLOAT_EQ(probe[0], 2.0f);  // 1 + (10 - 1) / 9
+  EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f * 64.0f / 81.0f + 1.0f / 81.0f);  // (1 - w)² f + w²
   shortenHistory(h, 20.0f);
   EXPECT_FLOAT_EQ(h.n, 9.0f);
 }

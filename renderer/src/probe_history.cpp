@@ -102,10 +102,9 @@ float estimateVariance(const ProbeHistory& h, int k) {
 
 void shortenHistory(ProbeHistory& h, float n) {
   if (!(n > 0.0f) || h.n <= n) return;
+  // Only the weights to come change: the value, hence its variance, is what it was.
   h.n = n;
-  h.varianceFactor = std::max(h.varianceFactor, 1.0f / n);  // at least as uncertain as n estimates
   h.fastCount = std::min(h.fastCount, n);
-  h.fastFactor = std::max(h.fastFactor, 1.0f / h.fastCount);
 }
 
 float historyStandardError(const ProbeHistory& h) {

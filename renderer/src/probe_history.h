@@ -58,8 +58,8 @@ BlendOutcome blendEstimate(ProbeHistory& history, float probe[27], const float e
                            float weight = 1.0f);
 
 // A neighbour restarted, so this probe's light has likely changed too: from now on its history
-// counts for at most `n` estimates (its value and statistics stay; new estimates weigh in as they
-// would after n of them). A held-back estimate stays held.
+// counts for at most `n` estimates (its value, its variance and its statistics stay; new estimates
+// weigh in as they would after n of them). A held-back estimate stays held.
 void shortenHistory(ProbeHistory& history, float n);
 
 // σ² of one update's estimate of luminance `k` (0 = c00), as the history knows it.
