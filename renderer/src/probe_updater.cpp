@@ -2,6 +2,7 @@
 #include "probecast/renderer/probe_updater.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -104,7 +105,9 @@ struct ProbeUpdater::Impl {
   ClassifyStats classifyStats;
   std::vector<ProbeHistory> history;  // per probe: blend count and noise statistics
   std::vector<uint32_t> restarted;    // probes restarted by the update being blended
-  std::vector<uint32_t> strongRestarts;  // of those, the ones moved by over twice the rejection threshold
+  // Per probe, how the update being blended restarted it (all kNoRestart between updates).
+  static constexpr uint8_t kNoRestart = 0, kRestart = 1, kStrongRestart = 2;  // strong: moved by twice the threshold
+  std::vector<uint8_t> restartKind;
   // The ray budget: per probe its view weight (empty = all seen), updates since it was traced,
   // and the samples of the last update.
   std::vector<float> viewWeights;
@@ -399,6 +402,7 @@ void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const st
   const float* part = static_cast<const float*>(s.partials.mapped);
   const HistoryOptions blend{s.options.minBlendWeight, s.options.rejectSigmas};
   s.volume.noise.resize(s.volume.count(), 0.0f);
+  s.restartKind.resize(s.volume.count(), kNoRestart);
   for (size_t i = 0; i < list.size(); ++i) {
     const uint32_t p = list[i];
     const float scale = 4.0f * 3.14159265358979f / static_cast<float>(traced[i]);
@@ -431,18 +435,16 @@ void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const st
     }
     for (float& v : spread) v /= static_cast<float>(kLanes) * static_cast<float>(kLanes - 1);
     float* c = &s.volume.probes[static_cast<size_t>(p) * 27];
-    // What a restart moved the probe by, against the noise of the history it replaced.
-    const ProbeHistory before = s.history[p];
+    // What a restart moves the probe by is weighed against the noise of the history it replaces.
     const float lumBefore = coefficientLuminance(c, 0);
+    const float noiseBefore = estimateVariance(s.history[p], 0) * (1.0f / weight + s.history[p].varianceFactor);
     const BlendOutcome outcome = blendEstimate(s.history[p], c, fresh, spread, blend, weight);
-    const bool restartedNow = outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage;
-    stats.restartedProbes += restartedNow ? 1u : 0u;
-    if (restartedNow) {
+    if (outcome == BlendOutcome::Restarted || outcome == BlendOutcome::RestartedFromAverage) {
+      ++stats.restartedProbes;
       const float moved = coefficientLuminance(c, 0) - lumBefore;
-      const float noise = estimateVariance(before, 0) * (1.0f / weight + before.varianceFactor);
       const float strong = 2.0f * s.options.rejectSigmas;
       s.restarted.push_back(p);
-      if (moved * moved > strong * strong * noise) s.strongRestarts.push_back(p);
+      s.restartKind[p] = moved * moved > strong * strong * noiseBefore ? kStrongRestart : kRestart;
     }
     s.volume.noise[p] = historyStandardError(s.history[p]);
   }
@@ -451,40 +453,39 @@ void ProbeUpdater::Impl::blendTraced(const std::vector<uint32_t>& list, const st
 
 void ProbeUpdater::Impl::shortenNeighbours() {
   Impl& s = *this;
+  const uint32_t* n = s.volume.grid.dims;
+  const auto at = [n](uint32_t p) { return std::array<uint32_t, 3>{p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])}; };
+  // Whether another probe of p's 3×3×3 block restarted in this update.
+  const auto anotherAround = [&](uint32_t p) {
+    const std::array<uint32_t, 3> c = at(p);
+    for (uint32_t z = c[2] ? c[2] - 1 : 0; z <= std::min(c[2] + 1, n[2] - 1); ++z)
+      for (uint32_t y = c[1] ? c[1] - 1 : 0; y <= std::min(c[1] + 1, n[1] - 1); ++y)
+        for (uint32_t x = c[0] ? c[0] - 1 : 0; x <= std::min(c[0] + 1, n[0] - 1); ++x) {
+          const uint32_t q = x + n[0] * (y + n[1] * z);
+          if (q != p && s.restartKind[q] != kNoRestart) return true;
+        }
+    return false;
+  };
   if (s.options.neighbourHistory > 0.0f && s.options.rejectSigmas > 0.0f) {
-    const uint32_t* n = s.volume.grid.dims;
     const uint32_t stride[3] = {1, n[0], n[0] * n[1]};
-    std::sort(s.restarted.begin(), s.restarted.end());
-    std::sort(s.strongRestarts.begin(), s.strongRestarts.end());
-    const auto restartedAt = [&](uint32_t q) { return std::binary_search(s.restarted.begin(), s.restarted.end(), q); };
     for (uint32_t p : s.restarted) {
-      const uint32_t at[3] = {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])};
       // Only a restart that moved the probe by twice the rejection threshold, or one another
-      // nearby (its 3×3×3 block) agrees with: noise restarts a probe now and then, alone and
-      // barely past the threshold; a change of the light moves it further, or several together.
-      bool corroborated = false;
-      for (int dz = -1; dz <= 1 && !corroborated; ++dz)
-        for (int dy = -1; dy <= 1 && !corroborated; ++dy)
-          for (int dx = -1; dx <= 1 && !corroborated; ++dx) {
-            const int x = static_cast<int>(at[0]) + dx, y = static_cast<int>(at[1]) + dy, z = static_cast<int>(at[2]) + dz;
-            if ((dx == 0 && dy == 0 && dz == 0) || x < 0 || y < 0 || z < 0 || x >= static_cast<int>(n[0]) ||
-                y >= static_cast<int>(n[1]) || z >= static_cast<int>(n[2]))
-              continue;
-            corroborated = restartedAt(static_cast<uint32_t>(x) + n[0] * (static_cast<uint32_t>(y) + n[1] * static_cast<uint32_t>(z)));
-          }
-      if (!corroborated && !std::binary_search(s.strongRestarts.begin(), s.strongRestarts.end(), p)) continue;
+      // nearby agrees with: noise restarts a probe now and then, alone and barely past the
+      // threshold; a change of the light moves it further, or several together.
+      if (s.restartKind[p] != kStrongRestart && !anotherAround(p)) continue;
+      const std::array<uint32_t, 3> c = at(p);
       for (int axis = 0; axis < 3; ++axis)
         for (int side = -1; side <= 1; side += 2) {
-          if ((side < 0 && at[axis] == 0) || (side > 0 && at[axis] + 1 >= n[axis])) continue;
+          if ((side < 0 && c[axis] == 0) || (side > 0 && c[axis] + 1 >= n[axis])) continue;
           const uint32_t q = side < 0 ? p - stride[axis] : p + stride[axis];
-          if (!s.volume.active[q] || restartedAt(q)) continue;
+          if (!s.volume.active[q] || s.restartKind[q] != kNoRestart) continue;
           shortenHistory(s.history[q], s.options.neighbourHistory);
           s.volume.noise[q] = historyStandardError(s.history[q]);
         }
     }
   }
+  for (uint32_t p : s.restarted) s.restartKind[p] = kNoRestart;
   s.restarted.clear();
-  s.strongRestarts.clear();
 }
 
 void ProbeUpdater::setViewWeights(std::vector<float> weights) {
