@@ -433,7 +433,7 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
   adaptive->add_option("--deadzone", ao->bench.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
   adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
-                       "noise-aware stream: refinements of a brick wait until its last version is this many updates old")
+                       "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")
       ->check(CLI::Range(0u, 100000u));
   adaptive->add_option("--scored-updates", ao->bench.scoredUpdates,
                        "images scored at the last this many updates of each phase (the loss averaged over them)")

@@ -96,8 +96,8 @@ void addServeCommand(CLI::App& app) {
                     "Monte Carlo noise (0 = off; bench adaptive measures 2)")
       ->check(CLI::Range(0.0f, 1000.0f));
   serve->add_option("--refinement-interval", o->refinementInterval,
-                    "with --noise-scale: a brick's refinements (changes within twice the noise threshold) wait until "
-                    "its last version is this many updates old (0 = at once)")
+                    "with --noise-scale: refinements (changes within twice the noise threshold) wait for the next "
+                    "update whose sequence is a multiple of this, every brick's going in that one frame (0 = at once)")
       ->check(CLI::Range(0u, 100000u));
   serve->add_option("--error-bound", o->errorBound,
                     "send each brick in the cheapest of l1, zh3, l2 (up to --repr) that keeps its probes within "

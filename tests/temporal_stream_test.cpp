@@ -173,20 +173,21 @@ TEST(Stream, NoiseRuleStaysDriftFreeOver1000Frames) {
   EXPECT_LT(static_cast<double>(stillBytes) / 100.0 / count, 0.5);
 }
 
-// The noise rule with a refinement interval: a grey probe of c00 = 1 and σ = 0.01 (c = 2, so c·σ =
+// The noise rule with a refinement interval: grey probes of c00 = 1 and σ = 0.01 (c = 2, so c·σ =
 // 0.02). A DC change d moves the irradiance-weighted RMS of withinNoise by d·√(3/7.9375) = 0.615 d
 // (DC weight 1 of 1 + 3·4/9 + 5/16 per channel): d = 0.05 (0.031) is a refinement, beyond c·σ and
-// within 2c·σ; d = 0.1 (0.061) is new light. A refinement waits until the brick's last version is 4
-// updates old; new light goes at once; without an interval both go at once.
+// within 2c·σ; d = 0.1 (0.061) is new light. Two bricks (probe 0 and 1 in brick 0, probe 4 in brick
+// 1). With an interval of 4, refinements wait for update 4 (its frame sequence a multiple of 4) and
+// then both bricks' go in that one frame; new light goes at once. Without an interval all go at once.
 TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
-  const StreamLayout layout = makeLayout(4, 4, 4, Representation::Zh3);
-  const auto frameWith = [](float probe0, float probe1) {
-    std::vector<float> p(64 * kProbeFloats, 0.0f);
-    for (int i = 0; i < 64; ++i)
-      for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = i == 0 ? probe0 : (i == 1 ? probe1 : 1.0f);
+  const StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
+  const auto frameWith = [](float probe0, float probe4, float probe1) {
+    std::vector<float> p(128 * kProbeFloats, 0.0f);
+    for (int i = 0; i < 128; ++i)
+      for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = i == 0 ? probe0 : i == 4 ? probe4 : i == 1 ? probe1 : 1.0f;
     return p;
   };
-  const std::vector<float> noise(64, 0.01f);
+  const std::vector<float> noise(128, 0.01f);
   for (uint32_t interval : {4u, 0u}) {
     EncoderOptions options;
     options.noiseScale = 2.0f;
@@ -194,25 +195,32 @@ TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
     StreamEncoder enc(layout, options);
     StreamDecoder dec(layout);
     std::vector<uint8_t> frame;
-    const auto step = [&](float probe0, float probe1) {
-      enc.update(frameWith(probe0, probe1).data(), nullptr, noise.data());
+    // Returns the bricks given a version (the sections of the frame).
+    const auto step = [&](float probe0, float probe4, float probe1) {
+      const uint32_t changed = enc.update(frameWith(probe0, probe4, probe1).data(), nullptr, noise.data());
       enc.writeChangedFrame(frame);
       EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
       expectSameState(enc, dec, "interval " + std::to_string(interval));
-      return enc.brickVersion(0);
+      return changed;
     };
-    EXPECT_EQ(step(1.0f, 1.0f), 1u);  // update 1: the first version
+    EXPECT_EQ(step(1.0f, 1.0f, 1.0f), 2u);  // update 1: the first versions
     if (interval == 4) {
-      EXPECT_EQ(step(1.05f, 1.0f), 1u);  // update 2: a refinement waits
-      EXPECT_EQ(step(1.05f, 1.0f), 1u);
-      EXPECT_EQ(step(1.05f, 1.0f), 1u);  // update 4: 3 updates since the last version
-      EXPECT_EQ(step(1.05f, 1.0f), 2u);  // update 5: 4 updates, it goes
+      EXPECT_EQ(step(1.05f, 1.0f, 1.0f), 0u);   // update 2: a refinement in brick 0 waits
+      EXPECT_EQ(step(1.05f, 1.05f, 1.0f), 0u);  // update 3: and one in brick 1
+      EXPECT_EQ(enc.brickVersion(0), 1u);
+      EXPECT_EQ(step(1.05f, 1.05f, 1.0f), 2u);  // update 4: both go, in one frame
+      EXPECT_EQ(enc.brickVersion(0), 2u);
+      EXPECT_EQ(enc.brickVersion(1), 2u);
       EXPECT_NEAR(dec.probes()[0], 1.05f, 0.005f);
-      EXPECT_EQ(step(1.05f, 1.1f), 3u);  // new light on probe 1 goes at once
+      EXPECT_NEAR(dec.probes()[4 * kProbeFloats], 1.05f, 0.005f);
+      EXPECT_EQ(step(1.05f, 1.05f, 1.1f), 1u);  // update 5: new light on probe 1 goes at once
     } else {
-      EXPECT_EQ(step(1.05f, 1.0f), 2u);  // the refinement goes at once
-      EXPECT_EQ(step(1.05f, 1.1f), 3u);
+      EXPECT_EQ(step(1.05f, 1.0f, 1.0f), 1u);  // each refinement goes at once
+      EXPECT_EQ(step(1.05f, 1.05f, 1.0f), 1u);
+      EXPECT_EQ(step(1.05f, 1.05f, 1.0f), 0u);
+      EXPECT_EQ(step(1.05f, 1.05f, 1.1f), 1u);
     }
+    EXPECT_EQ(enc.brickVersion(0), 3u);
     EXPECT_NEAR(dec.probes()[kProbeFloats], 1.1f, 0.005f);
   }
 }

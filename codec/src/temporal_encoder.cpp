@@ -24,7 +24,6 @@ struct StreamEncoder::Impl {
   std::vector<uint32_t> versions;
   std::vector<Representation> brickRepr;   // of each brick's current version
   std::vector<uint8_t> deltaIsKeyframe;    // per brick: its latest version changed representation
-  std::vector<uint32_t> lastVersionFrame;  // per brick: the update that made its latest version
   std::vector<Representation> choices;     // brickRepresentations(layout.repr) with an error bound, else the layout's
   std::vector<float> change;
   static constexpr uint32_t kHistory = 16;
@@ -61,7 +60,6 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
   s.versions.assign(bricks, 0);
   s.brickRepr.assign(bricks, layout.repr);
   s.deltaIsKeyframe.assign(bricks, 0);
-  s.lastVersionFrame.assign(bricks, 0);
   s.choices = options.errorBound > 0.0f ? brickRepresentations(layout.repr) : std::vector<Representation>{layout.repr};
   s.change.assign(bricks, 0.0f);
   s.changeHistory.assign(static_cast<size_t>(bricks) * Impl::kHistory, 0.0f);
@@ -192,9 +190,9 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
                 std::memcmp(&s.next[k], &s.base[k], sizeof(ProbeSymbols)) != 0;
     }
     // Refinements alone (changes between c·σ and 2c·σ: the estimate converging, not new light) wait
-    // until the brick's last version is refinementInterval updates old, and then go together.
-    if (changed && !urgent && s.options.refinementInterval > 0 &&
-        s.frame - s.lastVersionFrame[b] < s.options.refinementInterval)
+    // for the next update whose sequence is a multiple of refinementInterval, and then go together,
+    // every brick's in one frame.
+    if (changed && !urgent && s.options.refinementInterval > 0 && s.frame % s.options.refinementInterval != 0)
       changed = false;
     if (!changed) continue;
 
@@ -206,7 +204,6 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
                  s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);
     s.brickRepr[b] = repr;
     s.deltaIsKeyframe[b] = switched ? 1 : 0;
-    s.lastVersionFrame[b] = s.frame;
     s.keyframeValid[b] = 0;
     s.changedThisFrame.push_back(b);
 

@@ -86,9 +86,10 @@ struct EncoderOptions {
   // changes cannot add up past the threshold. 0 = off.
   float noiseScale = 0.0f;
   // With the noise rule: a brick whose changes are all refinements (beyond c·σ but within 2c·σ of
-  // what the decoder holds: the estimate converging, not new light) gets a new version only when
-  // its last one is at least this many updates old, the refinements then going together. A change
-  // beyond 2c·σ, a probe switching on or off, or one without noise goes at once. 0 = off.
+  // what the decoder holds: the estimate converging, not new light) gets a new version only on an
+  // update whose frame sequence is a multiple of this, so each brick's refinements go together and
+  // every brick's in the same frame (one frame header, not one per brick). A change beyond 2c·σ, a
+  // probe switching on or off, or one without noise goes at once. 0 = off.
   uint32_t refinementInterval = 0;
   // Per-brick representation: > 0 sends each brick in the cheapest of brickRepresentations(repr)
   // whose relative irradiance error against the input, over the brick's active probes, stays within
