@@ -3,6 +3,7 @@
 // budget is the plain update bit for bit.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -220,6 +221,49 @@ TEST(NeighbourHistory, AShortenedHistoryWeighsTheNextEstimateAsAfterNOfThem) {
   EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f * 64.0f / 81.0f + 1.0f / 81.0f);  // (1 - w)² f + w²
   shortenHistory(h, 20.0f);
   EXPECT_FLOAT_EQ(h.n, 9.0f);
+}
+
+TEST(HistoryRejection, ABrightEstimateFollowedByANormalOneIsBlendedInTwoThatAgreeRestart) {
+  // A history of 50 estimates alternating 0.9 and 1.1 in every coefficient (σ = 0.1, the spread
+  // saying the same), k = 4. One estimate 12σ bright (2.2) is held back; the next is normal (1.0):
+  // their mean (1.6) is 6σ off, but the normal one does not lean its way, so both are blended in
+  // (the history, worth 52 estimates, is their plain mean) and nothing restarts. Two estimates
+  // 6σ off (1.6, 1.6) are a jump: held, then restarted from their mean, worth 2.
+  const auto filled = [](float v) {
+    std::array<float, 27> a;
+    a.fill(v);
+    return a;
+  };
+  const float spread[kHistoryLuma] = {0.01f, 0.01f, 0.01f, 0.01f};
+  const HistoryOptions rule{0.0f, 4.0f};
+  struct After {
+    BlendOutcome first, second;
+    float n, value;
+  };
+  // Two estimates, `a` then `b`, into a converged history of 1.
+  const auto after = [&](float a, float b) {
+    ProbeHistory h;
+    float probe[27] = {};
+    for (int k = 0; k < 50; ++k) blendEstimate(h, probe, filled(k % 2 ? 1.1f : 0.9f).data(), spread, rule);
+    EXPECT_NEAR(probe[0], 1.0f, 1e-5f);
+    EXPECT_FLOAT_EQ(h.n, 50.0f);
+    After r{};
+    r.first = blendEstimate(h, probe, filled(a).data(), spread, rule);
+    r.second = blendEstimate(h, probe, filled(b).data(), spread, rule);
+    r.n = h.n;
+    r.value = probe[0];
+    return r;
+  };
+  const After outlier = after(2.2f, 1.0f);
+  EXPECT_EQ(outlier.first, BlendOutcome::Held);
+  EXPECT_EQ(outlier.second, BlendOutcome::Accumulated);
+  EXPECT_FLOAT_EQ(outlier.n, 52.0f);
+  EXPECT_NEAR(outlier.value, (50.0f + 2.2f + 1.0f) / 52.0f, 1e-5f);  // the plain mean of all 52
+  const After jump = after(1.6f, 1.6f);
+  EXPECT_EQ(jump.first, BlendOutcome::Held);
+  EXPECT_EQ(jump.second, BlendOutcome::Restarted);
+  EXPECT_FLOAT_EQ(jump.n, 2.0f);
+  EXPECT_FLOAT_EQ(jump.value, 1.6f);
 }
 
 }  // namespace

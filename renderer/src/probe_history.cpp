@@ -88,6 +88,21 @@ bool disagree(const ProbeHistory& h, const float a[27], const float b[27], float
   return false;
 }
 
+// True when `next` departs from `history` the way `held` did: in some luminance where `held` is off
+// the history, `next` is off it to the same side by more than k standard errors, the difference
+// having variance σ² · factor. A bright path now and then is not followed by another.
+bool confirms(const ProbeHistory& h, const float held[27], const float next[27], const float history[27], float factor,
+              float k) {
+  for (int c = 0; c < kHistoryLuma; ++c) {
+    const float base = coefficientLuminance(history, c);
+    const float a = coefficientLuminance(held, c) - base, b = coefficientLuminance(next, c) - base;
+    const float floor = kRelativeFloor * std::fabs(coefficientLuminance(history, 0));
+    const float variance = estimateVariance(h, c) * factor + floor * floor;
+    if (a * b > 0.0f && b * b > k * k * variance) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 float coefficientLuminance(const float probe[27], int coefficient) {
@@ -130,7 +145,8 @@ BlendOutcome blendEstimate(ProbeHistory& h, float probe[27], const float estimat
     const float both = held.weight + weight;
     float pair[27];  // their weighted mean, of variance σ² / both
     for (int i = 0; i < 27; ++i) pair[i] = (held.weight * held.value[i] + weight * estimate[i]) / both;
-    if (disagree(h, pair, probe, 1.0f / both + h.varianceFactor, k)) {
+    if (disagree(h, pair, probe, 1.0f / both + h.varianceFactor, k) &&
+        confirms(h, held.value, estimate, probe, 1.0f / weight + h.varianceFactor, 0.5f * k)) {
       restart(h, probe, pair, both, {held, fresh});
       return BlendOutcome::Restarted;
     }

@@ -4,7 +4,10 @@
 // estimate's independent partial sums, an estimate of its variance. Path-traced estimates have a
 // heavy tail (a bright path now and then), so one disagreeing estimate only raises suspicion: it
 // is held back, and the history restarts when the mean of it and the next estimate disagrees too
-// (an outlier followed by a normal estimate is blended in as usual, keeping the mean unbiased). The history keeps, for the
+// and the next one, on its own, is off the history to the same side by more than k/2 standard
+// errors. An outlier followed by a normal estimate is blended in as usual, keeping the mean
+// unbiased: a mean of the two alone would restart on any outlier of about 1.5k or more, and did, on
+// about one probe in 500 an update with the light still. The history keeps, for the
 // luminance of c00 and of the three L1 coefficients, a Welford mean and sum of squares of the
 // per-update estimates since its last restart; their variance σ² (pooled with the within-update
 // estimate, which is all there is right after a restart) sets the standard error of the history,
