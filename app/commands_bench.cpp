@@ -425,9 +425,14 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_option("--still", ao->bench.stillUpdates, "updates of each still phase")->check(CLI::Range(8u, 100000u));
   adaptive->add_option("--moving", ao->bench.movingUpdates, "updates with the light moving")->check(CLI::Range(1u, 100000u));
   adaptive->add_option("--light-step", ao->bench.lightStep, "t the light moves per update")->check(CLI::Range(0.0f, 1.0f));
+  adaptive->add_option("--seed", ao->bench.seed, "seed of the traced rules' updaters (the spread between seeds is the bench's own noise)");
   adaptive->add_option("--reject-sigmas", ao->bench.rejectSigmas, "k of the adaptive rule")->check(CLI::Range(0.5f, 1000.0f));
   adaptive->add_option("--neighbour-history", ao->bench.neighbourHistory,
                        "adaptive rule: neighbours of a restarted probe keep at most this many updates of history (0 = off)")
+      ->check(CLI::Range(0.0f, 1e6f));
+  adaptive->add_option("--change-history", ao->bench.changeHistory,
+                       "adaptive rule: when the scene changes, every probe keeps at most this many updates of history "
+                       "(0 = off)")
       ->check(CLI::Range(0.0f, 1e6f));
   adaptive->add_option("--w-mins", ao->bench.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
   adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));

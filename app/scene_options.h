@@ -159,6 +159,7 @@ struct TracerOptions {
   float wMin = 0.05f;
   float rejectSigmas = 4.0f;
   float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;
+  float changeHistory = renderer::UpdaterOptions{}.changeHistory;
   float clamp = 16.0f;
   bool relocate = true;
   uint64_t raysPerUpdate = 0;
@@ -178,6 +179,10 @@ struct TracerOptions {
                     "the neighbours of a probe whose history restarts keep at most this many updates of theirs (0 = "
                     "off)")
         ->check(CLI::Range(0.0f, 1e6f));
+    cmd->add_option("--change-history", changeHistory,
+                    "when the scene's lights, materials or geometry change, every probe keeps at most this many "
+                    "updates of history (0 = off)")
+        ->check(CLI::Range(0.0f, 1e6f));
     cmd->add_option("--clamp", clamp, "max luminance of an indirect contribution (0 = off)")->check(CLI::Range(0.0f, 1e9f));
     cmd->add_flag("--relocate,!--no-relocate", relocate,
                   "move probes inside or too close to geometry (up to 45 % of a cell per axis) instead of only "
@@ -191,6 +196,7 @@ struct TracerOptions {
     o.minBlendWeight = wMin;
     o.rejectSigmas = rejectSigmas;
     o.neighbourHistory = neighbourHistory;
+    o.changeHistory = changeHistory;
     o.indirectClamp = clamp;
     o.relocate = relocate;
     o.raysPerUpdate = raysPerUpdate;

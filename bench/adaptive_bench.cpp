@@ -59,6 +59,7 @@ void addReconvergence(renderer::VulkanContext& context, const AdaptiveBenchOptio
   ro.viewYfov = o.viewYfov;
   ro.rejectSigmas = o.rejectSigmas;
   ro.neighbourHistory = o.neighbourHistory;
+  ro.changeHistory = o.changeHistory;
   ro.afterUpdates = o.reconvergenceUpdates;
   const ReconvergenceResult rc = measureReconvergence(context, ro);
   r.json["reconvergence"] = rc.json();
@@ -122,6 +123,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   };
   // The truth at every t a scored update has: the view of a converged float volume.
   std::map<float, renderer::Image> truthImages;
+  std::map<float, std::vector<float>> truthProbes;  // and the converged volume itself
   for (const Moment& m : moments)
     for (uint32_t f = m.first; f <= m.frame; ++f) {
       const float t = tAt(f);
@@ -134,6 +136,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       renderer::ProbeUpdater u(context, sceneAt(t), grid, ro);
       for (int k = 0; k < 16; ++k) u.update();
       truthImages.emplace(t, render(u.volume(), t));
+      truthProbes.emplace(t, u.volume().probes);
     }
 
   AdaptiveBenchResult r;
@@ -143,14 +146,17 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["scene"] = first.name;
   j["grid"] = {o.dims[0], o.dims[1], o.dims[2]};
   j["samples_per_probe"] = o.samplesPerProbe;
+  j["seed"] = o.seed;
   j["phases"] = {{"still", o.stillUpdates}, {"moving", o.movingUpdates}, {"still_again", o.stillUpdates},
                  {"light_step_t", o.lightStep}};
   j["representation"] = representationName(o.repr);
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
   j["refinement_interval"] = o.refinementInterval;
+  j["change_history"] = o.changeHistory;
   j["metric"] = "flicker: median relative irradiance change per update over the last half of a still phase; PSNR of "
-                "the raster view against the one from a converged float volume (plain gamma 2.2)";
+                "the raster view against the one from a converged float volume (plain gamma 2.2); probe error: relative "
+                "irradiance RMSE of the held volume against that converged volume";
   std::string& table = r.table;
   table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", first.name, o.dims[0],
                       o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
@@ -169,9 +175,11 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     say(fmt::format("adaptive bench: {}", ruleName(rule)));
     renderer::UpdaterOptions uo;
     uo.samplesPerProbe = o.samplesPerProbe;
+    uo.seed = o.seed;
     uo.minBlendWeight = rule.wMin;
     uo.rejectSigmas = rule.rejectSigmas;
     uo.neighbourHistory = rule.rejectSigmas > 0 ? o.neighbourHistory : 0.0f;
+    uo.changeHistory = rule.rejectSigmas > 0 ? o.changeHistory : 0.0f;
     renderer::ProbeUpdater u(context, first, grid, uo);
     std::vector<Stream> streams(3);
     streams[0].name = "full";  // every quantised change
@@ -189,6 +197,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     nlohmann::json ruleJson = {{"rule", ruleName(rule)}, {"w_min", rule.wMin}, {"reject_sigmas", rule.rejectSigmas}};
     // psnr[stream][moment]: one value per scored update.
     std::vector<std::vector<std::vector<double>>> psnr(streams.size(), std::vector<std::vector<double>>(moments.size()));
+    // probeError[stream][moment]: the held volume's relative irradiance RMSE against the converged one.
+    std::vector<std::vector<std::vector<double>>> probeError = psnr;
     std::vector<uint8_t> frame;
     for (uint32_t f = 0; f < frames; ++f) {
       if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) u.setScene(sceneAt(tAt(f)));
@@ -214,6 +224,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
           ProbeVolume held;
           streams[k].encoder->copyVolume(grid.bounds, held);
           const renderer::Image img = render(held, tAt(f));
+          probeError[k][m].push_back(irradianceRmseRel(held.probes.data(), truthProbes.at(tAt(f)).data(),
+                                                       held.active.data(), count));
           psnr[k][m].push_back(imaging::compareImages(img.rgb, truthImages.at(tAt(f)).rgb,
                                                       static_cast<int>(o.width), static_cast<int>(o.height))
                                    .psnrDb);
@@ -252,6 +264,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         for (double x : loss) var += (x - meanLoss) * (x - meanLoss);
         const double se = loss.size() > 1 ? std::sqrt(var / static_cast<double>(loss.size() - 1) / static_cast<double>(loss.size())) : 0.0;
         sj["psnr_db"][moments[m].name] = mean(mine, 0, mine.size());
+        sj["probe_error_rel"][moments[m].name] = mean(probeError[k][m], 0, probeError[k][m].size());
         sj["psnr_loss_db"][moments[m].name] = meanLoss;
         sj["psnr_loss_standard_error_db"][moments[m].name] = se;
         worstLoss = std::max(worstLoss, meanLoss);

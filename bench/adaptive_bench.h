@@ -20,11 +20,13 @@ struct AdaptiveBenchOptions {
   std::string sceneSpec = "builtin:cornell";  // an animated scene: t moves its light
   std::array<uint32_t, 3> dims = {4, 4, 4};
   uint32_t samplesPerProbe = 32;
+  uint32_t seed = renderer::UpdaterOptions{}.seed;  // of the traced rules' updaters (not the converged truth)
   uint32_t stillUpdates = 96;        // light still at t = 0 (then the same after moving)
   uint32_t movingUpdates = 32;       // light moving by lightStep of t per update
   float lightStep = 0.004f;
   float rejectSigmas = 4.0f;         // the adaptive rule (w_min = 0)
   float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;  // and its UpdaterOptions::neighbourHistory
+  float changeHistory = renderer::UpdaterOptions{}.changeHistory;        // and UpdaterOptions::changeHistory
   std::vector<float> fixedWMins = {0.02f, 0.05f, 0.25f};  // the fixed rules compared
   float noiseScale = 2.0f;           // the noise-aware stream's c
   uint32_t refinementInterval = 0;   // and its EncoderOptions::refinementInterval

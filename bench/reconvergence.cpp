@@ -54,6 +54,7 @@ ReconvergenceResult measureReconvergence(renderer::VulkanContext& context, const
   bo.minBlendWeight = 0.0f;
   bo.rejectSigmas = o.rejectSigmas;
   bo.neighbourHistory = o.neighbourHistory;
+  bo.changeHistory = o.changeHistory;
   renderer::ProbeUpdater brute(context, before, grid, bo);
   ReconvergenceResult r;
   const ProbeVolume& bv = brute.volume();

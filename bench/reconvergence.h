@@ -26,6 +26,7 @@ struct ReconvergenceOptions {
   uint32_t afterUpdates = 160;     // updates measured after the jump to t = 0.5
   float rejectSigmas = 4.0f;       // both (w_min 0)
   float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;  // both
+  float changeHistory = renderer::UpdaterOptions{}.changeHistory;        // both
 };
 
 struct ReconvergenceResult {

@@ -278,11 +278,24 @@ struct ProbeUpdater::Impl {
   void blendTraced(const std::vector<uint32_t>& list, const std::vector<uint32_t>& traced, UpdateStats& stats);
   // UpdaterOptions::neighbourHistory for the probes restarted by this update.
   void shortenNeighbours();
+  // What lights the scene besides its geometry, as of the last setScene (UpdaterOptions::changeHistory).
+  std::vector<scene::Light> lights;
+  std::vector<scene::Material> materials;
+  std::vector<uint32_t> triangleMaterial;
   void setGeometry(const scene::Scene& s) {
     uploadGpuScene(*d, s, gpu);
     markClientLit(s);
     geometryPositions = s.positions;
     geometryIndices = s.indices;
+  }
+  // Whether `s` lights the probes differently from the scene last set (its geometry aside), and
+  // keeps what it would compare next time.
+  bool shadingChanged(const scene::Scene& s) {
+    const bool changed = s.lights != lights || s.materials != materials || s.triangleMaterial != triangleMaterial;
+    lights = s.lights;
+    materials = s.materials;
+    triangleMaterial = s.triangleMaterial;
+    return changed;
   }
 };
 
@@ -298,6 +311,7 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   s.volume = makeProbeVolume(grid);
   s.volume.samplesPerProbe = s.samples;
   s.history.assign(grid.count(), ProbeHistory{});
+  s.shadingChanged(scene);
   s.age.assign(grid.count(), 0u);
   s.lastSamples.assign(grid.count(), 0u);
   createRayTracingPass(*s.d, kProbeTraceRgen, sizeof kProbeTraceRgen, sizeof(PtPushConstants), s.pass);
@@ -334,6 +348,7 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
   Impl& s = *impl_;
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   const bool geometryChanged = scene.positions != s.geometryPositions || scene.indices != s.geometryIndices;
+  const bool shadingChanged = s.shadingChanged(scene);
   if (geometryChanged) {
     s.setGeometry(scene);
     s.classify();
@@ -341,6 +356,10 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
     uploadGpuShading(*s.d, scene, s.gpu);
     s.markClientLit(scene);
   }
+  // The light may have changed anywhere: no probe's history older than changeHistory updates is
+  // trusted. Restarts alone would follow only changes a probe can tell from its noise.
+  if ((geometryChanged || shadingChanged) && s.options.changeHistory > 0.0f && s.options.rejectSigmas > 0.0f)
+    for (ProbeHistory& h : s.history) shortenHistory(h, s.options.changeHistory);
 }
 
 UpdateStats ProbeUpdater::update() {

@@ -46,6 +46,12 @@ struct UpdaterOptions {
   // threshold), its grid neighbours (one step along an axis) keep at most this many updates'
   // worth of history, so they follow a change they cannot yet tell from their own noise; 0 = off.
   float neighbourHistory = 8.0f;
+  // With rejection: when setScene changes what lights the probes (its geometry, lights, materials
+  // or which material each triangle has; textures are not compared), every probe keeps at most
+  // this many updates' worth of history (as above: its value and variance stay, the
+  // next estimates weigh in as after that many), so the volume follows a light that moves by less
+  // than its noise per update instead of averaging the light's path; 0 = off.
+  float changeHistory = 8.0f;
   uint32_t seed = 1;
   bool classify = true;            // mark probes inside geometry inactive
   uint32_t classifySamples = 64;

@@ -24,6 +24,7 @@ struct TextureTransform {
   glm::vec3 row0{1.0f, 0.0f, 0.0f};
   glm::vec3 row1{0.0f, 1.0f, 0.0f};
   uint32_t texCoord = 0;  // 0 or 1
+  bool operator==(const TextureTransform&) const = default;
 };
 
 struct Material {
@@ -50,6 +51,7 @@ struct Material {
   bool transmissive() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }
   // Rays must look at the material per hit (cut-outs or transmission).
   bool opaqueToRays() const { return alphaMode == AlphaMode::Opaque && !(transmission > 0.0f); }
+  bool operator==(const Material&) const = default;
 };
 
 // An sRGB-encoded RGBA8 image (glTF base colour and emissive textures are sRGB; alpha is linear),
@@ -72,6 +74,7 @@ struct Light {
   float range = 0.0f;  // 0 = unlimited
   float innerConeAngle = 0.0f;
   float outerConeAngle = 0.7853982f;
+  bool operator==(const Light&) const = default;
 };
 
 struct Camera {
