@@ -88,9 +88,9 @@ bool disagree(const ProbeHistory& h, const float a[27], const float b[27], float
   return false;
 }
 
-// True when `next` departs from `history` the way `held` did: in some luminance where `held` is off
-// the history, `next` is off it to the same side by more than k standard errors, the difference
-// having variance σ² · factor. A bright path now and then is not followed by another.
+// True when `next` departs from `history` the way `held` did: in some luminance, `next` is off the
+// history to the same side as `held` and by more than k standard errors, the difference having
+// variance σ² · factor. A bright path now and then is not followed by another.
 bool confirms(const ProbeHistory& h, const float held[27], const float next[27], const float history[27], float factor,
               float k) {
   for (int c = 0; c < kHistoryLuma; ++c) {
