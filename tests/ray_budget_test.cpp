@@ -182,16 +182,22 @@ TEST_F(RayBudget, AnAbsurdBudgetIsCappedAndBadViewWeightsAreRefused) {
   EXPECT_EQ(u.update().paths, static_cast<uint64_t>(st.activeProbes) * 8u * 32u);
 }
 
+// A probe (or estimate) with every coefficient `v`, and the spread and plain rule the blend tests use.
+std::array<float, 27> filled(float v) {
+  std::array<float, 27> a;
+  a.fill(v);
+  return a;
+}
+constexpr float kSpread[kHistoryLuma] = {0.04f, 0.04f, 0.04f, 0.04f};  // σ = 0.2 per estimate
+constexpr HistoryOptions kPlain{0.0f, 0.0f};                             // no floor, no rejection
+
 TEST(RayBudgetBlend, AnEstimateCountsAsItsSamplesOverTheNominal) {
   // A plain mean (no floor, no rejection): one estimate of weight 1, then one of weight 3, is the
   // history (a + 3b) / 4 worth 4 updates, of variance σ²/4.
   ProbeHistory h;
-  float probe[27] = {}, a[27], b[27];
-  for (int i = 0; i < 27; ++i) a[i] = 1.0f, b[i] = 2.0f;
-  const float spread[kHistoryLuma] = {0.04f, 0.04f, 0.04f, 0.04f};
-  const HistoryOptions plain{0.0f, 0.0f};
-  blendEstimate(h, probe, a, spread, plain, 1.0f);
-  blendEstimate(h, probe, b, spread, plain, 3.0f);
+  float probe[27] = {};
+  blendEstimate(h, probe, filled(1.0f).data(), kSpread, kPlain, 1.0f);
+  blendEstimate(h, probe, filled(2.0f).data(), kSpread, kPlain, 3.0f);
   EXPECT_FLOAT_EQ(probe[0], 1.75f);
   EXPECT_FLOAT_EQ(h.n, 4.0f);
   EXPECT_FLOAT_EQ(h.varianceFactor, 0.25f);
@@ -203,11 +209,8 @@ TEST(NeighbourHistory, AShortenedHistoryWeighsTheNextEstimateAsAfterNOfThem) {
   // (only the weights to come change). One already shorter than the cap, and a cap of 0, leave it
   // as it is.
   ProbeHistory h;
-  float probe[27] = {}, one[27], ten[27];
-  for (int i = 0; i < 27; ++i) one[i] = 1.0f, ten[i] = 10.0f;
-  const float spread[kHistoryLuma] = {0.04f, 0.04f, 0.04f, 0.04f};
-  const HistoryOptions plain{0.0f, 0.0f};
-  for (int k = 0; k < 100; ++k) blendEstimate(h, probe, one, spread, plain, 1.0f);
+  float probe[27] = {};
+  for (int k = 0; k < 100; ++k) blendEstimate(h, probe, filled(1.0f).data(), kSpread, kPlain, 1.0f);
   EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f);
   ProbeHistory same = h;
   shortenHistory(same, 0.0f);
@@ -216,7 +219,7 @@ TEST(NeighbourHistory, AShortenedHistoryWeighsTheNextEstimateAsAfterNOfThem) {
   EXPECT_FLOAT_EQ(h.n, 8.0f);
   EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f);
   EXPECT_FLOAT_EQ(probe[0], 1.0f);  // its value stays
-  blendEstimate(h, probe, ten, spread, plain, 1.0f);
+  blendEstimate(h, probe, filled(10.0f).data(), kSpread, kPlain, 1.0f);
   EXPECT_FLOAT_EQ(probe[0], 2.0f);  // 1 + (10 - 1) / 9
   EXPECT_FLOAT_EQ(h.varianceFactor, 0.01f * 64.0f / 81.0f + 1.0f / 81.0f);  // (1 - w)² f + w²
   shortenHistory(h, 20.0f);
@@ -229,11 +232,6 @@ TEST(HistoryRejection, ABrightEstimateFollowedByANormalOneIsBlendedInTwoThatAgre
   // their mean (1.6) is 6σ off, but the normal one does not lean its way, so both are blended in
   // (the history, worth 52 estimates, is their plain mean) and nothing restarts. Two estimates
   // 6σ off (1.6, 1.6) are a jump: held, then restarted from their mean, worth 2.
-  const auto filled = [](float v) {
-    std::array<float, 27> a;
-    a.fill(v);
-    return a;
-  };
   const float spread[kHistoryLuma] = {0.01f, 0.01f, 0.01f, 0.01f};
   const HistoryOptions rule{0.0f, 4.0f};
   struct After {
