@@ -156,7 +156,7 @@ struct TracerOptions {
   uint32_t spp = 128;
   uint32_t bounces = 4;
   uint32_t seed = 1;
-  float wMin = 0.05f;
+  float wMin = renderer::UpdaterOptions{}.minBlendWeight;
   float rejectSigmas = 4.0f;
   float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;
   float changeHistory = renderer::UpdaterOptions{}.changeHistory;
@@ -170,7 +170,7 @@ struct TracerOptions {
                     "32; at most 8x --spp per probe (a larger budget is capped); 0 = every probe traces --spp");
     cmd->add_option("--bounces", bounces, "surface interactions per path")->check(CLI::Range(1, 16));
     cmd->add_option("--seed", seed, "random seed (same seed, same result)");
-    cmd->add_option("--w-min", wMin, "minimum temporal blend weight (0: a true mean until the history is rejected)")
+    cmd->add_option("--w-min", wMin, "minimum temporal blend weight (0: a true mean until the history restarts or the scene changes)")
         ->check(CLI::Range(0.0f, 1.0f));
     cmd->add_option("--reject-sigmas", rejectSigmas,
                     "restart a probe's history when new estimates differ by more than this many standard errors (0 = never)")

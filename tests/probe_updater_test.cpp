@@ -306,7 +306,7 @@ TEST_F(Updater, StillProbeErrorFallsAsOneOverRootN) {
   const std::vector<float> reference = convergedProbes(*context_, s, g);
   UpdaterOptions o;
   o.samplesPerProbe = 32;
-  o.minBlendWeight = 0.0f;  // a true mean (the default keeps a floor)
+  // The default blend (w_min 0): a true mean until the history restarts.
   ProbeUpdater u(*context_, s, g, o);
   std::vector<std::pair<double, double>> at;
   uint32_t restarts = 0;
@@ -442,7 +442,7 @@ TEST_F(Updater, StillVolumeIsRarelyResent) {
   const ProbeGrid g = sceneGrid(s, {4, 4, 4});
   UpdaterOptions o;
   o.samplesPerProbe = 32;
-  o.minBlendWeight = 0.0f;  // a true mean, whose stated noise keeps falling (the default keeps a floor)
+  // The default blend (w_min 0): a true mean, whose stated noise keeps falling.
   ProbeUpdater u(*context_, s, g, o);
   const StreamLayout layout = streamLayoutFor(g, Representation::Zh3, 4);
   EncoderOptions withNoise;

@@ -37,7 +37,9 @@ struct UpdaterOptions {
   uint32_t samplesPerProbe = 128;  // rounded up to a multiple of 32; with a budget, one update's worth in the blend
   uint32_t maxBounces = 4;         // surface interactions per path
   float indirectClamp = 16.0f;     // max luminance of one contribution after the first bounce; 0 = off
-  float minBlendWeight = 0.05f;    // w_min of the temporal blend (0: a true mean until rejected)
+  // w_min of the temporal blend, w = max(1/n, w_min); 0: a true mean until the history restarts or
+  // the scene changes (changeHistory), so a still probe's noise keeps falling as 1/√n.
+  float minBlendWeight = 0.0f;
   // History rejection: restart a probe whose new estimate (or short moving average) differs from
   // its history by more than this many standard errors of the difference; 0 = off (plain blend).
   float rejectSigmas = 4.0f;
