@@ -25,6 +25,10 @@ void addDemoCommand(CLI::App& app) {
   demo->add_option("--light-field", o->lightField, "the light-field display's view set (lf:NxM or lfh:NxM)");
   demo->add_option("--settle-updates", o->settleUpdates, "updates with the light frozen before the comparison")
       ->check(CLI::Range(1, 10000));
+  demo->add_option("--noise-scale", o->noiseScale,
+                   "as serve: a probe is not re-sent while its change stays within this many standard errors of its "
+                   "Monte Carlo noise (0 = off)")
+      ->check(CLI::Range(0.0f, 1000.0f));
   addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
   addVisibilityOption(demo, o->visibility);
   demo->add_option("--supersample", o->supersample,

@@ -77,13 +77,16 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
                     commandLine(), report["wall_seconds"].get<double>(), device);
   md += fmt::format(
       "A server path-traces {} into {}x{}x{} probes ({} samples per probe per update, median "
-      "{:.0f} ms per update) while its light circles, and streams them as `{}`. A stereo headset "
+      "{:.0f} ms per update) while its light circles, and streams them as `{}`{}. A stereo headset "
       "and a {} light-field display subscribe over gRPC, re-render each time new lighting arrives "
       "(direct light locally at the light's current position, indirect light from the probes they "
       "hold), and after {:.0f} s the light stops, the probes settle for {} updates, and every view "
       "is compared with the reference path tracer ({} samples per pixel).\n\n",
       report["scene"].get<std::string>(), report["grid"][0].get<int>(), report["grid"][1].get<int>(),
-      report["grid"][2].get<int>(), o.spp, report["update_ms_median"].get<double>(), o.repr, o.lightField,
+      report["grid"][2].get<int>(), o.spp, report["update_ms_median"].get<double>(), o.repr,
+      o.noiseScale > 0.0f ? fmt::format(" (a probe is re-sent only beyond {:g} standard errors of its noise)", o.noiseScale)
+                          : std::string(),
+      o.lightField,
       report["stream_seconds"].get<double>(), o.settleUpdates, o.referenceSpp);
   md +=
       "| viewer | views | size | budget | frames | renders | ms/view | bytes/s while moving | PSNR dB (mean) | SSIM "
@@ -262,6 +265,7 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
   report["scene"] = run.scene0.name;
   report["grid"] = {run.grid.dims[0], run.grid.dims[1], run.grid.dims[2]};
   report["representation"] = o.repr;
+  report["noise_scale"] = o.noiseScale;
   report["environment"] = !o.environment.file.empty() ? nlohmann::json(o.environment.file)
                           : !o.environment.sky.empty() ? nlohmann::json({{"sky", o.environment.sky}})
                                                        : nlohmann::json(nullptr);

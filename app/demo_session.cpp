@@ -37,8 +37,9 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   run.scene0 = session::loadSceneOrThrow(o.scene, 0.0f);
   run.grid = o.grid.resolve(run.scene0);
   run.serverContext = std::make_unique<renderer::VulkanContext>(renderer::ContextOptions{});
-  run.producer = std::make_unique<session::ProbeProducer>(
-      service::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1));
+  service::HubConfig hub = service::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1);
+  hub.encoder.noiseScale = o.noiseScale;
+  run.producer = std::make_unique<session::ProbeProducer>(hub);
   renderer::UpdaterOptions uo;
   uo.samplesPerProbe = o.spp;
   uo.environment = o.sky;

@@ -36,3 +36,12 @@ if(EXTRA MATCHES "--sky")
     message(FATAL_ERROR "the report does not name the sky it ran under: ${noSky}")
   endif()
 endif()
+if(EXTRA MATCHES "--noise-scale")
+  # The hub's noise rule: stated in both reports, and the viewers still end holding the server's
+  # volume bit for bit (checked above), since what is not re-sent is what the hub holds too.
+  string(JSON scale GET "${json}" noise_scale)
+  file(READ ${WORK}/report.md md)
+  if(NOT scale EQUAL 2 OR NOT md MATCHES "re-sent only beyond 2 standard errors")
+    message(FATAL_ERROR "the report does not state the noise rule it ran under (noise_scale ${scale})")
+  endif()
+endif()
