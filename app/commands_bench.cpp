@@ -455,6 +455,9 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_option("--reconvergence-updates", ao->bench.reconvergenceUpdates,
                        "updates measured after the re-convergence jump")
       ->check(CLI::Range(1u, 100000u));
+  adaptive->add_option("--reconvergence-seeds", ao->bench.reconvergenceSeeds,
+                       "seeds the re-convergence is measured with (--seed, --seed + 1, ...); the summary is their median")
+      ->check(CLI::Range(1u, 1000u));
   adaptive->callback([ao] {
     bench::AdaptiveBenchOptions o = ao->bench;
     o.dims = {ao->grid.dims[0], ao->grid.dims[1], ao->grid.dims[2]};

@@ -43,6 +43,9 @@ struct AdaptiveBenchOptions {
   float viewYfov = 0.03f;            // the viewer whose probes are scored (builtin:cornell 4³: 16 of 64 probes)
   bool reconvergenceOnly = false;    // measure only that
   uint32_t reconvergenceUpdates = 160;  // updates measured after its jump (brute force needs over 100)
+  // Seeds it is measured with (seed, seed + 1, ...): one jump's ratio is a first passage of a noisy
+  // error curve, so the summary takes the median over these.
+  uint32_t reconvergenceSeeds = 5;
 
   renderer::ContextOptions context;
   std::string command;

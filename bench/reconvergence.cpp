@@ -55,6 +55,7 @@ ReconvergenceResult measureReconvergence(renderer::VulkanContext& context, const
   bo.rejectSigmas = o.rejectSigmas;
   bo.neighbourHistory = o.neighbourHistory;
   bo.changeHistory = o.changeHistory;
+  bo.seed = o.seed;
   renderer::ProbeUpdater brute(context, before, grid, bo);
   ReconvergenceResult r;
   const ProbeVolume& bv = brute.volume();

@@ -27,6 +27,7 @@ struct ReconvergenceOptions {
   float rejectSigmas = 4.0f;       // both (w_min 0)
   float neighbourHistory = renderer::UpdaterOptions{}.neighbourHistory;  // both
   float changeHistory = renderer::UpdaterOptions{}.changeHistory;        // both
+  uint32_t seed = 1;                                                      // both updaters'
 };
 
 struct ReconvergenceResult {
