@@ -432,6 +432,35 @@ TEST_F(Updater, SettingTheSameSceneAgainChangesNothing) {
   EXPECT_EQ(alone.volume().noise, reset.volume().noise);
 }
 
+TEST_F(Updater, ChangedTexturesReachTheTracer) {
+  // Every material of the box takes its base colour from one 1×1 texture; setScene turns it from
+  // white to dark grey, positions, indices and materials unchanged. 16 updates later the volume is
+  // that of a fresh updater of the dark box (up to noise), far from the white box's. (Before, a
+  // setScene without new geometry uploaded only lights and materials: the tracer kept the white
+  // texture, and a material naming a texture the device lacked read past the texture table.)
+  Scene white = cornellAt(0.0f);
+  white.textures = {scene::Texture{1, 1, {255, 255, 255, 255}}};
+  for (scene::Material& m : white.materials) m.baseColorTexture = 0;
+  Scene dark = white;
+  dark.textures[0].rgba = {40, 40, 40, 255};
+  const ProbeGrid g = sceneGrid(white, {3, 3, 3});
+  UpdaterOptions o;
+  o.samplesPerProbe = 64;
+  ProbeUpdater fresh(*context_, dark, g, o), u(*context_, white, g, o);
+  for (int k = 0; k < 16; ++k) fresh.update();
+  for (int k = 0; k < 8; ++k) u.update();
+  const std::vector<float> whiteProbes = u.volume().probes;
+  u.setScene(dark);
+  for (int k = 0; k < 16; ++k) u.update();
+  const std::vector<float>& darkProbes = fresh.volume().probes;
+  const uint8_t* active = fresh.volume().active.data();
+  const double before = bench::irradianceRmseRel(whiteProbes.data(), darkProbes.data(), active, g.count());
+  const double after = bench::irradianceRmseRel(u.volume().probes.data(), darkProbes.data(), active, g.count());
+  std::printf("against a fresh dark box: white %.4f, after the texture changed %.4f\n", before, after);
+  EXPECT_GT(before, 0.2);
+  EXPECT_LT(after, 0.25 * before);
+}
+
 TEST_F(Updater, StillVolumeIsRarelyResent) {
   // The light still: what changes from update to update is noise the updater states, so an
   // encoder with a noise scale makes new brick versions only now and then, while one without

@@ -93,6 +93,40 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+TEST(RasterClient, ShadingWithOtherTexturesDrawsThem) {
+  // The box's materials take their base colour from one 1×1 texture, white; setShading with it dark
+  // grey (same geometry and probes) must darken the directly lit picture: the raster draws the
+  // texture it was given last, as a fresh renderer of the dark box does, bit for bit. The same
+  // texture again changes nothing; other geometry is refused.
+  VulkanContext context(test::validatedContext());
+  scene::Scene white = test::builtinScene("cornell", 0.0f);
+  white.textures = {scene::Texture{1, 1, {255, 255, 255, 255}}};
+  for (scene::Material& m : white.materials) m.baseColorTexture = 0;
+  scene::Scene dark = white;
+  dark.textures[0].rgba = {40, 40, 40, 255};
+  const ProbeVolume v = onceUpdatedProbes(context, white, 4, 32);
+  const CameraView cam = CameraView::fromScene(white);
+  const auto meanOf = [](const Image& i) {
+    double sum = 0;
+    for (float x : i.rgb) sum += x;
+    return sum / static_cast<double>(i.rgb.size());
+  };
+  RasterRenderer raster(context, white, 32, 24), fresh(context, dark, 32, 24);
+  raster.setProbes(v);
+  fresh.setProbes(v);
+  const Image before = raster.render(raster.viewProjection(cam), cam.position);
+  raster.setShading(dark);
+  const Image after = raster.render(raster.viewProjection(cam), cam.position);
+  EXPECT_EQ(after.rgb, fresh.render(fresh.viewProjection(cam), cam.position).rgb);
+  EXPECT_LT(meanOf(after), 0.5 * meanOf(before));
+  raster.setShading(dark);
+  EXPECT_EQ(raster.render(raster.viewProjection(cam), cam.position).rgb, after.rgb);
+  scene::Scene moved = dark;
+  moved.positions.push_back(glm::vec3(0.0f));
+  EXPECT_THROW(raster.setShading(moved), std::invalid_argument);
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
 TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
   VulkanContext context(test::validatedContext());
   const scene::Scene s = test::builtinScene("cornell", 0.0f);

@@ -1,5 +1,6 @@
 #include "gpu_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -14,7 +15,11 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   destroyBuffer(d, g.lights);
   g.triangleMaterial = createBufferWithData(d, s.triangleMaterial.data(), s.triangleMaterial.size() * 4, kStorage);
   std::vector<shaders::PtMaterial> mats;
-  const auto textureIndex = [&](int32_t t) { return t >= 0 && t < static_cast<int32_t>(s.textures.size()) ? t : -1; };
+  // Against the textures on the device: a scene whose textures changed without uploadGpuSurfaces
+  // must not send a shader past them.
+  const auto textureIndex = [&](int32_t t) {
+    return t >= 0 && t < static_cast<int32_t>(std::min<size_t>(s.textures.size(), g.textureCount)) ? t : -1;
+  };
   const auto rows = [](const scene::TextureTransform& t, shaders::vec4& row0, shaders::vec4& row1) {
     row0 = {t.row0.x, t.row0.y, t.row0.z, static_cast<float>(t.texCoord)};
     row1 = {t.row1.x, t.row1.y, t.row1.z, 0.0f};
@@ -100,10 +105,25 @@ void uploadGpuEnvironment(VulkanDevice& d, const Environment* env, bool sampling
   g.environmentData = createBufferWithData(d, data.data(), data.size() * sizeof(float), kStorage);
 }
 
+bool SurfaceRecord::changedBy(const scene::Scene& s) {
+  if (s.normals == normals && s.texcoords == texcoords && s.texcoords1 == texcoords1 && s.textures == textures)
+    return false;
+  normals = s.normals;
+  texcoords = s.texcoords;
+  texcoords1 = s.texcoords1;
+  textures = s.textures;
+  return true;
+}
+
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
-  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   if (g.accel.tlas.handle) destroySceneAccel(d, g.accel);
   buildSceneAccel(d, s, g.accel);
+  uploadGpuSurfaces(d, s, g);
+  if (!g.environment.buffer) uploadGpuEnvironment(d, nullptr, false, g);
+}
+
+void uploadGpuSurfaces(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
+  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   for (Buffer* b : {&g.normals, &g.texcoords, &g.texels, &g.textures}) destroyBuffer(d, *b);
   std::vector<glm::vec3> normals = s.normals;
   normals.resize(s.positions.size(), glm::vec3(0.0f));  // 0: the shader uses the geometric normal
@@ -125,8 +145,8 @@ void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   }
   g.texels = createBufferWithData(d, texels.data(), texels.size() * 4, kStorage);
   g.textures = createBufferWithData(d, infos.data(), infos.size() * sizeof(shaders::PtTexture), kStorage);
+  g.textureCount = static_cast<uint32_t>(infos.size());
   uploadGpuShading(d, s, g);
-  if (!g.environment.buffer) uploadGpuEnvironment(d, nullptr, false, g);
 }
 
 void destroyGpuScene(VulkanDevice& d, GpuScene& g) {

@@ -1,6 +1,8 @@
 // A scene on the device: acceleration structures plus the shading buffers the raygens read.
 #pragma once
 
+#include <vector>
+
 #include "probecast/renderer/environment.h"
 #include "probecast/scene/scene.h"
 #include "vk_acceleration.h"
@@ -20,11 +22,25 @@ struct GpuScene {
   Buffer environment;       // PtEnvironment
   Buffer environmentData;   // radiance, row CDF, column CDFs (PT_BINDING_ENV_DATA)
   uint32_t lightCount = 0;
+  uint32_t textureCount = 0;  // in `textures`: a material's texture index beyond them reads none
   uint32_t emitterCount = 0;
   float emitterPower = 0.0f;
 };
 
-void uploadGpuScene(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);  // geometry + shading
+// The surfaces (normals, texture coordinates, textures) a GpuScene was last given, to tell whether
+// an animated scene needs uploadGpuSurfaces again.
+struct SurfaceRecord {
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> texcoords, texcoords1;
+  std::vector<scene::Texture> textures;
+  // Whether `s` has other surfaces than the record; the record becomes `s`'s.
+  bool changedBy(const scene::Scene& s);
+};
+
+void uploadGpuScene(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);  // geometry + surfaces + shading
+// The vertices' normals and texture coordinates and the textures (same positions and indices),
+// then the shading.
+void uploadGpuSurfaces(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);
 void uploadGpuShading(VulkanDevice& d, const scene::Scene& scene, GpuScene& out);  // materials, lights only
 // The environment the ray-tracing passes see (none when `env` is null or empty); `sampling`:
 // next-event estimation importance-samples it. uploadGpuScene starts with none.

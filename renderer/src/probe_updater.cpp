@@ -288,6 +288,7 @@ struct ProbeUpdater::Impl {
     geometryPositions = s.positions;
     geometryIndices = s.indices;
   }
+  SurfaceRecord surfaces;  // as of the last setScene
   // Whether `s` lights the probes differently from the scene last set (its geometry aside), and
   // keeps what it would compare next time.
   bool shadingChanged(const scene::Scene& s) {
@@ -312,6 +313,7 @@ ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, co
   s.volume.samplesPerProbe = s.samples;
   s.history.assign(grid.count(), ProbeHistory{});
   s.shadingChanged(scene);
+  s.surfaces.changedBy(scene);
   s.age.assign(grid.count(), 0u);
   s.lastSamples.assign(grid.count(), 0u);
   createRayTracingPass(*s.d, kProbeTraceRgen, sizeof kProbeTraceRgen, sizeof(PtPushConstants), s.pass);
@@ -348,17 +350,22 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
   Impl& s = *impl_;
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   const bool geometryChanged = scene.positions != s.geometryPositions || scene.indices != s.geometryIndices;
+  const bool surfacesChanged = s.surfaces.changedBy(scene);
   const bool shadingChanged = s.shadingChanged(scene);
   if (geometryChanged) {
     s.setGeometry(scene);
     s.classify();
+  } else if (surfacesChanged) {
+    uploadGpuSurfaces(*s.d, scene, s.gpu);
+    s.markClientLit(scene);
   } else {
     uploadGpuShading(*s.d, scene, s.gpu);
     s.markClientLit(scene);
   }
   // The light may have changed anywhere: no probe's history older than changeHistory updates is
   // trusted. Restarts alone would follow only changes a probe can tell from its noise.
-  if ((geometryChanged || shadingChanged) && s.options.changeHistory > 0.0f && s.options.rejectSigmas > 0.0f)
+  if ((geometryChanged || surfacesChanged || shadingChanged) && s.options.changeHistory > 0.0f &&
+      s.options.rejectSigmas > 0.0f)
     for (ProbeHistory& h : s.history) shortenHistory(h, s.options.changeHistory);
 }
 

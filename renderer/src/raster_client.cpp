@@ -140,6 +140,8 @@ struct RasterRenderer::Impl {
   VulkanDevice* d = nullptr;
   RasterOptions options;
   RasterTimings timings;
+  SurfaceRecord surfaces;  // as uploaded last
+  size_t vertexCount = 0;
   uint32_t width = 0, height = 0, chunk = 1;  // of the targets: samplesPerSide × the images' size
   GpuScene gpu;
   GpuImage color, depth;  // `chunk` layers each
@@ -447,6 +449,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.sceneMin = scene.boundsMin;
   s.sceneMax = scene.boundsMax;
   uploadGpuScene(d, scene, s.gpu);
+  s.surfaces.changedBy(scene);
+  s.vertexCount = scene.positions.size();
   s.indexCount = static_cast<uint32_t>(scene.indices.size());
   s.drawnOpaque = scene::leadingTrianglesBelowClass(scene, 2);
   s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {s.width, s.height}, s.chunk,
@@ -599,10 +603,11 @@ void RasterRenderer::setProbes(const ProbeVolume& volume) {
 
 void RasterRenderer::setShading(const scene::Scene& scene) {
   Impl& s = *impl_;
-  if (scene.triangleMaterial.size() != s.indexCount / 3)
+  if (scene.triangleMaterial.size() != s.indexCount / 3 || scene.positions.size() != s.vertexCount)
     throw std::invalid_argument("setShading needs the same geometry (" + scene.name + " differs)");
   vkDeviceWaitIdle(s.d->device);
-  uploadGpuShading(*s.d, scene, s.gpu);
+  if (s.surfaces.changedBy(scene)) uploadGpuSurfaces(*s.d, scene, s.gpu);  // and the shading
+  else uploadGpuShading(*s.d, scene, s.gpu);
   s.push.lightCount = s.gpu.lightCount;
   planShadowMaps(*s.d, scene, s.shadows);
   s.planAreaLights(scene);

@@ -48,8 +48,9 @@ struct UpdaterOptions {
   // threshold), its grid neighbours (one step along an axis) keep at most this many updates'
   // worth of history, so they follow a change they cannot yet tell from their own noise; 0 = off.
   float neighbourHistory = 8.0f;
-  // With rejection: when setScene changes what lights the probes (its geometry, lights, materials
-  // or which material each triangle has; textures are not compared), every probe keeps at most
+  // With rejection: when setScene changes what lights the probes (its geometry, normals, texture
+  // coordinates, textures, lights, materials or which material each triangle has; the environment
+  // is fixed at construction), every probe keeps at most
   // this many updates' worth of history (as above: its value and variance stay, the
   // next estimates weigh in as after that many), so the volume follows a light that moves by less
   // than its noise per update instead of averaging the light's path; 0 = off.
@@ -112,8 +113,9 @@ class ProbeUpdater {
   ProbeUpdater(const ProbeUpdater&) = delete;
   ProbeUpdater& operator=(const ProbeUpdater&) = delete;
 
-  // The animated scene: lights and materials are re-uploaded; changed geometry rebuilds the
-  // acceleration structures and reclassifies the probes.
+  // The animated scene: lights and materials are re-uploaded; changed normals, texture coordinates
+  // or textures are uploaded again; changed geometry (positions, indices) rebuilds the acceleration
+  // structures and reclassifies the probes.
   void setScene(const scene::Scene& scene);
   UpdateStats update();
   // How much each probe (grid order) matters to viewers, in [0, 1]: 1 inside some subscriber's

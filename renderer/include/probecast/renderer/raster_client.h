@@ -107,7 +107,8 @@ class RasterRenderer {
   static uint32_t visibilityMapTexels();
   // The host copy of a probe's moments (E[r], E[r²]) toward `dir`, metres (nearest texel).
   glm::vec2 probeMoments(uint32_t probe, const glm::vec3& dir) const;
-  // The same geometry with new lights or materials (an animated scene); shadows are redrawn.
+  // The same geometry with new lights, materials, normals, texture coordinates or textures (an
+  // animated scene); shadows are redrawn.
   void setShading(const scene::Scene& scene);
   // The same, with client area lights by other options (those a stream's probes were made with:
   // RasterOptions::areaLights from now on).

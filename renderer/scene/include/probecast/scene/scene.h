@@ -61,6 +61,7 @@ struct Texture {
   uint32_t width = 0;
   uint32_t height = 0;
   std::vector<uint8_t> rgba;
+  bool operator==(const Texture&) const = default;
 };
 
 enum class LightType : uint32_t { Point = 0, Spot = 1, Directional = 2 };
