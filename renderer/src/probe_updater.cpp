@@ -355,11 +355,9 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
   if (geometryChanged) {
     s.setGeometry(scene);
     s.classify();
-  } else if (surfacesChanged) {
-    uploadGpuSurfaces(*s.d, scene, s.gpu);
-    s.markClientLit(scene);
   } else {
-    uploadGpuShading(*s.d, scene, s.gpu);
+    if (surfacesChanged) uploadGpuSurfaces(*s.d, scene, s.gpu);  // and the shading
+    else uploadGpuShading(*s.d, scene, s.gpu);
     s.markClientLit(scene);
   }
   // The light may have changed anywhere: no probe's history older than changeHistory updates is
