@@ -23,7 +23,10 @@ constexpr float kErrorBound = 0.05f;
 
 StreamLayout fuzzLayout(Representation repr);
 // The base keyframe (mode 1) and a delta that applies to it; `perBrick`: with kErrorBound.
-void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector<uint8_t>& delta, bool perBrick = false);
+// `smallDelta` (when given): another delta on the same keyframe that changes one probe a little, so
+// the seeds hold each of format 3's delta forms (a changed list, one-byte DC differences).
+void baseFrames(Representation repr, std::vector<uint8_t>& keyframe, std::vector<uint8_t>& delta, bool perBrick = false,
+                std::vector<uint8_t>* smallDelta = nullptr);
 void repairChecksums(std::vector<uint8_t>& frame);
 
 }  // namespace probecast::fuzz

@@ -31,8 +31,8 @@ int main(int argc, char** argv) {
   for (int r = 0; r < 5; ++r) {
     const Representation repr = kAllRepresentations[r];
     const std::string name = representationName(repr);
-    std::vector<uint8_t> key, delta;
-    fuzz::baseFrames(repr, key, delta);
+    std::vector<uint8_t> key, delta, small;
+    fuzz::baseFrames(repr, key, delta, false, &small);
     const auto control = [&](uint8_t mode, bool repair) {
       return static_cast<uint8_t>(r | (mode << 3) | (repair ? fuzz::kRepairFlag : 0));
     };
@@ -40,6 +40,8 @@ int main(int argc, char** argv) {
     write(dir, name + "-keyframe-repair", control(fuzz::kFrameFresh, true), key);
     write(dir, name + "-delta", control(fuzz::kFrameOnBase, false), delta);
     write(dir, name + "-delta-repair", control(fuzz::kFrameOnBase, true), delta);
+    write(dir, name + "-small-delta", control(fuzz::kFrameOnBase, false), small);
+    write(dir, name + "-small-delta-repair", control(fuzz::kFrameOnBase, true), small);
     std::vector<uint8_t> record(recordSize(repr));
     float probe[kProbeFloats];
     for (int i = 0; i < kProbeFloats; ++i) probe[i] = 1.0f / static_cast<float>(1 + i);

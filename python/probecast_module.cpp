@@ -177,7 +177,8 @@ PYBIND11_MODULE(probecast, m) {
                         .value("BadVersion", CodecStatus::BadVersion)
                         .value("BadMask", CodecStatus::BadMask)
                         .value("BadSymbol", CodecStatus::BadSymbol)
-                        .value("TrailingBytes", CodecStatus::TrailingBytes);
+                        .value("TrailingBytes", CodecStatus::TrailingBytes)
+                        .value("NonCanonical", CodecStatus::NonCanonical);
   m.attr("PROBE_FLOATS") = kProbeFloats;
   py::list names;
   for (Representation r : kAllRepresentations) names.append(representationName(r));

@@ -162,9 +162,9 @@ TEST_P(MemorySafety, VerifyFrameChecksTheContainerWithoutDecoding) {
   EXPECT_EQ(verifyFrame(longer.data(), longer.size()), CodecStatus::TrailingBytes);
   // The last byte of the first section's data: only that section's CRC can tell.
   std::vector<uint8_t> bad = s.keyframe;
-  const size_t firstEnd = kFrameHeaderSize + kSectionHeaderSize +
-                          (bad[kFrameHeaderSize + 14] | bad[kFrameHeaderSize + 15] << 8 |
-                           bad[kFrameHeaderSize + 16] << 16 | static_cast<size_t>(bad[kFrameHeaderSize + 17]) << 24);
+  SectionBytes first;
+  ASSERT_TRUE(locateSection(bad.data() + kFrameHeaderSize, bad.size() - kFrameHeaderSize, &first));
+  const size_t firstEnd = kFrameHeaderSize + first.dataAt + first.storedSize;
   ASSERT_LE(firstEnd, bad.size());
   bad[firstEnd - 1] = static_cast<uint8_t>(bad[firstEnd - 1] ^ 0x20);
   EXPECT_EQ(verifyFrame(bad.data(), bad.size()), CodecStatus::SectionChecksum);

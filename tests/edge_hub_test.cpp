@@ -6,7 +6,7 @@
 #include <cstring>
 #include <random>
 
-#include "probecast/codec/crc32c.h"
+#include "probecast/codec/internal/frame_checksums.h"
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/service/bus_format.h"
 #include "probecast/service/probe_hub.h"
@@ -64,11 +64,6 @@ uint32_t drain(ProbeHub& hub, uint64_t id, StreamDecoder& dec, uint32_t* section
 
 bool same(const ProbeVolume& a, const float* probes, size_t floats) {
   return a.probes.size() == floats && std::memcmp(a.probes.data(), probes, floats * sizeof(float)) == 0;
-}
-
-uint32_t crc32cOfSection(const std::vector<uint8_t>& section) {
-  const uint32_t header = crc32c(section.data(), 18);
-  return crc32c(section.data() + kSectionHeaderSize, section.size() - kSectionHeaderSize, header);
 }
 
 std::vector<HeldBrick> heldBy(const StreamDecoder& dec) {
@@ -300,13 +295,10 @@ TEST(EdgeHub, AKeyframeThatDoesNotDecodeIsRefusedAndNothingChanges) {
   std::string why;
   ASSERT_TRUE(bus::readMessage(p.messages[seen].data(), p.messages[seen].size(), m, why));
   // A keyframe section whose header and CRC are valid but whose payload is of another size.
-  std::vector<uint8_t> key(m.brick.keyframe.begin(), m.brick.keyframe.end());
-  key.resize(key.size() - 1);
-  const uint32_t stored = static_cast<uint32_t>(key.size() - kSectionHeaderSize);
-  std::memcpy(key.data() + 14, &stored, 4);
-  if (key[9] == 0) std::memcpy(key.data() + 10, &stored, 4);  // raw: its raw size is the stored size
-  uint32_t crc = crc32cOfSection(key);
-  std::memcpy(key.data() + 18, &crc, 4);
+  SectionBytes at;
+  ASSERT_TRUE(locateSection(m.brick.keyframe.data(), m.brick.keyframe.size(), &at));
+  const std::vector<uint8_t> shorter(m.brick.keyframe.begin() + at.dataAt, m.brick.keyframe.end() - 1);
+  const std::vector<uint8_t> key = sealSection(m.brick.brick, m.brick.version, m.brick.keyframe[at.kindAt], shorter);
   bus::Brick bad = m.brick;
   bad.keyframe = key;
   bad.delta = {};

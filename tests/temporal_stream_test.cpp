@@ -251,8 +251,9 @@ std::string hex(const std::vector<uint8_t>& bytes) {
 }
 
 TEST(Stream, GoldenBytes) {
-  // A 2×2×1 grid, one brick, l1, stored raw. Pins the format of CODEC.md §7 byte for byte:
-  // frame 0 keyframe of 4 probes (probe 3 inactive), frame 1 delta of probe 2.
+  // A 2×2×1 grid, one brick, l1, stored raw. Pins the format of stream.h (CODEC.md §7) byte for
+  // byte: frame 0 keyframe of 4 probes (probe 3 inactive), frame 1 delta of probe 2. CRCs are
+  // CRC-32C (crc32c_test pins its known answers).
   // Derivation of the first record: DC (1, 0.5, 0.25) → RGB9E5 0x81010100 (CODEC.md §8.5);
   // R ratio of c11: 0.3 / 1 / √3 · 127 = 22.0 → 0x16; G ratio of c10: 0.2 / 0.5 / √3 · 127 = 29.3 → 0x1d.
   const StreamLayout layout = makeLayout(2, 2, 1, Representation::L1, 2);
@@ -265,9 +266,9 @@ TEST(Stream, GoldenBytes) {
   enc.writeKeyframeFrame(frame);
   const std::string keyframe = hex(frame);
   EXPECT_EQ(keyframe,
-            "50524243" "02" "01" "02" "00" "0200" "0200" "0100" "0000"  // magic, version, l1, brick 2, grid
-            "01000000" "01000000" "3e000000" "3a5ac6e5"                 // frame 1, 1 section, 62 bytes, CRC
-            "00000000" "01000000" "01" "00" "28000000" "28000000" "5a83f9fe"  // brick 0 v1 keyframe raw
+            "50524243" "03" "01" "02" "00" "0200" "0200" "0100" "0000"  // magic, version 3, l1, brick 2, grid
+            "01000000" "01000000" "30000000" "20e9886d"                 // frame 1, 1 section, 48 bytes, CRC
+            "00" "01" "01" "28" "fa37e486"                              // brick 0, v1, keyframe raw, 40 bytes, CRC
             "07"                                                        // active mask: probes 0, 1, 2
             "004080" "010101" "010101" "818181"                         // RGB9E5 bytes 0..3, one plane each
             "000000" "000000" "000000"                                  // c1-1 R, G, B
@@ -279,37 +280,105 @@ TEST(Stream, GoldenBytes) {
   enc.writeChangedFrame(frame);
   ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
   // Delta: probe 2's G c10 ratio goes 0.2/0.5 → 0.1/0.5, symbol 29 → 15, zig-zag(−14) = 27 = 0x1b.
+  // The active set is the base's (no mask), one changed probe of four is a one-byte mask (a list
+  // would take two), and the DC differences fit a byte each.
   const std::string delta = hex(frame);
   EXPECT_EQ(delta,
-            "50524243" "02" "01" "02" "00" "0200" "0200" "0100" "0000"
-            "02000000" "01000000" "27000000" "095e3174"
-            "00000000" "02000000" "02" "00" "11000000" "11000000" "33b2653c"  // brick 0 v2 delta raw
-            "07" "04"                                                   // active mask, changed mask
-            "0000" "0000" "0000"                                        // DC code deltas (lo, hi planes)
-            "000000" "00" "1b" "00" "000000");                          // ratio deltas
-  // The same two frames as format 1 wrote them (pinned when it was current; only the version byte
-  // and the header CRC differ, l1 being unchanged by format 2) still decode, to the same state.
+            "50524243" "03" "01" "02" "00" "0200" "0200" "0100" "0000"
+            "02000000" "01000000" "16000000" "89937a2d"
+            "00" "02" "02" "0e" "b00b5e65"                              // brick 0, v2, delta raw, 14 bytes, CRC
+            "04"                                                        // form: wide differences in one byte
+            "04"                                                        // changed mask: probe 2
+            "00" "00" "00"                                              // DC code differences (low bytes)
+            "000000" "00" "1b" "00" "000000");                          // ratio differences
+  // The same two frames as format 2 wrote them (pinned when it was current: 22-byte section
+  // headers, and a delta with both masks and both bytes of each DC difference) still decode, to the
+  // same state; and as format 1 wrote them (only the version byte and the header CRC differ, l1
+  // being unchanged by format 2).
   const auto bytes = [](const std::string& h) {
     std::vector<uint8_t> out;
     for (size_t i = 0; i + 1 < h.size(); i += 2) out.push_back(static_cast<uint8_t>(std::stoi(h.substr(i, 2), nullptr, 16)));
     return out;
   };
+  const std::string v2KeyframeHex =
+      "50524243" "02" "01" "02" "00" "0200" "0200" "0100" "0000" "01000000" "01000000" "3e000000" "3a5ac6e5"
+      "00000000" "01000000" "01" "00" "28000000" "28000000" "5a83f9fe"  // brick 0 v1 keyframe raw
+      "07" "004080" "010101" "010101" "818181" "000000" "000000" "000000" "000000" "1d1d1d" "000000" "16120f"
+      "000000" "000000";
+  const std::vector<uint8_t> v2Keyframe = bytes(v2KeyframeHex);
+  const std::vector<uint8_t> v2Delta = bytes(
+      "50524243" "02" "01" "02" "00" "0200" "0200" "0100" "0000" "02000000" "01000000" "27000000" "095e3174"
+      "00000000" "02000000" "02" "00" "11000000" "11000000" "33b2653c"  // brick 0 v2 delta raw
+      "07" "04" "0000" "0000" "0000" "000000" "00" "1b" "00" "000000");
+  StreamDecoder second(layout);
+  ASSERT_EQ(second.apply(v2Keyframe.data(), v2Keyframe.size()), CodecStatus::Ok);
+  ASSERT_EQ(second.apply(v2Delta.data(), v2Delta.size()), CodecStatus::Ok);
+  expectSameState(enc, second, "format 2 frames");
   const std::vector<uint8_t> v1Keyframe = bytes(
       "5052424301010200020002000100000001000000010000003e000000596bfa2e0000000001000000010028000000280000005a83f9fe07"
       "0040800101010101018181810000000000000000000000001d1d1d00000016120f000000000000");
   const std::vector<uint8_t> v1Delta = bytes(
       "505242430101020002000200010000000200000001000000270000006a6f0dbf00000000020000000200110000001100000033b2653c07"
       "04000000000000000000001b00000000");
-  EXPECT_EQ(hex(v1Keyframe).substr(10), keyframe.substr(10, 46) + hex(v1Keyframe).substr(56, 8) + keyframe.substr(64));
+  EXPECT_EQ(hex(v1Keyframe).substr(10),
+            v2KeyframeHex.substr(10, 46) + hex(v1Keyframe).substr(56, 8) + v2KeyframeHex.substr(64));
   StreamDecoder old(layout);
   ASSERT_EQ(old.apply(v1Keyframe.data(), v1Keyframe.size()), CodecStatus::Ok);
   ASSERT_EQ(old.apply(v1Delta.data(), v1Delta.size()), CodecStatus::Ok);
   expectSameState(enc, old, "format 1 frames");
 }
 
+// Unsigned LEB128, as stream.h states it; returns the bytes it took.
+size_t getVarintForTest(const uint8_t* p, size_t size, uint32_t* v) {
+  uint32_t value = 0;
+  for (size_t i = 0; i < size && i < 5; ++i) {
+    value |= static_cast<uint32_t>(p[i] & 0x7f) << (7 * i);
+    if (!(p[i] & 0x80)) {
+      *v = value;
+      return i + 1;
+    }
+  }
+  ADD_FAILURE() << "not a varint";
+  return size;
+}
+
+// A frame of raw keyframe sections as formats 1 and 2 spelled it (22-byte section headers; keyframe
+// payloads are the same in every format), with `version` in its header.
+std::vector<uint8_t> asFixedFormat(const std::vector<uint8_t>& frame, uint8_t version) {
+  std::vector<uint8_t> out(frame.begin(), frame.begin() + kFrameHeaderSize);
+  out[4] = version;
+  size_t at = kFrameHeaderSize;
+  const auto put32 = [&out](uint32_t v) {
+    for (int b = 0; b < 4; ++b) out.push_back(static_cast<uint8_t>(v >> (8 * b)));
+  };
+  while (at < frame.size()) {
+    SectionBytes b;
+    EXPECT_TRUE(locateSection(frame.data() + at, frame.size() - at, &b));
+    const uint8_t kind = frame[at + b.kindAt];
+    EXPECT_EQ(kind & 0x0f, 1) << "keyframes only";
+    EXPECT_EQ(kind & 0x04, 0) << "raw sections only";
+    uint32_t brick = 0, brickVersion = 0;
+    const size_t n = getVarintForTest(frame.data() + at, b.kindAt, &brick);
+    getVarintForTest(frame.data() + at + n, b.kindAt - n, &brickVersion);
+    put32(brick);
+    put32(brickVersion);
+    out.push_back(kind);
+    out.push_back(0);  // raw
+    put32(b.storedSize);
+    put32(b.storedSize);
+    put32(0);  // CRC, below
+    out.insert(out.end(), frame.begin() + at + b.dataAt, frame.begin() + at + b.dataAt + b.storedSize);
+    at += b.dataAt + b.storedSize;
+  }
+  const uint32_t sectionBytes = static_cast<uint32_t>(out.size() - kFrameHeaderSize);
+  for (int b = 0; b < 4; ++b) out[24 + b] = static_cast<uint8_t>(sectionBytes >> (8 * b));
+  rewriteFrameChecksums(out);
+  return out;
+}
+
 // Format 1 zh3h frames decode as format 1 meant them: every probe hallucinates, whatever the
-// parity of its L1 bytes; the same sections under a format 2 header decode per probe as chosen.
-// Versions outside 1..2 are refused.
+// parity of its L1 bytes; the same sections in a format 2 or 3 frame decode per probe as chosen.
+// Versions outside 1..3 are refused.
 TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
   const StreamLayout layout = makeLayout(4, 4, 4, Representation::Zh3Hallucinated);
   std::mt19937 rng(21);
@@ -318,13 +387,19 @@ TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
     const test::Probe q = test::randomNonNegativeProbe(rng, 1 + p % 3, 0.05f);
     probes.insert(probes.end(), q.begin(), q.end());
   }
-  StreamEncoder enc(layout);
+  EncoderOptions raw;
+  raw.compress = false;
+  StreamEncoder enc(layout, raw);
   enc.update(probes.data(), nullptr);
   std::vector<uint8_t> frame;
   enc.writeKeyframeFrame(frame);
   StreamDecoder current(layout);
   ASSERT_EQ(current.apply(frame.data(), frame.size()), CodecStatus::Ok);
-  expectSameState(enc, current, "format 2");
+  expectSameState(enc, current, "format 3");
+  const std::vector<uint8_t> v2 = asFixedFormat(frame, 2);
+  StreamDecoder second(layout);
+  ASSERT_EQ(second.apply(v2.data(), v2.size()), CodecStatus::Ok);
+  expectSameState(enc, second, "format 2");
   const auto withVersion = [&frame](uint8_t version) {
     std::vector<uint8_t> f = frame;
     f[4] = version;
@@ -332,7 +407,7 @@ TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
     for (int b = 0; b < 4; ++b) f[28 + b] = static_cast<uint8_t>(crc >> (8 * b));
     return f;
   };
-  const std::vector<uint8_t> v1 = withVersion(1);
+  const std::vector<uint8_t> v1 = asFixedFormat(frame, 1);
   StreamDecoder old(layout);
   ASSERT_EQ(old.apply(v1.data(), v1.size()), CodecStatus::Ok);
   int plainL1 = 0;
@@ -345,10 +420,132 @@ TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
     for (int k = 0; k < kProbeFloats; ++k) ASSERT_EQ(old.probes()[p * kProbeFloats + k], expected[k]) << p << "," << k;
   }
   EXPECT_GT(plainL1, 0);  // format 2 kept some probes at plain L1, which format 1 hallucinates
-  for (uint8_t version : {uint8_t{0}, uint8_t{3}}) {
+  for (uint8_t version : {uint8_t{0}, uint8_t{4}}) {
     const std::vector<uint8_t> f = withVersion(version);
     StreamDecoder dec(layout);
     EXPECT_EQ(dec.apply(f.data(), f.size()), CodecStatus::UnsupportedVersion) << int(version);
+  }
+}
+
+// Format 3 spells a delta in its shortest form (stream.h): the active mask only when it changed,
+// the changed probes as a list when that is shorter than a mask (bricks of at most 256 probes), the
+// DC differences in one byte when they fit. Each form round-trips; any other spelling of the same
+// change, and a varint header number not in its shortest form, is refused and changes nothing.
+TEST(Stream, Format3DeltaFormsRoundTripAndOnlyTheShortestIsRead) {
+  for (const uint8_t brickDim : {uint8_t{4}, uint8_t{8}}) {  // 64 probes (8 mask bytes); 512 (64, no lists)
+    SCOPED_TRACE(testing::Message() << "brick " << int(brickDim));
+    const StreamLayout layout = makeLayout(brickDim, brickDim, brickDim, Representation::L1, brickDim);
+    const uint32_t n = probeCount(layout), mbytes = n / 8;
+    EncoderOptions options;
+    options.compress = false;
+    StreamEncoder enc(layout, options);
+    StreamDecoder dec(layout);
+    std::vector<float> probes(n * kProbeFloats, 0.0f);
+    for (uint32_t p = 0; p < n; ++p) {
+      probes[p * kProbeFloats + 0] = probes[p * kProbeFloats + 1] = probes[p * kProbeFloats + 2] = 1.0f;
+      probes[p * kProbeFloats + 9] = 0.2f;
+    }
+    std::vector<uint8_t> active(n, 1), frame;
+    enc.update(probes.data(), active.data());
+    enc.writeKeyframeFrame(frame);
+    ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+    // The form byte of each delta, and the decoder's state after it.
+    const auto step = [&]() {
+      EXPECT_EQ(enc.update(probes.data(), active.data()), 1u);
+      enc.writeChangedFrame(frame);
+      EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+      expectSameState(enc, dec, "after a delta");
+      SectionBytes b;
+      EXPECT_TRUE(locateSection(frame.data() + kFrameHeaderSize, frame.size() - kFrameHeaderSize, &b));
+      return frame[kFrameHeaderSize + b.dataAt];
+    };
+    const bool lists = n <= 256;
+    probes[5 * kProbeFloats + 9] = 0.1f;  // one ratio of probe 5
+    EXPECT_EQ(step(), lists ? 0x06 : 0x04);  // narrow DC; a list of one where a list is allowed
+    const std::vector<uint8_t> oneProbe = frame;
+    for (uint32_t p = 0; p < 12; ++p) probes[p * kProbeFloats + 9] = 0.3f;
+    EXPECT_EQ(step(), 0x04);  // 12 probes: a mask is shorter than 1 + 12 bytes
+    probes[7 * kProbeFloats + 1] = 40.0f;  // G of probe 7's DC: a code difference past one byte
+    EXPECT_EQ(step(), lists ? 0x02 : 0x00);
+    active[9] = 0;
+    EXPECT_EQ(step(), lists ? 0x07 : 0x05);  // the active mask changed: spelled out
+    active[9] = 1;
+    EXPECT_EQ(step(), lists ? 0x03 : 0x01);  // probe 9 back: its DC from black needs both bytes
+
+    // Re-spellings of the one-probe delta (brick 0, version 2 over version 1), each against a
+    // decoder that holds version 1.
+    SectionBytes b;
+    ASSERT_TRUE(locateSection(oneProbe.data() + kFrameHeaderSize, oneProbe.size() - kFrameHeaderSize, &b));
+    const std::vector<uint8_t> data(oneProbe.begin() + kFrameHeaderSize + b.dataAt, oneProbe.end());
+    const auto applied = [&](const std::vector<uint8_t>& section) {
+      StreamEncoder base(layout, options);
+      std::vector<float> first = probes;
+      for (uint32_t p = 0; p < n; ++p) {
+        first[p * kProbeFloats + 1] = 1.0f;
+        first[p * kProbeFloats + 9] = 0.2f;
+      }
+      std::vector<uint8_t> key;
+      base.update(first.data(), nullptr);
+      base.writeKeyframeFrame(key);
+      StreamDecoder fresh(layout);
+      EXPECT_EQ(fresh.apply(key.data(), key.size()), CodecStatus::Ok);
+      std::vector<uint8_t> f;
+      const std::span<const uint8_t> sections[] = {section};
+      writeFrame(layout, 2, sections, f);
+      const CodecStatus st = fresh.apply(f.data(), f.size());
+      if (st != CodecStatus::Ok) {
+        EXPECT_EQ(fresh.brickVersion(0), 1u);  // refused whole
+      }
+      return st;
+    };
+    ASSERT_EQ(applied(sealSection(0, 2, 0x02, data)), CodecStatus::Ok);
+    const std::vector<uint8_t> planes(data.end() - 12, data.end());  // 3 DC low bytes, 9 ratio bytes
+    std::vector<uint8_t> changedMask(mbytes, 0);
+    changedMask[0] = 1 << 5;
+    std::vector<uint8_t> activeAll(mbytes, 0xff);
+    const auto payload = [](std::initializer_list<std::vector<uint8_t>> parts) {
+      std::vector<uint8_t> out;
+      for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+      return out;
+    };
+    // The base's active set spelled out.
+    EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{0x05}, activeAll, changedMask, planes}))),
+              CodecStatus::NonCanonical);
+    // A mask where a list is shorter (brick of 64), or a list where none is allowed (512).
+    if (lists) {
+      EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{0x04}, changedMask, planes}))), CodecStatus::NonCanonical);
+    } else {
+      EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{0x06, 0x01, 0x05}, planes}))), CodecStatus::NonCanonical);
+    }
+    const std::vector<uint8_t> changed = lists ? std::vector<uint8_t>{0x01, 0x05} : changedMask;
+    const uint8_t listBit = lists ? 0x02 : 0x00;
+    // Both bytes of each DC difference, every high byte zero.
+    const std::vector<uint8_t> wide = {planes[0], 0, planes[1], 0, planes[2], 0};
+    const std::vector<uint8_t> ratios(planes.begin() + 3, planes.end());
+    EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{listBit}, changed, wide, ratios}))), CodecStatus::NonCanonical);
+    // An unknown form bit.
+    EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{static_cast<uint8_t>(0x0c | listBit)}, changed, planes}))),
+              CodecStatus::NonCanonical);
+    if (lists) {  // a list that does not increase
+      const std::vector<uint8_t> twice = {0x02, 0x05, 0x05};
+      std::vector<uint8_t> doubled;
+      for (int plane = 0; plane < 12; ++plane) doubled.insert(doubled.end(), 2, planes[plane]);
+      EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{0x06}, twice, doubled}))), CodecStatus::BadMask);
+    }
+    // Header numbers: the brick as two bytes (0x80 0x00) is not its shortest form; cut off it is truncated.
+    ASSERT_LT(data.size(), 128u);
+    std::vector<uint8_t> overlong = {0x80, 0x00, 0x02, 0x02, static_cast<uint8_t>(data.size()), 0, 0, 0, 0};
+    const uint32_t crc = crc32c(data.data(), data.size(), crc32c(overlong.data(), 5));
+    for (int k = 0; k < 4; ++k) overlong[5 + k] = static_cast<uint8_t>(crc >> (8 * k));
+    overlong.insert(overlong.end(), data.begin(), data.end());
+    std::vector<uint8_t> f;
+    const std::span<const uint8_t> sections[] = {overlong};
+    writeFrame(layout, 2, sections, f);
+    StreamDecoder other(layout);
+    EXPECT_EQ(other.apply(f.data(), f.size()), CodecStatus::NonCanonical);
+    const uint8_t cut[] = {0x80};
+    SectionInfo info;
+    EXPECT_EQ(readSection(layout, cut, 1, &info), CodecStatus::Truncated);
   }
 }
 
@@ -428,7 +625,9 @@ TEST(Stream, SectionRepresentationsOutsideTheStreamsAreRefused) {
   std::vector<uint8_t> key;
   enc.writeKeyframeFrame(key);
   // Brick 0's section comes first: its kind byte says keyframe (1) in l1 (1 << 4).
-  const size_t kindAt = kFrameHeaderSize + 8;
+  SectionBytes first;
+  ASSERT_TRUE(locateSection(key.data() + kFrameHeaderSize, key.size() - kFrameHeaderSize, &first));
+  const size_t kindAt = kFrameHeaderSize + first.kindAt;
   ASSERT_EQ(key[kindAt], 0x11);
   const auto refused = [&](uint8_t kind) {
     std::vector<uint8_t> f = key;

@@ -14,6 +14,12 @@ namespace probecast {
 
 constexpr uint8_t kCompressionRaw = 0;
 constexpr uint8_t kCompressionZstd = 1;
+constexpr uint8_t kSectionZstdBit = 0x04;  // format 3 kind byte: the data is a magicless zstd frame
+
+// Format 3 delta payloads open with a form byte (stream.h).
+constexpr uint8_t kDeltaActiveMask = 0x01;   // an active mask follows; without, the base's is kept
+constexpr uint8_t kDeltaChangedList = 0x02;  // changed probes as u8 count + u8 indices, not a mask
+constexpr uint8_t kDeltaNarrowWide = 0x04;   // one byte per wide difference (every zig-zag < 256)
 
 inline uint32_t maskBytes(uint32_t probes) { return (probes + 7) / 8; }
 inline bool maskBit(const uint8_t* mask, uint32_t i) { return (mask[i >> 3] >> (i & 7)) & 1u; }
@@ -33,12 +39,13 @@ size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick);
 // Raw payloads (before compression). `active` has one byte per brick probe (0/1).
 void buildKeyframePayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* symbols,
                           std::vector<uint8_t>& out);
-void buildDeltaPayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* base,
-                       const ProbeSymbols* next, std::vector<uint8_t>& out);
+// A format 3 delta from (baseActive, base) to (active, next).
+void buildDeltaPayload(Representation repr, uint32_t probes, const uint8_t* baseActive, const uint8_t* active,
+                       const ProbeSymbols* base, const ProbeSymbols* next, std::vector<uint8_t>& out);
 
-// Appends section header + (possibly compressed) payload. `zstdContext` is a ZSTD_CCtx*, or null to
-// store the payload raw. `repr` is the brick's representation; it is written into the kind byte
-// when it differs from the stream's (`layoutRepr`).
+// Writes a format 3 section (header + possibly compressed payload) into `out`. `zstdContext` is a
+// ZSTD_CCtx*, or null to store the payload raw. `repr` is the brick's representation; it is written
+// into the kind byte when it differs from the stream's (`layoutRepr`).
 void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representation repr, Representation layoutRepr,
                   const std::vector<uint8_t>& raw, int zstdLevel, void* zstdContext, std::vector<uint8_t>& out);
 
@@ -53,10 +60,10 @@ struct SectionView {
   uint32_t storedSize = 0;
 };
 
-// Parses one section header at data[0..size) and checks its CRC and sizes against the layout.
-// On success *consumed is the section's full length.
-CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
-                         size_t* consumed);
+// Parses one section header of the given format at data[0..size) and checks its CRC and sizes
+// against the layout. On success *consumed is the section's full length.
+CodecStatus parseSection(const StreamLayout& layout, uint8_t formatVersion, const uint8_t* data, size_t size,
+                         SectionView* view, size_t* consumed);
 
 // Parses every section of a frame whose header checked out (`frame` points at the header), in
 // order, handing each to visit(const SectionView&) -> CodecStatus; stops at the first error, its
@@ -68,7 +75,8 @@ CodecStatus forEachSection(const StreamLayout& layout, const uint8_t* frame, con
   for (uint32_t i = 0; i < header.sectionCount; ++i) {
     SectionView view;
     size_t consumed = 0;
-    if (CodecStatus st = parseSection(layout, p, left, &view, &consumed); st != CodecStatus::Ok) return st;
+    if (CodecStatus st = parseSection(layout, header.formatVersion, p, left, &view, &consumed); st != CodecStatus::Ok)
+      return st;
     p += consumed;
     left -= consumed;
     if (CodecStatus st = visit(static_cast<const SectionView&>(view)); st != CodecStatus::Ok) return st;
@@ -76,9 +84,9 @@ CodecStatus forEachSection(const StreamLayout& layout, const uint8_t* frame, con
   return left == 0 ? CodecStatus::Ok : CodecStatus::TrailingBytes;
 }
 
-// Applies a decompressed payload to a brick's symbols. `active`/`symbols` hold the brick's state
-// on entry (the base) and the new state on success. `scratch` avoids allocation.
-CodecStatus applyPayload(Representation repr, uint32_t probes, SectionKind kind, const uint8_t* raw, size_t rawSize,
-                         uint8_t* active, ProbeSymbols* symbols);
+// Applies a decompressed payload of the given format to a brick's symbols. `active`/`symbols` hold
+// the brick's state on entry (the base) and the new state on success.
+CodecStatus applyPayload(uint8_t formatVersion, Representation repr, uint32_t probes, SectionKind kind,
+                         const uint8_t* raw, size_t rawSize, uint8_t* active, ProbeSymbols* symbols);
 
 }  // namespace probecast

@@ -3,11 +3,13 @@
 #include <cassert>
 #include <cstring>
 
+#define ZSTD_STATIC_LINKING_ONLY  // the magicless frame format (stable in the format, "experimental" in the API)
 #include <zstd.h>
 
 #include "brick_section.h"
 #include "byte_io.h"
 #include "probecast/codec/crc32c.h"
+#include "probecast/codec/internal/frame_checksums.h"
 #include "probecast/codec/stream.h"
 
 namespace probecast {
@@ -41,6 +43,7 @@ const char* codecStatusName(CodecStatus status) {
     case CodecStatus::BadMask: return "bad probe mask";
     case CodecStatus::BadSymbol: return "symbol out of range";
     case CodecStatus::TrailingBytes: return "trailing bytes";
+    case CodecStatus::NonCanonical: return "non-canonical encoding";
   }
   return "unknown status";
 }
@@ -211,17 +214,59 @@ void BrickTable::build(const StreamLayout& layout) {
   first[bricks] = at;
 }
 
+bool locateSection(const uint8_t* section, size_t size, SectionBytes* out) {
+  SectionBytes b;
+  uint32_t value = 0;
+  size_t at = 0;
+  for (int field = 0; field < 3; ++field) {  // brick, version, (kind byte), stored size
+    const size_t n = getVarint(section + at, size - at, &value);
+    if (n == 0) return false;
+    at += n;
+    if (field == 1) {
+      if (at >= size) return false;
+      b.kindAt = at++;
+    }
+  }
+  b.storedSize = value;
+  b.crcAt = at;
+  b.dataAt = at + 4;
+  if (b.dataAt > size || value > size - b.dataAt) return false;
+  *out = b;
+  return true;
+}
+
+std::vector<uint8_t> sealSection(uint32_t brick, uint32_t version, uint8_t kindByte, std::span<const uint8_t> data) {
+  std::vector<uint8_t> out;
+  putVarint(out, brick);
+  putVarint(out, version);
+  out.push_back(kindByte);
+  putVarint(out, static_cast<uint32_t>(data.size()));
+  const size_t crcAt = out.size();
+  putU32(out, 0);
+  out.insert(out.end(), data.begin(), data.end());
+  setU32(out.data() + crcAt, crc32c(data.data(), data.size(), crc32c(out.data(), crcAt)));
+  return out;
+}
+
 void rewriteFrameChecksums(std::vector<uint8_t>& f) {
   if (f.size() < kFrameHeaderSize) return;
   setU32(f.data() + 28, crc32c(f.data(), 28));
+  const bool compact = f[4] >= kCompactSectionFormat;
   size_t at = kFrameHeaderSize;
-  while (at + kSectionHeaderSize <= f.size()) {
-    const uint32_t stored = getU32(f.data() + at + 14);
-    if (stored > f.size() - at - kSectionHeaderSize) break;
-    uint32_t crc = crc32c(f.data() + at, 18);
-    crc = crc32c(f.data() + at + kSectionHeaderSize, stored, crc);
-    setU32(f.data() + at + 18, crc);
-    at += kSectionHeaderSize + stored;
+  while (at < f.size()) {
+    SectionBytes b;
+    if (compact) {
+      if (!locateSection(f.data() + at, f.size() - at, &b)) return;
+    } else {
+      if (f.size() - at < kFixedSectionHeaderSize) return;
+      b.crcAt = 18;
+      b.dataAt = kFixedSectionHeaderSize;
+      b.storedSize = getU32(f.data() + at + 14);
+      if (b.storedSize > f.size() - at - b.dataAt) return;
+    }
+    const uint32_t crc = crc32c(f.data() + at + b.dataAt, b.storedSize, crc32c(f.data() + at, b.crcAt));
+    setU32(f.data() + at + b.crcAt, crc);
+    at += b.dataAt + b.storedSize;
   }
 }
 
@@ -229,7 +274,7 @@ size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick) {
   const uint32_t probes = brickProbeCount(layout, brick);
   const SymbolShape shape = symbolShape(layout.repr);
   const size_t perProbe = std::max<size_t>(recordSize(layout.repr), 2u * shape.wide + shape.narrow);
-  return 2u * maskBytes(probes) + probes * perProbe;
+  return 1u + 2u * maskBytes(probes) + probes * perProbe;  // a format 3 delta's form byte, both masks
 }
 
 std::vector<Representation> brickRepresentations(Representation repr) {
@@ -242,55 +287,119 @@ std::vector<Representation> brickRepresentations(Representation repr) {
 
 void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representation repr, Representation layoutRepr,
                   const std::vector<uint8_t>& raw, int zstdLevel, void* zstdContext, std::vector<uint8_t>& out) {
+  // The payload goes first, behind room for the longest header, since the header holds its size.
+  constexpr size_t kRoom = 16;  // three varints of at most 5 bytes and the kind byte
   out.clear();
-  putU32(out, brick);
-  putU32(out, version);
-  const uint8_t reprBits = repr == layoutRepr ? 0 : static_cast<uint8_t>(static_cast<uint8_t>(repr) << 4);
-  out.push_back(static_cast<uint8_t>(static_cast<uint8_t>(kind) | reprBits));
-  out.push_back(kCompressionRaw);
-  putU32(out, static_cast<uint32_t>(raw.size()));
-  putU32(out, 0);  // stored size, patched below
-  putU32(out, 0);  // CRC, patched below
-  const size_t headerEnd = out.size();
-  if (!raw.empty() && zstdContext == nullptr) {
-    out.insert(out.end(), raw.begin(), raw.end());
-  } else if (!raw.empty()) {
+  size_t stored = raw.size();
+  bool zstd = false;
+  if (!raw.empty() && zstdContext != nullptr) {
+    auto* cctx = static_cast<ZSTD_CCtx*>(zstdContext);
+    ZSTD_CCtx_reset(cctx, ZSTD_reset_session_and_parameters);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, zstdLevel);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_format, ZSTD_f_zstd1_magicless);
     const size_t bound = ZSTD_compressBound(raw.size());
-    out.resize(headerEnd + bound);
-    const size_t n = ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstdContext), out.data() + headerEnd, bound,
-                                       raw.data(), raw.size(), zstdLevel);
+    out.resize(kRoom + bound);
+    const size_t n = ZSTD_compress2(cctx, out.data() + kRoom, bound, raw.data(), raw.size());
     if (!ZSTD_isError(n) && n < raw.size()) {
-      out.resize(headerEnd + n);
-      out[9] = kCompressionZstd;
-    } else {
-      out.resize(headerEnd);
-      out.insert(out.end(), raw.begin(), raw.end());
+      stored = n;
+      zstd = true;
     }
   }
-  setU32(out.data() + 14, static_cast<uint32_t>(out.size() - headerEnd));
-  uint32_t crc = crc32c(out.data(), 18);
-  crc = crc32c(out.data() + headerEnd, out.size() - headerEnd, crc);
-  setU32(out.data() + 18, crc);
+  if (!zstd) {
+    out.resize(kRoom + raw.size());
+    if (!raw.empty()) std::memcpy(out.data() + kRoom, raw.data(), raw.size());
+  }
+  out.resize(kRoom + stored);
+  std::vector<uint8_t> header;
+  header.reserve(kRoom);
+  putVarint(header, brick);
+  putVarint(header, version);
+  const uint8_t reprBits = repr == layoutRepr ? 0 : static_cast<uint8_t>(static_cast<uint8_t>(repr) << 4);
+  header.push_back(static_cast<uint8_t>(static_cast<uint8_t>(kind) | (zstd ? kSectionZstdBit : 0) | reprBits));
+  putVarint(header, static_cast<uint32_t>(stored));
+  // Header, then its CRC (of the header and the data), then the data.
+  std::memmove(out.data() + header.size() + 4, out.data() + kRoom, stored);
+  out.resize(header.size() + 4 + stored);
+  std::memcpy(out.data(), header.data(), header.size());
+  uint32_t crc = crc32c(header.data(), header.size());
+  crc = crc32c(out.data() + header.size() + 4, stored, crc);
+  setU32(out.data() + header.size(), crc);
 }
 
-CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionView* view,
-                         size_t* consumed) {
-  if (size < kSectionHeaderSize) return CodecStatus::Truncated;
-  SectionView v;
+namespace {
+
+// Format 1 and 2 sections: a fixed 22-byte header.
+CodecStatus parseFixedSection(const uint8_t* data, size_t size, SectionView& v, uint8_t& kindByte, size_t& headerSize) {
+  if (size < kFixedSectionHeaderSize) return CodecStatus::Truncated;
   v.brick = getU32(data);
   v.version = getU32(data + 4);
-  const uint8_t kind = data[8] & 0x0f, reprCode = data[8] >> 4;
+  kindByte = data[8];
   v.compression = data[9];
   v.rawSize = getU32(data + 10);
   v.storedSize = getU32(data + 14);
-  if (size - kSectionHeaderSize < v.storedSize) return CodecStatus::Truncated;
+  if (size - kFixedSectionHeaderSize < v.storedSize) return CodecStatus::Truncated;
   uint32_t crc = crc32c(data, 18);
-  crc = crc32c(data + kSectionHeaderSize, v.storedSize, crc);
+  crc = crc32c(data + kFixedSectionHeaderSize, v.storedSize, crc);
   if (crc != getU32(data + 18)) return CodecStatus::SectionChecksum;
+  if (v.compression != kCompressionRaw && v.compression != kCompressionZstd) return CodecStatus::BadSectionKind;
+  headerSize = kFixedSectionHeaderSize;
+  return CodecStatus::Ok;
+}
+
+// Format 3 sections: varint brick, version and stored size around the kind byte, then the CRC.
+CodecStatus parseCompactSection(const uint8_t* data, size_t size, SectionView& v, uint8_t& kindByte,
+                                size_t& headerSize) {
+  size_t at = 0;
+  const auto varint = [&](uint32_t* value) {
+    const size_t n = getVarint(data + at, size - at, value);
+    if (n == 0) {  // cut off, or not in its shortest form
+      size_t run = at;
+      while (run < size && run < at + 5 && (data[run] & 0x80)) ++run;
+      return run == size ? CodecStatus::Truncated : CodecStatus::NonCanonical;
+    }
+    at += n;
+    return CodecStatus::Ok;
+  };
+  if (CodecStatus st = varint(&v.brick); st != CodecStatus::Ok) return st;
+  if (CodecStatus st = varint(&v.version); st != CodecStatus::Ok) return st;
+  if (at >= size) return CodecStatus::Truncated;
+  kindByte = data[at++];
+  if (CodecStatus st = varint(&v.storedSize); st != CodecStatus::Ok) return st;
+  if (size - at < 4 || size - at - 4 < v.storedSize) return CodecStatus::Truncated;
+  uint32_t crc = crc32c(data, at);
+  crc = crc32c(data + at + 4, v.storedSize, crc);
+  if (crc != getU32(data + at)) return CodecStatus::SectionChecksum;
+  headerSize = at + 4;
+  v.compression = (kindByte & kSectionZstdBit) ? kCompressionZstd : kCompressionRaw;
+  if (kindByte & 0x08) return CodecStatus::BadSectionKind;
+  kindByte = static_cast<uint8_t>(kindByte & 0xf3);
+  v.rawSize = v.storedSize;
+  if (v.compression == kCompressionZstd) {  // the raw size is the zstd frame's content size
+    ZSTD_frameHeader zh;
+    if (ZSTD_getFrameHeader_advanced(&zh, data + headerSize, v.storedSize, ZSTD_f_zstd1_magicless) != 0 ||
+        zh.frameType != ZSTD_frame || zh.frameContentSize == ZSTD_CONTENTSIZE_UNKNOWN ||
+        zh.frameContentSize > 0xffffffffu)
+      return CodecStatus::DecompressFailed;
+    v.rawSize = static_cast<uint32_t>(zh.frameContentSize);
+  }
+  return CodecStatus::Ok;
+}
+
+}  // namespace
+
+CodecStatus parseSection(const StreamLayout& layout, uint8_t formatVersion, const uint8_t* data, size_t size,
+                         SectionView* view, size_t* consumed) {
+  SectionView v;
+  uint8_t kindByte = 0;
+  size_t headerSize = 0;
+  const CodecStatus parsed = formatVersion >= kCompactSectionFormat
+                                 ? parseCompactSection(data, size, v, kindByte, headerSize)
+                                 : parseFixedSection(data, size, v, kindByte, headerSize);
+  if (parsed != CodecStatus::Ok) return parsed;
   if (v.brick >= brickCount(layout)) return CodecStatus::BadBrickIndex;
+  const uint8_t kind = kindByte & 0x0f, reprCode = kindByte >> 4;
   if (kind != static_cast<uint8_t>(SectionKind::Keyframe) && kind != static_cast<uint8_t>(SectionKind::Delta))
     return CodecStatus::BadSectionKind;
-  if (v.compression != kCompressionRaw && v.compression != kCompressionZstd) return CodecStatus::BadSectionKind;
   v.kind = static_cast<SectionKind>(kind);
   v.repr = layout.repr;
   if (reprCode != 0) {  // one of the stream's cheaper brick representations, never its own spelled out
@@ -302,16 +411,17 @@ CodecStatus parseSection(const StreamLayout& layout, const uint8_t* data, size_t
   }
   if (v.rawSize > maxRawSectionSize(layout, v.brick)) return CodecStatus::SectionTooLarge;
   if (v.compression == kCompressionRaw && v.storedSize != v.rawSize) return CodecStatus::SizeMismatch;
-  v.data = data + kSectionHeaderSize;
+  v.data = data + headerSize;
   *view = v;
-  *consumed = kSectionHeaderSize + v.storedSize;
+  *consumed = headerSize + v.storedSize;
   return CodecStatus::Ok;
 }
 
 CodecStatus readSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionInfo* info) {
   SectionView view;
   size_t consumed = 0;
-  if (CodecStatus st = parseSection(layout, data, size, &view, &consumed); st != CodecStatus::Ok) return st;
+  if (CodecStatus st = parseSection(layout, kFormatVersion, data, size, &view, &consumed); st != CodecStatus::Ok)
+    return st;
   info->brick = view.brick;
   info->version = view.version;
   info->kind = view.kind;

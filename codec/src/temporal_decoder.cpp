@@ -2,6 +2,7 @@
 #include <cassert>
 #include <vector>
 
+#define ZSTD_STATIC_LINKING_ONLY  // the magicless frame format of format 3 sections
 #include <zstd.h>
 
 #include "brick_section.h"
@@ -71,7 +72,7 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
   }
   s.staged.clear();
   const bool zh3hChoice = header.formatVersion >= 2;  // format 1: every zh3h probe hallucinates
-  const CodecStatus parsed = forEachSection(s.layout, data, header, [&s, zh3hChoice](const SectionView& view) {
+  const CodecStatus parsed = forEachSection(s.layout, data, header, [&s, &header, zh3hChoice](const SectionView& view) {
     if (s.seenInFrame[view.brick] == s.stamp) return CodecStatus::DuplicateBrick;
     s.seenInFrame[view.brick] = s.stamp;
 
@@ -83,8 +84,11 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
 
     const uint8_t* raw = view.data;
     if (view.compression == kCompressionZstd) {
-      const unsigned long long content = ZSTD_getFrameContentSize(view.data, view.storedSize);
-      if (content != view.rawSize) return CodecStatus::DecompressFailed;
+      // Format 3 stores magicless zstd frames, whose content size parseSection already read.
+      const bool magicless = header.formatVersion >= kCompactSectionFormat;
+      if (!magicless && ZSTD_getFrameContentSize(view.data, view.storedSize) != view.rawSize)
+        return CodecStatus::DecompressFailed;
+      ZSTD_DCtx_setParameter(s.dctx, ZSTD_d_format, magicless ? ZSTD_f_zstd1_magicless : ZSTD_f_zstd1);
       s.raw.resize(view.rawSize);
       const size_t n = ZSTD_decompressDCtx(s.dctx, s.raw.data(), s.raw.size(), view.data, view.storedSize);
       if (ZSTD_isError(n) || n != view.rawSize) return CodecStatus::DecompressFailed;
@@ -103,7 +107,7 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
       st.active[k] = s.active[s.table.probes[first + k]];
       st.symbols[k] = s.symbols[s.table.probes[first + k]];
     }
-    if (CodecStatus r = applyPayload(view.repr, n, view.kind, raw, view.rawSize, st.active.data(),
+    if (CodecStatus r = applyPayload(header.formatVersion, view.repr, n, view.kind, raw, view.rawSize, st.active.data(),
                                      st.symbols.data());
         r != CodecStatus::Ok)
       return r;

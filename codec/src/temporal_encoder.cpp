@@ -36,7 +36,7 @@ struct StreamEncoder::Impl {
 
   // Scratch, sized for one brick.
   std::vector<ProbeSymbols> base, next;
-  std::vector<uint8_t> nextActive, raw;
+  std::vector<uint8_t> baseActive, nextActive, raw;
   std::vector<ProbeSymbols> candidates;  // per choice × brick probe, with an error bound
 
   // The representation brick `b` is sent in this update (EncoderOptions::errorBound), its probes'
@@ -150,6 +150,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     const uint32_t first = s.table.first[b];
     const uint32_t n = s.table.first[b + 1] - first;
     s.base.resize(n);
+    s.baseActive.resize(n);
     s.next.resize(n);
     s.nextActive.resize(n);
     const Representation repr = s.choices.size() > 1 ? s.chooseRepresentation(b, probes, activeIn) : s.brickRepr[b];
@@ -161,6 +162,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t p = s.table.probes[first + k];
       s.base[k] = s.symbols[p];
+      s.baseActive[k] = s.active[p];
       const bool isActive = activeIn == nullptr || activeIn[p] != 0;
       s.nextActive[k] = isActive ? 1 : 0;
       if (isActive) {
@@ -198,7 +200,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
 
     // A brick that changed representation starts again from a keyframe (no symbol differences across them).
     if (switched) buildKeyframePayload(repr, n, s.nextActive.data(), s.next.data(), s.raw);
-    else buildDeltaPayload(repr, n, s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
+    else buildDeltaPayload(repr, n, s.baseActive.data(), s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
     ++s.versions[b];
     writeSection(b, s.versions[b], switched ? SectionKind::Keyframe : SectionKind::Delta, repr, s.layout.repr, s.raw,
                  s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);

@@ -24,6 +24,7 @@ enum class CodecStatus : int {
   BadMask,              // changed probe that is not active, or stray bits past the brick
   BadSymbol,            // a decoded value outside its domain (DC code, NaN half)
   TrailingBytes,        // bytes after the last section
+  NonCanonical,         // a number or payload form not in the one encoding the format allows
 };
 
 const char* codecStatusName(CodecStatus status);

@@ -14,13 +14,28 @@
 // decoding is bit-identical to the encoder's reconstruction after every frame.
 //
 // Wire format, little-endian. Frame = header (32 bytes) + sections:
-//   header:  magic "PRBC" | u8 formatVersion (2; 1 is read) | u8 representation | u8 brickDim | u8 flags (0)
-//            | u16 nx, ny, nz | u16 reserved (0) | u32 frameSequence | u32 sectionCount
+//   header:  magic "PRBC" | u8 formatVersion (3; 1 and 2 are read) | u8 representation | u8 brickDim
+//            | u8 flags (0) | u16 nx, ny, nz | u16 reserved (0) | u32 frameSequence | u32 sectionCount
 //            | u32 sectionBytes | u32 CRC-32C of the preceding 28 bytes
-//   section: u32 brick | u32 version | u8 kind (bits 0-3: 1 keyframe, 2 delta; bits 4-7: the
-//            brick's representation when it is not the stream's, else 0) | u8 compression (0 raw,
-//            1 zstd) | u32 rawSize | u32 storedSize | u32 CRC-32C of the preceding 18 bytes and
-//            the data | data[storedSize]
+//   section (format 3): varint brick | varint version | u8 kind (bits 0-1: 1 keyframe, 2 delta; bit 2:
+//            the data is zstd-compressed; bit 3: 0; bits 4-7: the brick's representation when it is
+//            not the stream's, else 0) | varint storedSize | u32 CRC-32C of the header bytes before it
+//            and the data | data[storedSize]
+//            Varints are unsigned LEB128 in their shortest form, at most 32 bits. Compressed data is
+//            a zstd frame without its 4-byte magic number that states its content size (the raw size).
+//   payload: keyframe: active mask | byte planes of the active probes' records.
+//            delta (format 3): u8 form | active mask, when form bit 0 (else the base's is kept)
+//            | changed probes: u8 count and that many increasing u8 indices when form bit 1, else a
+//            changed mask | per wide symbol (DC codes; every one in fp16) a plane of the low bytes
+//            of its zig-zag difference and, unless form bit 2, a plane of the high bytes | per narrow
+//            symbol a plane of zig-zag differences. Each choice has one allowed spelling: the active
+//            mask only when it changed, the list only for bricks of at most 256 probes when it is
+//            shorter than the mask (1 + count < mask bytes), bit 2 exactly when every wide
+//            difference fits one byte. Anything else is refused (CodecStatus::NonCanonical).
+// Format 1 and 2 sections: u32 brick | u32 version | u8 kind (bits 0-3: 1 keyframe, 2 delta; bits 4-7
+//            as above) | u8 compression (0 raw, 1 zstd with magic) | u32 rawSize | u32 storedSize
+//            | u32 CRC-32C of the preceding 18 bytes and the data | data; their deltas are active mask
+//            | changed mask | both byte planes of every wide difference | narrow planes.
 // A section is encoded once per brick version; frames for different subscribers reuse the same
 // section bytes and differ only in their header.
 // Format 2 differs from format 1 in what zh3h symbols mean: the parity of each probe's L1 ratio
@@ -28,7 +43,11 @@
 // sent in a cheaper representation (brickRepresentations, EncoderOptions::errorBound), said in its
 // sections' kind byte. A version in another representation than the brick's last is a keyframe
 // (a delta in another representation is refused). A format 1 frame still decodes, every zh3h probe
-// hallucinating as before; a stream without an error bound is otherwise byte-identical.
+// hallucinating as before.
+// Format 3 differs from format 2 only in how sections and deltas are spelled (the varint header,
+// the delta's form byte); what they decode to is the same. A section header is 8 to 10 bytes instead
+// of 22, and a small delta drops its masks and high bytes. Format 1 and 2 frames still decode; a
+// carrier of bare sections (bus, wire) states the codec format and refuses another.
 #pragma once
 
 #include <cstddef>
@@ -43,13 +62,15 @@
 
 namespace probecast {
 
-constexpr uint8_t kFormatVersion = 2;        // what encoders write
-constexpr uint8_t kOldestFormatVersion = 1;  // the oldest a decoder reads
+constexpr uint8_t kFormatVersion = 3;         // what encoders write
+constexpr uint8_t kOldestFormatVersion = 1;   // the oldest a decoder reads
+constexpr uint8_t kCompactSectionFormat = 3;  // the first format with varint section headers and delta forms
 constexpr size_t kFrameHeaderSize = 32;
-constexpr size_t kSectionHeaderSize = 22;
+constexpr size_t kFixedSectionHeaderSize = 22;  // formats 1 and 2
 constexpr int kMaxGridDim = 1024;
 constexpr int kMinBrickDim = 1;
 constexpr int kMaxBrickDim = 8;
+constexpr uint32_t kMaxBrickProbes = kMaxBrickDim * kMaxBrickDim * kMaxBrickDim;
 constexpr uint32_t kMaxProbes = 1u << 24;
 
 enum class SectionKind : uint8_t { Keyframe = 1, Delta = 2 };
