@@ -149,7 +149,8 @@ struct SectionInfo {
 };
 
 // Parses and checks the section at the start of data[0..size) (header fields against the layout,
-// stored size within `size`, CRC-32C), for carriers that hold sections outside a frame. The
+// stored size within `size`, CRC-32C), for carriers that hold sections outside a frame. The section
+// is read as kFormatVersion spells it; carriers state the codec format and refuse another. The
 // payload itself is checked only when a decoder applies it.
 CodecStatus readSection(const StreamLayout& layout, const uint8_t* data, size_t size, SectionInfo* info);
 
