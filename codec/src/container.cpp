@@ -287,8 +287,9 @@ std::vector<Representation> brickRepresentations(Representation repr) {
 
 void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representation repr, Representation layoutRepr,
                   const std::vector<uint8_t>& raw, int zstdLevel, void* zstdContext, std::vector<uint8_t>& out) {
-  // The payload goes first, behind room for the longest header, since the header holds its size.
-  constexpr size_t kRoom = 16;  // three varints of at most 5 bytes and the kind byte
+  // The payload goes first, behind room for the longest header and its CRC, since the header holds
+  // its size; it then moves down to right after the actual header (never up).
+  constexpr size_t kRoom = 20;  // three varints of at most 5 bytes, the kind byte, the CRC
   out.clear();
   size_t stored = raw.size();
   bool zstd = false;
@@ -311,7 +312,7 @@ void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representa
   }
   out.resize(kRoom + stored);
   std::vector<uint8_t> header;
-  header.reserve(kRoom);
+  header.reserve(kRoom - 4);
   putVarint(header, brick);
   putVarint(header, version);
   const uint8_t reprBits = repr == layoutRepr ? 0 : static_cast<uint8_t>(static_cast<uint8_t>(repr) << 4);
