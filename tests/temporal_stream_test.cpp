@@ -430,7 +430,8 @@ TEST(Stream, Format1Zh3hFramesHallucinateEveryProbe) {
 // Format 3 spells a delta in its shortest form (stream.h): the active mask only when it changed,
 // the changed probes as a list when that is shorter than a mask (bricks of at most 256 probes), the
 // DC differences in one byte when they fit. Each form round-trips; any other spelling of the same
-// change, and a varint header number not in its shortest form, is refused and changes nothing.
+// change (a probe listed with nothing changed among them), and a varint header number not in its
+// shortest form, is refused and changes nothing.
 TEST(Stream, Format3DeltaFormsRoundTripAndOnlyTheShortestIsRead) {
   for (const uint8_t brickDim : {uint8_t{4}, uint8_t{8}}) {  // 64 probes (8 mask bytes); 512 (64, no lists)
     SCOPED_TRACE(testing::Message() << "brick " << int(brickDim));
@@ -523,6 +524,10 @@ TEST(Stream, Format3DeltaFormsRoundTripAndOnlyTheShortestIsRead) {
     const std::vector<uint8_t> wide = {planes[0], 0, planes[1], 0, planes[2], 0};
     const std::vector<uint8_t> ratios(planes.begin() + 3, planes.end());
     EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{listBit}, changed, wide, ratios}))), CodecStatus::NonCanonical);
+    // The probe listed with nothing changed: the base state, spelled as a delta that changes it.
+    const std::vector<uint8_t> nothing(planes.size(), 0);
+    EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{static_cast<uint8_t>(0x04 | listBit)}, changed, nothing}))),
+              CodecStatus::NonCanonical);
     // An unknown form bit.
     EXPECT_EQ(applied(sealSection(0, 2, 0x02, payload({{static_cast<uint8_t>(0x0c | listBit)}, changed, planes}))),
               CodecStatus::NonCanonical);

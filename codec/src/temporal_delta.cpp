@@ -220,14 +220,20 @@ CodecStatus applyPayload(uint8_t formatVersion, Representation repr, uint32_t pr
     if (!isActive || !active[i]) symbols[i] = ProbeSymbols{};  // inactive, or newly active from black
     active[i] = isActive ? 1 : 0;
     if (!maskBit(d.changedMask, i)) continue;
+    bool moved = false;
     for (int w = 0; w < shape.wide; ++w) {
       const uint32_t at = d.wideBytes * w * changed + k;
       const uint16_t z = static_cast<uint16_t>(p[at] | (d.wideBytes == 2 ? p[at + changed] << 8 : 0));
       symbols[i].wide[w] = static_cast<uint16_t>(symbols[i].wide[w] + unzigzag16(z));
+      moved = moved || z != 0;
     }
-    for (int j = 0; j < shape.narrow; ++j)
-      symbols[i].narrow[j] =
-          static_cast<uint8_t>(symbols[i].narrow[j] + unzigzag8(p[(d.wideBytes * shape.wide + j) * changed + k]));
+    for (int j = 0; j < shape.narrow; ++j) {
+      const uint8_t z = p[(d.wideBytes * shape.wide + j) * changed + k];
+      symbols[i].narrow[j] = static_cast<uint8_t>(symbols[i].narrow[j] + unzigzag8(z));
+      moved = moved || z != 0;
+    }
+    // Format 3: a probe is listed only when something of it changed (else it is one more spelling).
+    if (!moved && formatVersion >= kCompactSectionFormat) return CodecStatus::NonCanonical;
     ++k;
   }
   return CodecStatus::Ok;

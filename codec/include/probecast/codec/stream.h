@@ -31,7 +31,8 @@
 //            symbol a plane of zig-zag differences. Each choice has one allowed spelling: the active
 //            mask only when it changed, the list only for bricks of at most 256 probes when it is
 //            shorter than the mask (1 + count < mask bytes), bit 2 exactly when every wide
-//            difference fits one byte. Anything else is refused (CodecStatus::NonCanonical).
+//            difference fits one byte, and a probe listed or masked as changed only when one of its
+//            differences is not 0. Anything else is refused (CodecStatus::NonCanonical).
 // Format 1 and 2 sections: u32 brick | u32 version | u8 kind (bits 0-3: 1 keyframe, 2 delta; bits 4-7
 //            as above) | u8 compression (0 raw, 1 zstd with magic) | u32 rawSize | u32 storedSize
 //            | u32 CRC-32C of the preceding 18 bytes and the data | data; their deltas are active mask
