@@ -298,7 +298,9 @@ TEST(EdgeHub, AKeyframeThatDoesNotDecodeIsRefusedAndNothingChanges) {
   SectionBytes at;
   ASSERT_TRUE(locateSection(m.brick.keyframe.data(), m.brick.keyframe.size(), &at));
   const std::vector<uint8_t> shorter(m.brick.keyframe.begin() + at.dataAt, m.brick.keyframe.end() - 1);
-  const std::vector<uint8_t> key = sealSection(m.brick.brick, m.brick.version, m.brick.keyframe[at.kindAt], shorter);
+  // Stored raw (the zstd bit cleared), so the container checks out and only decoding can tell.
+  const uint8_t rawKind = static_cast<uint8_t>(m.brick.keyframe[at.kindAt] & ~0x04);
+  const std::vector<uint8_t> key = sealSection(m.brick.brick, m.brick.version, rawKind, shorter);
   bus::Brick bad = m.brick;
   bad.keyframe = key;
   bad.delta = {};

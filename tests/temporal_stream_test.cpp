@@ -554,6 +554,44 @@ TEST(Stream, Format3DeltaFormsRoundTripAndOnlyTheShortestIsRead) {
   }
 }
 
+// A compressed section holds exactly one zstd frame (format 3 without its 4-byte magic): the same
+// payload with an empty frame after it is one more spelling, refused by the container check and
+// the decoder alike.
+TEST(Stream, Format3ZstdDataIsOneFrameWithoutItsMagic) {
+  const StreamLayout layout = makeLayout(4, 4, 4, Representation::L2);
+  std::vector<float> probes(64 * kProbeFloats, 0.0f);
+  for (int p = 0; p < 64; ++p)
+    for (int c = 0; c < 3; ++c) probes[p * kProbeFloats + c] = 1.0f;  // alike: zstd finds the repeats
+  StreamEncoder enc(layout);
+  enc.update(probes.data(), nullptr);
+  std::vector<uint8_t> key;
+  enc.writeKeyframeFrame(key);
+  SectionBytes b;
+  ASSERT_TRUE(locateSection(key.data() + kFrameHeaderSize, key.size() - kFrameHeaderSize, &b));
+  const uint8_t kind = key[kFrameHeaderSize + b.kindAt];
+  ASSERT_EQ(kind, 0x05) << "a compressed keyframe";
+  const std::vector<uint8_t> data(key.begin() + kFrameHeaderSize + b.dataAt, key.end());
+  EXPECT_NE(data[0], 0x28) << "the magic is left out";
+  const auto decoded = [&](const std::vector<uint8_t>& section) {
+    std::vector<uint8_t> f;
+    const std::span<const uint8_t> sections[] = {section};
+    writeFrame(layout, 1, sections, f);
+    StreamDecoder dec(layout);
+    const CodecStatus checked = verifyFrame(f.data(), f.size());
+    const CodecStatus applied = dec.apply(f.data(), f.size());
+    EXPECT_EQ(checked, applied);
+    return applied;
+  };
+  ASSERT_EQ(decoded(sealSection(0, 1, kind, data)), CodecStatus::Ok);
+  std::vector<uint8_t> twoFrames = data;
+  const uint8_t emptyFrame[] = {0x28, 0xb5, 0x2f, 0xfd, 0x20, 0x00, 0x01, 0x00, 0x00};  // zstd of nothing
+  twoFrames.insert(twoFrames.end(), std::begin(emptyFrame), std::end(emptyFrame));
+  EXPECT_EQ(decoded(sealSection(0, 1, kind, twoFrames)), CodecStatus::DecompressFailed);
+  std::vector<uint8_t> withMagic = {0x28, 0xb5, 0x2f, 0xfd};
+  withMagic.insert(withMagic.end(), data.begin(), data.end());
+  EXPECT_EQ(decoded(sealSection(0, 1, kind, withMagic)), CodecStatus::DecompressFailed);
+}
+
 // An 8×4×4 l2 stream in two bricks: brick 0 under a uniform sky (L1 is exact there), brick 1 lit
 // by three small lights each (it needs the whole L2 band: one light alone is zonal, which zh3
 // holds). With an error bound each brick goes in the cheapest representation that keeps its probes

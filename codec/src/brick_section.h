@@ -14,7 +14,15 @@ namespace probecast {
 
 constexpr uint8_t kCompressionRaw = 0;
 constexpr uint8_t kCompressionZstd = 1;
-constexpr uint8_t kSectionZstdBit = 0x04;  // format 3 kind byte: the data is a magicless zstd frame
+constexpr uint8_t kSectionZstdBit = 0x04;  // format 3 kind byte: the data is a zstd frame without its magic
+// The 4 bytes every zstd frame opens with (ZSTD_MAGICNUMBER, little-endian): format 3 leaves them out.
+constexpr uint8_t kZstdMagic[4] = {0x28, 0xb5, 0x2f, 0xfd};
+
+// The zstd frame of a section's stored data, whole (format 3 data gets its magic back, in `scratch`),
+// checked to be exactly one frame that states its content size: that size, or nullopt.
+// `frame`/`frameSize` then point at the frame to decompress.
+bool wholeZstdFrame(uint8_t formatVersion, const uint8_t* data, size_t size, std::vector<uint8_t>& scratch,
+                    const uint8_t** frame, size_t* frameSize, unsigned long long* contentSize);
 
 // Format 3 delta payloads open with a form byte (stream.h).
 constexpr uint8_t kDeltaActiveMask = 0x01;   // an active mask follows; without, the base's is kept

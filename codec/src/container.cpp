@@ -3,7 +3,6 @@
 #include <cassert>
 #include <cstring>
 
-#define ZSTD_STATIC_LINKING_ONLY  // the magicless frame format (stable in the format, "experimental" in the API)
 #include <zstd.h>
 
 #include "brick_section.h"
@@ -294,15 +293,14 @@ void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representa
   size_t stored = raw.size();
   bool zstd = false;
   if (!raw.empty() && zstdContext != nullptr) {
-    auto* cctx = static_cast<ZSTD_CCtx*>(zstdContext);
-    ZSTD_CCtx_reset(cctx, ZSTD_reset_session_and_parameters);
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, zstdLevel);
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_format, ZSTD_f_zstd1_magicless);
+    // A plain zstd frame (with its content size) written 4 bytes early, so its magic falls before
+    // kRoom and is dropped.
     const size_t bound = ZSTD_compressBound(raw.size());
     out.resize(kRoom + bound);
-    const size_t n = ZSTD_compress2(cctx, out.data() + kRoom, bound, raw.data(), raw.size());
-    if (!ZSTD_isError(n) && n < raw.size()) {
-      stored = n;
+    const size_t n = ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstdContext), out.data() + kRoom - 4, bound + 4,
+                                       raw.data(), raw.size(), zstdLevel);
+    if (!ZSTD_isError(n) && n > 4 && std::memcmp(out.data() + kRoom - 4, kZstdMagic, 4) == 0 && n - 4 < raw.size()) {
+      stored = n - 4;
       zstd = true;
     }
   }
@@ -325,6 +323,27 @@ void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representa
   uint32_t crc = crc32c(header.data(), header.size());
   crc = crc32c(out.data() + header.size() + 4, stored, crc);
   setU32(out.data() + header.size(), crc);
+}
+
+bool wholeZstdFrame(uint8_t formatVersion, const uint8_t* data, size_t size, std::vector<uint8_t>& scratch,
+                    const uint8_t** frame, size_t* frameSize, unsigned long long* contentSize) {
+  if (formatVersion >= kCompactSectionFormat) {
+    scratch.assign(kZstdMagic, kZstdMagic + 4);
+    scratch.insert(scratch.end(), data, data + size);
+    data = scratch.data();
+    size = scratch.size();
+  }
+  // One frame exactly: nothing after it (a second frame, empty or skippable, would be another
+  // spelling of the same payload), and a content size that it states.
+  const size_t whole = ZSTD_findFrameCompressedSize(data, size);
+  const unsigned long long content = ZSTD_getFrameContentSize(data, size);
+  if (ZSTD_isError(whole) || whole != size || content == ZSTD_CONTENTSIZE_UNKNOWN ||
+      content == ZSTD_CONTENTSIZE_ERROR)
+    return false;
+  *frame = data;
+  *frameSize = size;
+  *contentSize = content;
+  return true;
 }
 
 namespace {
@@ -376,12 +395,14 @@ CodecStatus parseCompactSection(const uint8_t* data, size_t size, SectionView& v
   kindByte = static_cast<uint8_t>(kindByte & 0xf3);
   v.rawSize = v.storedSize;
   if (v.compression == kCompressionZstd) {  // the raw size is the zstd frame's content size
-    ZSTD_frameHeader zh;
-    if (ZSTD_getFrameHeader_advanced(&zh, data + headerSize, v.storedSize, ZSTD_f_zstd1_magicless) != 0 ||
-        zh.frameType != ZSTD_frame || zh.frameContentSize == ZSTD_CONTENTSIZE_UNKNOWN ||
-        zh.frameContentSize > 0xffffffffu)
+    thread_local std::vector<uint8_t> scratch;
+    const uint8_t* frame = nullptr;
+    size_t frameSize = 0;
+    unsigned long long content = 0;
+    if (!wholeZstdFrame(kCompactSectionFormat, data + headerSize, v.storedSize, scratch, &frame, &frameSize, &content) ||
+        content > 0xffffffffu)
       return CodecStatus::DecompressFailed;
-    v.rawSize = static_cast<uint32_t>(zh.frameContentSize);
+    v.rawSize = static_cast<uint32_t>(content);
   }
   return CodecStatus::Ok;
 }

@@ -2,7 +2,6 @@
 #include <cassert>
 #include <vector>
 
-#define ZSTD_STATIC_LINKING_ONLY  // the magicless frame format of format 3 sections
 #include <zstd.h>
 
 #include "brick_section.h"
@@ -35,6 +34,7 @@ struct StreamDecoder::Impl {
   };
   std::vector<Staged> staged;
   std::vector<uint8_t> raw;
+  std::vector<uint8_t> zstdFrame;  // a format 3 section's zstd data with its magic restored
 
   ~Impl() { ZSTD_freeDCtx(dctx); }
 };
@@ -84,13 +84,14 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
 
     const uint8_t* raw = view.data;
     if (view.compression == kCompressionZstd) {
-      // Format 3 stores magicless zstd frames, whose content size parseSection already read.
-      const bool magicless = header.formatVersion >= kCompactSectionFormat;
-      if (!magicless && ZSTD_getFrameContentSize(view.data, view.storedSize) != view.rawSize)
+      const uint8_t* frame = nullptr;
+      size_t frameSize = 0;
+      unsigned long long content = 0;
+      if (!wholeZstdFrame(header.formatVersion, view.data, view.storedSize, s.zstdFrame, &frame, &frameSize, &content) ||
+          content != view.rawSize)
         return CodecStatus::DecompressFailed;
-      ZSTD_DCtx_setParameter(s.dctx, ZSTD_d_format, magicless ? ZSTD_f_zstd1_magicless : ZSTD_f_zstd1);
       s.raw.resize(view.rawSize);
-      const size_t n = ZSTD_decompressDCtx(s.dctx, s.raw.data(), s.raw.size(), view.data, view.storedSize);
+      const size_t n = ZSTD_decompressDCtx(s.dctx, s.raw.data(), s.raw.size(), frame, frameSize);
       if (ZSTD_isError(n) || n != view.rawSize) return CodecStatus::DecompressFailed;
       raw = s.raw.data();
     }

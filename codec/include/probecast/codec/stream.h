@@ -22,7 +22,8 @@
 //            not the stream's, else 0) | varint storedSize | u32 CRC-32C of the header bytes before it
 //            and the data | data[storedSize]
 //            Varints are unsigned LEB128 in their shortest form, at most 32 bits. Compressed data is
-//            a zstd frame without its 4-byte magic number that states its content size (the raw size).
+//            exactly one zstd frame without its 4-byte magic number, stating its content size (the
+//            raw size); nothing may follow it.
 //   payload: keyframe: active mask | byte planes of the active probes' records.
 //            delta (format 3): u8 form | active mask, when form bit 0 (else the base's is kept)
 //            | changed probes: u8 count and that many increasing u8 indices when form bit 1, else a
@@ -32,7 +33,9 @@
 //            mask only when it changed, the list only for bricks of at most 256 probes when it is
 //            shorter than the mask (1 + count < mask bytes), bit 2 exactly when every wide
 //            difference fits one byte, and a probe listed or masked as changed only when one of its
-//            differences is not 0. Anything else is refused (CodecStatus::NonCanonical).
+//            differences is not 0; form bits 3-7 are 0. Anything else is refused
+//            (CodecStatus::NonCanonical). These rules are about the payload: whether it is stored raw
+//            or compressed, and zstd's own choices, are the encoder's.
 // Format 1 and 2 sections: u32 brick | u32 version | u8 kind (bits 0-3: 1 keyframe, 2 delta; bits 4-7
 //            as above) | u8 compression (0 raw, 1 zstd with magic) | u32 rawSize | u32 storedSize
 //            | u32 CRC-32C of the preceding 18 bytes and the data | data; their deltas are active mask
@@ -46,8 +49,8 @@
 // (a delta in another representation is refused). A format 1 frame still decodes, every zh3h probe
 // hallucinating as before.
 // Format 3 differs from format 2 only in how sections and deltas are spelled (the varint header,
-// the delta's form byte); what they decode to is the same. A section header is 8 to 10 bytes instead
-// of 22, and a small delta drops its masks and high bytes. Format 1 and 2 frames still decode; a
+// the delta's form byte); what they decode to is the same. A section header is 8 to 12 bytes instead
+// of 22 (at most 16), and a small delta drops its masks and high bytes. Format 1 and 2 frames still decode; a
 // carrier of bare sections (bus, wire) states the codec format and refuses another.
 #pragma once
 
