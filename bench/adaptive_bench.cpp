@@ -163,6 +163,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   AdaptiveBenchResult r;
   nlohmann::json& j = r.json;
   j["command"] = o.command;
+  j["codec_format_version"] = kFormatVersion;  // the stream bytes below are of this format
   j["device"] = context.deviceName();
   j["scene"] = first.name;
   j["grid"] = {o.dims[0], o.dims[1], o.dims[2]};

@@ -77,6 +77,7 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
 
   nlohmann::json json;
   json["command"] = opt.command;
+  json["codec_format_version"] = kFormatVersion;  // the temporal bytes are of this format
   json["maps"] = names;
   json["metric"] =
       "irradiance relative RMSE, RGB pooled: sqrt(sum |E_test - E_ref|^2) / sqrt(sum |E_ref|^2) over equal-area "

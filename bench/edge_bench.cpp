@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "probecast/codec/stream.h"
 #include "probecast/service/client.h"
 #include "probecast/session/child_process.h"
 #include "probecast/session/edge_process.h"
@@ -185,6 +186,7 @@ EdgeBenchResult runEdgeBench(const EdgeBenchOptions& o) {
   const double p50e = session::percentile(edgeMs, 0.5), p99e = session::percentile(edgeMs, 0.99);
   EdgeBenchResult r;
   r.json = {{"command", o.command},
+            {"codec_format_version", kFormatVersion},
             {"volume", "32x8x32 probes, bricks of 4, " + o.repr + ", dead-zone 1, light circling"},
             {"hz", o.hz},
             {"clients_per_phase", o.clients},

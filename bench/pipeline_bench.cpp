@@ -103,6 +103,7 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
   PipelineBenchResult r;
   nlohmann::json& j = r.json;
   j["command"] = o.command;
+  j["codec_format_version"] = kFormatVersion;
   j["scene"] = finalScene.name;
   j["device"] = context.deviceName();
   j["size"] = {o.width, o.height};

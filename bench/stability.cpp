@@ -455,6 +455,7 @@ StabilityResult runStabilitySuite(const StabilityOptions& o) {
   StabilityResult out;
   nlohmann::json& j = out.json;
   j["command"] = o.command;
+  j["codec_format_version"] = kFormatVersion;
   j["device"] = context.deviceName();
   std::string& md = out.markdown;
 

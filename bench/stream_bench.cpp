@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "load_client.h"
+#include "probecast/codec/stream.h"
 #include "probecast/service/edge_server.h"
 #include "probecast/service/server.h"
 #include "probecast/session/child_process.h"
@@ -525,6 +526,7 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   }
   StreamBenchResult r;
   r.json = {{"command", o.command},
+            {"codec_format_version", kFormatVersion},
             {"volume", fmt::format("{}x{}x{} probes, bricks of 4, {}, dead-zone 1, light circling", o.grid[0], o.grid[1],
                                    o.grid[2], o.repr)},
             {"hz", o.hz},
