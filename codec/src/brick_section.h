@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "probe_symbols.h"
@@ -18,11 +19,10 @@ constexpr uint8_t kSectionZstdBit = 0x04;  // format 3 kind byte: the data is a 
 // The 4 bytes every zstd frame opens with (ZSTD_MAGICNUMBER, little-endian): format 3 leaves them out.
 constexpr uint8_t kZstdMagic[4] = {0x28, 0xb5, 0x2f, 0xfd};
 
-// The zstd frame of a section's stored data, whole (format 3 data gets its magic back, in `scratch`),
-// checked to be exactly one frame that states its content size: that size, or nullopt.
-// `frame`/`frameSize` then point at the frame to decompress.
-bool wholeZstdFrame(uint8_t formatVersion, const uint8_t* data, size_t size, std::vector<uint8_t>& scratch,
-                    const uint8_t** frame, size_t* frameSize, unsigned long long* contentSize);
+// A section's stored zstd data as a zstd frame: format 3 data gets its magic back, in `scratch`.
+// parseSection has checked that it is exactly one frame stating the section's raw size.
+std::span<const uint8_t> zstdFrameOf(uint8_t formatVersion, const uint8_t* data, size_t size,
+                                     std::vector<uint8_t>& scratch);
 
 // Format 3 delta payloads open with a form byte (stream.h).
 constexpr uint8_t kDeltaActiveMask = 0x01;   // an active mask follows; without, the base's is kept

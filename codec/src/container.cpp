@@ -325,25 +325,12 @@ void writeSection(uint32_t brick, uint32_t version, SectionKind kind, Representa
   setU32(out.data() + header.size(), crc);
 }
 
-bool wholeZstdFrame(uint8_t formatVersion, const uint8_t* data, size_t size, std::vector<uint8_t>& scratch,
-                    const uint8_t** frame, size_t* frameSize, unsigned long long* contentSize) {
-  if (formatVersion >= kCompactSectionFormat) {
-    scratch.assign(kZstdMagic, kZstdMagic + 4);
-    scratch.insert(scratch.end(), data, data + size);
-    data = scratch.data();
-    size = scratch.size();
-  }
-  // One frame exactly: nothing after it (a second frame, empty or skippable, would be another
-  // spelling of the same payload), and a content size that it states.
-  const size_t whole = ZSTD_findFrameCompressedSize(data, size);
-  const unsigned long long content = ZSTD_getFrameContentSize(data, size);
-  if (ZSTD_isError(whole) || whole != size || content == ZSTD_CONTENTSIZE_UNKNOWN ||
-      content == ZSTD_CONTENTSIZE_ERROR)
-    return false;
-  *frame = data;
-  *frameSize = size;
-  *contentSize = content;
-  return true;
+std::span<const uint8_t> zstdFrameOf(uint8_t formatVersion, const uint8_t* data, size_t size,
+                                     std::vector<uint8_t>& scratch) {
+  if (formatVersion < kCompactSectionFormat) return {data, size};
+  scratch.assign(kZstdMagic, kZstdMagic + 4);
+  scratch.insert(scratch.end(), data, data + size);
+  return scratch;
 }
 
 namespace {
@@ -393,17 +380,7 @@ CodecStatus parseCompactSection(const uint8_t* data, size_t size, SectionView& v
   v.compression = (kindByte & kSectionZstdBit) ? kCompressionZstd : kCompressionRaw;
   if (kindByte & 0x08) return CodecStatus::BadSectionKind;
   kindByte = static_cast<uint8_t>(kindByte & 0xf3);
-  v.rawSize = v.storedSize;
-  if (v.compression == kCompressionZstd) {  // the raw size is the zstd frame's content size
-    thread_local std::vector<uint8_t> scratch;
-    const uint8_t* frame = nullptr;
-    size_t frameSize = 0;
-    unsigned long long content = 0;
-    if (!wholeZstdFrame(kCompactSectionFormat, data + headerSize, v.storedSize, scratch, &frame, &frameSize, &content) ||
-        content > 0xffffffffu)
-      return CodecStatus::DecompressFailed;
-    v.rawSize = static_cast<uint32_t>(content);
-  }
+  v.rawSize = v.storedSize;  // raw data; compressed, the zstd frame's content size (parseSection)
   return CodecStatus::Ok;
 }
 
@@ -418,6 +395,18 @@ CodecStatus parseSection(const StreamLayout& layout, uint8_t formatVersion, cons
                                  ? parseCompactSection(data, size, v, kindByte, headerSize)
                                  : parseFixedSection(data, size, v, kindByte, headerSize);
   if (parsed != CodecStatus::Ok) return parsed;
+  if (v.compression == kCompressionZstd) {
+    // Exactly one zstd frame (a second one, even empty, would be another spelling of the payload)
+    // that states its content size: format 3's raw size, the stated one's twin in formats 1 and 2.
+    thread_local std::vector<uint8_t> scratch;
+    const std::span<const uint8_t> frame = zstdFrameOf(formatVersion, data + headerSize, v.storedSize, scratch);
+    const size_t whole = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
+    const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
+    // ZSTD_CONTENTSIZE_UNKNOWN and _ERROR are both above any 32-bit size.
+    if (ZSTD_isError(whole) || whole != frame.size() || content > 0xffffffffu) return CodecStatus::DecompressFailed;
+    if (formatVersion >= kCompactSectionFormat) v.rawSize = static_cast<uint32_t>(content);
+    else if (content != v.rawSize) return CodecStatus::DecompressFailed;
+  }
   if (v.brick >= brickCount(layout)) return CodecStatus::BadBrickIndex;
   const uint8_t kind = kindByte & 0x0f, reprCode = kindByte >> 4;
   if (kind != static_cast<uint8_t>(SectionKind::Keyframe) && kind != static_cast<uint8_t>(SectionKind::Delta))

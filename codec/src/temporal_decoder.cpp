@@ -84,14 +84,10 @@ CodecStatus StreamDecoder::apply(const uint8_t* data, size_t size) {
 
     const uint8_t* raw = view.data;
     if (view.compression == kCompressionZstd) {
-      const uint8_t* frame = nullptr;
-      size_t frameSize = 0;
-      unsigned long long content = 0;
-      if (!wholeZstdFrame(header.formatVersion, view.data, view.storedSize, s.zstdFrame, &frame, &frameSize, &content) ||
-          content != view.rawSize)
-        return CodecStatus::DecompressFailed;
+      // parseSection checked the frame: one, stating view.rawSize.
+      const std::span<const uint8_t> frame = zstdFrameOf(header.formatVersion, view.data, view.storedSize, s.zstdFrame);
       s.raw.resize(view.rawSize);
-      const size_t n = ZSTD_decompressDCtx(s.dctx, s.raw.data(), s.raw.size(), frame, frameSize);
+      const size_t n = ZSTD_decompressDCtx(s.dctx, s.raw.data(), s.raw.size(), frame.data(), frame.size());
       if (ZSTD_isError(n) || n != view.rawSize) return CodecStatus::DecompressFailed;
       raw = s.raw.data();
     }
