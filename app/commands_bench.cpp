@@ -436,6 +436,15 @@ void addBenchAdaptive(CLI::App* bench) {
       ->check(CLI::Range(0.0f, 1e6f));
   adaptive->add_option("--w-mins", ao->bench.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
   adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
+  adaptive->add_option("--oracle", ao->bench.oracleErrorRatios,
+                       "also streams that know the truth and keep the held error within each of these x the full "
+                       "stream's (a floor on bytes)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.5f, 100.0f));
+  adaptive->add_option("--oracle-exponents", ao->bench.oracleExponents,
+                       "oracle streams weigh each probe's error by its energy to the minus these")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0f, 2.0f));
   adaptive->add_option("--deadzone", ao->bench.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
   adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
                        "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")

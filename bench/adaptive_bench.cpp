@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <numeric>
 
@@ -26,6 +27,8 @@ struct Stream {
   std::string name;
   EncoderOptions options;
   bool withNoise = false;
+  float oracleRatio = 0.0f;  // > 0: the oracle stream (oracleSelect)
+  float oracleExponent = 0.0f;
   std::unique_ptr<StreamEncoder> encoder;
   std::vector<double> bytesPerProbe;  // per frame
   std::vector<float> held;            // what a subscriber holds after the frame before
@@ -44,6 +47,49 @@ struct Moment {
   uint32_t frame;  // the phase's last update
   uint32_t first;  // its first scored update
 };
+
+// One probe's irradiance error energy against the truth (the terms of irradianceRmseRel).
+double probeErrorEnergy(const float* test, const float* truth) {
+  double err = 0;
+  for (int i = 0; i < kShCoeffs; ++i) {
+    const double a2 = static_cast<double>(kCosineBand[shBand(i)]) * kCosineBand[shBand(i)];
+    for (int c = 0; c < 3; ++c) {
+      const double d = static_cast<double>(test[i * 3 + c]) - truth[i * 3 + c];
+      err += a2 * d * d;
+    }
+  }
+  return err;
+}
+
+// The oracle stream's input for one update: the new estimate for the probes it re-sends, what the
+// decoder holds for the rest. It re-sends, largest error cut first, until the held volume's error
+// is within `ratio` × the full stream's (both against the truth): the fewest probes any rule that
+// sends estimates could re-send for that error.
+void oracleSelect(const float* truth, const float* estimate, const uint8_t* active, const float* full,
+                  const float* held, uint32_t count, float ratio, float exponent, std::vector<float>& out) {
+  out.assign(held, held + static_cast<size_t>(count) * kProbeFloats);
+  std::vector<std::pair<double, uint32_t>> cuts;
+  double heldErr = 0, fullErr = 0;
+  for (uint32_t p = 0; p < count; ++p) {
+    if (!active[p]) continue;
+    const size_t at = static_cast<size_t>(p) * kProbeFloats;
+    const float zero[kProbeFloats] = {};
+    const double energy = probeErrorEnergy(truth + at, zero);
+    const double weight = energy > 0 ? std::pow(energy, -static_cast<double>(exponent)) : 0.0;
+    const double h = weight * probeErrorEnergy(held + at, truth + at), n = weight * probeErrorEnergy(full + at, truth + at);
+    heldErr += h;
+    fullErr += n;
+    if (h > n) cuts.push_back({h - n, p});
+  }
+  std::sort(cuts.begin(), cuts.end(), std::greater<>());
+  const double target = static_cast<double>(ratio) * ratio * fullErr;
+  for (const auto& [cut, p] : cuts) {
+    if (heldErr <= target) break;
+    std::copy(estimate + static_cast<size_t>(p) * kProbeFloats, estimate + static_cast<size_t>(p + 1) * kProbeFloats,
+              out.begin() + static_cast<long>(p) * kProbeFloats);
+    heldErr -= cut;
+  }
+}
 
 }  // namespace
 
@@ -145,20 +191,23 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   // The truth at every t a scored update has: the view of a converged float volume.
   std::map<float, renderer::Image> truthImages;
   std::map<float, std::vector<float>> truthProbes;  // and the converged volume itself
+  const auto converge = [&](float t, bool withImage) {
+    if (truthProbes.count(t) && (!withImage || truthImages.count(t))) return;
+    say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
+    renderer::UpdaterOptions ro;
+    ro.samplesPerProbe = 512;
+    ro.rejectSigmas = 0.0f;
+    ro.seed = 4242;
+    renderer::ProbeUpdater u(context, sceneAt(t), grid, ro);
+    for (int k = 0; k < 16; ++k) u.update();
+    if (withImage) truthImages.emplace(t, render(u.volume(), t));
+    truthProbes.emplace(t, u.volume().probes);
+  };
   for (const Moment& m : moments)
-    for (uint32_t f = m.first; f <= m.frame; ++f) {
-      const float t = tAt(f);
-      if (truthImages.count(t)) continue;
-      say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
-      renderer::UpdaterOptions ro;
-      ro.samplesPerProbe = 512;
-      ro.rejectSigmas = 0.0f;
-      ro.seed = 4242;
-      renderer::ProbeUpdater u(context, sceneAt(t), grid, ro);
-      for (int k = 0; k < 16; ++k) u.update();
-      truthImages.emplace(t, render(u.volume(), t));
-      truthProbes.emplace(t, u.volume().probes);
-    }
+    for (uint32_t f = m.first; f <= m.frame; ++f) converge(tAt(f), true);
+  // The oracle stream needs the truth at every update.
+  if (!o.oracleErrorRatios.empty())
+    for (uint32_t f = 0; f < frames; ++f) converge(tAt(f), false);
 
   AdaptiveBenchResult r;
   nlohmann::json& j = r.json;
@@ -212,7 +261,16 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].options.noiseScale = o.noiseScale;
     streams[2].options.refinementInterval = o.refinementInterval;
     streams[2].withNoise = true;
+    for (float exponent : o.oracleExponents)
+      for (float ratio : o.oracleErrorRatios) {
+        Stream& s = streams.emplace_back();
+        s.name = fmt::format("oracle {:g}/{:g}", ratio, exponent);
+        s.oracleRatio = ratio;
+        s.oracleExponent = exponent;
+        s.options.deadzone = o.deadzone;
+      }
     for (Stream& s : streams) s.encoder = std::make_unique<StreamEncoder>(layout, s.options);
+    std::vector<float> oracleInput;
     std::vector<double> changes;
     std::vector<uint32_t> restarts;
     std::vector<float> previous;
@@ -229,7 +287,15 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       changes.push_back(previous.empty() ? 0.0 : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), count));
       previous = v.probes;
       for (Stream& s : streams) {
-        const uint32_t changed = s.encoder->update(v.probes.data(), v.active.data(), s.withNoise ? v.noise.data() : nullptr);
+        const float* input = v.probes.data();
+        if (s.oracleRatio > 0.0f) {
+          // What knows the truth: re-send the fewest probes (largest error cut first) that bring the
+          // held volume's error to oracleErrorRatio × the full stream's; the rest input what is held.
+          oracleSelect(truthProbes.at(tAt(f)).data(), v.probes.data(), v.active.data(), streams[0].encoder->reconstruction(),
+                       s.encoder->reconstruction(), count, s.oracleRatio, s.oracleExponent, oracleInput);
+          input = oracleInput.data();
+        }
+        const uint32_t changed = s.encoder->update(input, v.active.data(), s.withNoise ? v.noise.data() : nullptr);
         s.encoder->writeChangedFrame(frame);
         // Frame 0 is the keyframe; a frame that changes no brick is never sent.
         s.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / count);

@@ -30,6 +30,13 @@ struct AdaptiveBenchOptions {
   std::vector<float> fixedWMins = {0.02f, 0.05f, 0.25f};  // the fixed rules compared
   float noiseScale = 2.0f;           // the noise-aware stream's c
   uint32_t refinementInterval = 0;   // and its EncoderOptions::refinementInterval
+  // Oracle streams, one per ratio: each knows the converged volume at every update and re-sends the
+  // fewest probes that keep the held error within ratio × the full stream's, a floor on what any
+  // rule that sends estimates needs for that error (costs a converged volume per moving update).
+  std::vector<float> oracleErrorRatios;
+  // and the weights of its probes' errors: each probe's error energy × its own energy^-exponent
+  // (0: absolute, 1: relative, about 0.55: what gamma 2.2 leaves of it in an image); one stream per pair
+  std::vector<float> oracleExponents = {0.0f};
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;
   uint32_t jumpUpdates = 48;         // updates charted after the light jump
