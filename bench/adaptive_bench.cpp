@@ -290,7 +290,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         const float* input = v.probes.data();
         if (s.oracleRatio > 0.0f) {
           // What knows the truth: re-send the fewest probes (largest error cut first) that bring the
-          // held volume's error to oracleErrorRatio × the full stream's; the rest input what is held.
+          // held volume's error to the stream's ratio × the full stream's; the rest input what is held.
           oracleSelect(truthProbes.at(tAt(f)).data(), v.probes.data(), v.active.data(), streams[0].encoder->reconstruction(),
                        s.encoder->reconstruction(), count, s.oracleRatio, s.oracleExponent, oracleInput);
           input = oracleInput.data();
