@@ -436,6 +436,9 @@ void addBenchAdaptive(CLI::App* bench) {
       ->check(CLI::Range(0.0f, 1e6f));
   adaptive->add_option("--w-mins", ao->bench.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
   adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
+  adaptive->add_option("--confirmations", ao->bench.confirmations,
+                       "the noise-aware stream re-sends a probe once it has been beyond c sigma this many updates more")
+      ->check(CLI::Range(0u, 1000u));
   adaptive->add_option("--oracle", ao->bench.oracleErrorRatios,
                        "also streams that know the truth and keep the held error within each of these x the full "
                        "stream's (a floor on bytes)")

@@ -27,7 +27,7 @@ struct ServeOptions {
   BusOptions bus;
   int brick = 4, deadzone = 1;
   float noiseScale = 0.0f, errorBound = 0.0f;
-  uint32_t refinementInterval = 0;
+  uint32_t refinementInterval = 0, confirmations = 0;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
 
@@ -61,6 +61,9 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   hub.encoder.refinementInterval = o.refinementInterval;
   if (o.refinementInterval > 0 && o.noiseScale <= 0.0f)
     throw std::runtime_error("--refinement-interval holds back what --noise-scale calls refinements: give both");
+  hub.encoder.confirmations = o.confirmations;
+  if (o.confirmations > 0 && o.noiseScale <= 0.0f)
+    throw std::runtime_error("--confirmations holds back what --noise-scale would re-send: give both");
   hub.encoder.errorBound = o.errorBound;
   if (o.errorBound > 0.0f && brickRepresentations(repr).size() < 2)
     throw std::runtime_error(std::string("--error-bound chooses among cheaper representations per brick: --repr ") +
@@ -99,6 +102,10 @@ void addServeCommand(CLI::App& app) {
                     "with --noise-scale: refinements (changes within twice the noise threshold) wait for the next "
                     "update whose sequence is a multiple of this, every brick's going in that one frame (0 = at once)")
       ->check(CLI::Range(0u, 100000u));
+  serve->add_option("--confirmations", o->confirmations,
+                    "with --noise-scale: a probe past the noise threshold is re-sent once it has stayed past it this "
+                    "many updates more (past 4x the threshold at once; 0 = at once; bench adaptive measures 1)")
+      ->check(CLI::Range(0u, 1000u));
   serve->add_option("--error-bound", o->errorBound,
                     "send each brick in the cheapest of l1, zh3, l2 (up to --repr) that keeps its probes within "
                     "this relative irradiance error (0 = every brick as --repr)")

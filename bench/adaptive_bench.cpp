@@ -223,6 +223,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["representation"] = representationName(o.repr);
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
+  j["confirmations"] = o.confirmations;
   j["refinement_interval"] = o.refinementInterval;
   j["change_history"] = o.changeHistory;
   j["metric"] = "flicker: median relative irradiance change per update over the last half of a still phase; PSNR of "
@@ -259,6 +260,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].name = "noise";
     streams[2].options.deadzone = o.deadzone;
     streams[2].options.noiseScale = o.noiseScale;
+    streams[2].options.confirmations = o.confirmations;
     streams[2].options.refinementInterval = o.refinementInterval;
     streams[2].withNoise = true;
     for (float exponent : o.oracleExponents)

@@ -29,6 +29,7 @@ struct AdaptiveBenchOptions {
   float changeHistory = renderer::UpdaterOptions{}.changeHistory;        // and UpdaterOptions::changeHistory
   std::vector<float> fixedWMins = {0.02f, 0.05f, 0.25f};  // the fixed rules compared
   float noiseScale = 2.0f;           // the noise-aware stream's c
+  uint32_t confirmations = 0;        // and its EncoderOptions::confirmations
   uint32_t refinementInterval = 0;   // and its EncoderOptions::refinementInterval
   // Oracle streams, one per ratio: each knows the converged volume at every update and re-sends the
   // fewest probes that keep the held error within ratio × the full stream's, a floor on what any

@@ -225,6 +225,60 @@ TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
   }
 }
 
+// Confirmations, on the probes of the test above (c·σ = 0.02; a DC change d moves the RMS by 0.615 d):
+// d = 0.1 (0.061) is past c·σ but within 4c·σ (0.08), so with one confirmation it is kept for one
+// update and sent on the second in a row; one update's excursion that comes back is never sent;
+// d = 0.3 (0.18) is past 4c·σ, new light, sent at once. Without confirmations every change past c·σ
+// goes on its first update. With a refinement interval of 4 as well, a confirmed refinement (d =
+// 0.05) keeps its confirmation while it waits for update 4.
+TEST(Stream, ConfirmationsKeepAOneUpdateExcursionNotNewLight) {
+  const StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
+  const auto frameWith = [](float probe0, float probe4) {
+    std::vector<float> p(128 * kProbeFloats, 0.0f);
+    for (int i = 0; i < 128; ++i)
+      for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = i == 0 ? probe0 : i == 4 ? probe4 : 1.0f;
+    return p;
+  };
+  const std::vector<float> noise(128, 0.01f);
+  for (uint32_t confirmations : {1u, 0u}) {
+    EncoderOptions options;
+    options.noiseScale = 2.0f;
+    options.confirmations = confirmations;
+    StreamEncoder enc(layout, options);
+    StreamDecoder dec(layout);
+    std::vector<uint8_t> frame;
+    const auto step = [&](float probe0, float probe4) {  // the bricks given a version
+      const uint32_t changed = enc.update(frameWith(probe0, probe4).data(), nullptr, noise.data());
+      enc.writeChangedFrame(frame);
+      EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
+      expectSameState(enc, dec, "confirmations " + std::to_string(confirmations));
+      return changed;
+    };
+    const uint32_t kept = confirmations > 0 ? 0u : 1u;  // what a first update past c·σ sends
+    EXPECT_EQ(step(1.0f, 1.0f), 2u);
+    EXPECT_EQ(step(1.1f, 1.0f), kept);  // an excursion...
+    EXPECT_EQ(step(1.0f, 1.0f), kept);  // ...that comes back: never sent with a confirmation
+    EXPECT_NEAR(dec.probes()[0], 1.0f, 0.005f);
+    EXPECT_EQ(step(1.1f, 1.0f), kept);  // the same change twice in a row
+    EXPECT_EQ(step(1.1f, 1.0f), 1u - kept);
+    EXPECT_NEAR(dec.probes()[0], 1.1f, 0.005f);
+    EXPECT_EQ(step(1.1f, 1.0f), 0u);
+    EXPECT_EQ(step(1.1f, 1.3f), 1u);  // new light: at once either way
+    EXPECT_NEAR(dec.probes()[4 * kProbeFloats], 1.3f, 0.005f);
+  }
+  EncoderOptions options;
+  options.noiseScale = 2.0f;
+  options.confirmations = 1;
+  options.refinementInterval = 4;
+  StreamEncoder enc(layout, options);
+  const auto changed = [&](float probe0) { return enc.update(frameWith(probe0, 1.0f).data(), nullptr, noise.data()); };
+  EXPECT_EQ(changed(1.0f), 2u);   // update 1
+  EXPECT_EQ(changed(1.05f), 0u);  // update 2: not confirmed
+  EXPECT_EQ(changed(1.05f), 0u);  // update 3: confirmed, a refinement: waits
+  EXPECT_EQ(changed(1.05f), 1u);  // update 4: goes
+  EXPECT_NEAR(enc.reconstruction()[0], 1.05f, 0.005f);
+}
+
 // Probes for the golden stream: deterministic, no randomness.
 std::vector<float> goldenProbes(int frame) {
   std::vector<float> p(4 * kProbeFloats, 0.0f);

@@ -38,6 +38,7 @@ struct StreamEncoder::Impl {
   std::vector<ProbeSymbols> base, next;
   std::vector<uint8_t> baseActive, nextActive, raw;
   std::vector<ProbeSymbols> candidates;  // per choice × brick probe, with an error bound
+  std::vector<uint32_t> beyond;  // per probe: consecutive updates beyond c·σ not yet sent (EncoderOptions::confirmations)
 
   // The representation brick `b` is sent in this update (EncoderOptions::errorBound), its probes'
   // symbols for each choice left in `candidates`.
@@ -54,6 +55,7 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
   const uint32_t probes = probeCount(layout);
   const uint32_t bricks = brickCount(layout);
   s.symbols.assign(probes, ProbeSymbols{});
+  s.beyond.assign(probes, 0);
   s.active.assign(probes, 0);
   s.reconstruction.assign(static_cast<size_t>(probes) * kProbeFloats, 0.0f);
   s.table.build(layout);
@@ -72,6 +74,9 @@ StreamEncoder::StreamEncoder(const StreamLayout& layout, const EncoderOptions& o
 StreamEncoder::~StreamEncoder() = default;
 
 namespace {
+
+// EncoderOptions::confirmations: a change beyond this × c·σ is new light, sent without waiting.
+constexpr float kConfirmedBeyond = 4.0f;
 
 // The noise rule of EncoderOptions::noiseScale: true when `candidate` (what a new version would
 // decode to) differs from `held` (what the decoder has) by at most `threshold` in the irradiance-
@@ -179,13 +184,24 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
           assert(ok && "the encoder only makes valid symbols");
           (void)ok;
           const float* held = s.reconstruction.data() + static_cast<size_t>(p) * kProbeFloats;
-          if (withinNoise(candidate, held, s.options.noiseScale * sigma)) s.next[k] = *previous;
-          else urgent = urgent || !withinNoise(candidate, held, 2.0f * s.options.noiseScale * sigma);
+          if (withinNoise(candidate, held, s.options.noiseScale * sigma)) {
+            s.next[k] = *previous;
+            s.beyond[p] = 0;
+          } else if (s.beyond[p] < s.options.confirmations &&
+                     withinNoise(candidate, held, kConfirmedBeyond * s.options.noiseScale * sigma)) {
+            ++s.beyond[p];  // not confirmed yet: kept (the count is cleared when the probe is sent)
+            s.next[k] = *previous;
+          } else {
+            urgent = urgent || !withinNoise(candidate, held, 2.0f * s.options.noiseScale * sigma);
+          }
         } else if (moved) {
           urgent = true;  // no noise to weigh it against, or newly active
+        } else {
+          s.beyond[p] = 0;
         }
       } else {
         s.next[k] = ProbeSymbols{};
+        s.beyond[p] = 0;
       }
       urgent = urgent || s.nextActive[k] != s.active[p];
       changed = changed || s.nextActive[k] != s.active[p] ||
@@ -212,6 +228,7 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     double diff = 0.0, total = 0.0;
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t p = s.table.probes[first + k];
+      if (std::memcmp(&s.next[k], &s.symbols[p], sizeof(ProbeSymbols)) != 0) s.beyond[p] = 0;
       s.symbols[p] = s.next[k];
       s.active[p] = s.nextActive[k];
       float decoded[kProbeFloats] = {};

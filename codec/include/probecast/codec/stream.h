@@ -116,6 +116,11 @@ struct EncoderOptions {
   // every brick's in the same frame (one frame header, not one per brick). A change beyond 2c·σ, a
   // probe switching on or off, or one without noise goes at once. 0 = off.
   uint32_t refinementInterval = 0;
+  // With the noise rule: a probe that would be re-sent (beyond c·σ of what the decoder holds) is kept
+  // until it has been beyond for this many updates more in a row, so an estimate's one-update
+  // excursion (a bright path) is not sent; one beyond 4c·σ is new light and goes at once. The
+  // refinement interval then applies as before. 0 = off (re-sent on the first update beyond).
+  uint32_t confirmations = 0;
   // Per-brick representation: > 0 sends each brick in the cheapest of brickRepresentations(repr)
   // whose relative irradiance error against the input, over the brick's active probes, stays within
   // this bound (exact over the sphere, RGB pooled: irradiance_error.h), the stream's own when none
