@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/stream.h"
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/imaging/svg_chart.h"
@@ -48,19 +49,6 @@ struct Moment {
   uint32_t first;  // its first scored update
 };
 
-// One probe's irradiance error energy against the truth (the terms of irradianceRmseRel).
-double probeErrorEnergy(const float* test, const float* truth) {
-  double err = 0;
-  for (int i = 0; i < kShCoeffs; ++i) {
-    const double a2 = static_cast<double>(kCosineBand[shBand(i)]) * kCosineBand[shBand(i)];
-    for (int c = 0; c < 3; ++c) {
-      const double d = static_cast<double>(test[i * 3 + c]) - truth[i * 3 + c];
-      err += a2 * d * d;
-    }
-  }
-  return err;
-}
-
 // The oracle stream's input for one update: the new estimate for the probes it re-sends, what the
 // decoder holds for the rest. It re-sends, largest error cut first, until the held volume's error
 // is within `ratio` × the full stream's (both against the truth): the fewest probes any rule that
@@ -73,10 +61,12 @@ void oracleSelect(const float* truth, const float* estimate, const uint8_t* acti
   for (uint32_t p = 0; p < count; ++p) {
     if (!active[p]) continue;
     const size_t at = static_cast<size_t>(p) * kProbeFloats;
-    const float zero[kProbeFloats] = {};
-    const double energy = probeErrorEnergy(truth + at, zero);
+    double h = 0, n = 0, energy = 0, again = 0;
+    irradianceErrorEnergy(held + at, truth + at, h, energy);
+    irradianceErrorEnergy(full + at, truth + at, n, again);
     const double weight = energy > 0 ? std::pow(energy, -static_cast<double>(exponent)) : 0.0;
-    const double h = weight * probeErrorEnergy(held + at, truth + at), n = weight * probeErrorEnergy(full + at, truth + at);
+    h *= weight;
+    n *= weight;
     heldErr += h;
     fullErr += n;
     if (h > n) cuts.push_back({h - n, p});

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/sh.h"
 #include "probecast/session/stats.h"
 #include "probecast/imaging/svg_chart.h"
@@ -24,17 +25,10 @@ double peakRssMiB() {
 
 double irradianceRmseRel(const float* test, const float* reference, const uint8_t* active, uint32_t count) {
   double err = 0, energy = 0;
-  for (uint32_t p = 0; p < count; ++p) {
-    if (active && !active[p]) continue;
-    for (int i = 0; i < kShCoeffs; ++i) {
-      const double a2 = static_cast<double>(kCosineBand[shBand(i)]) * kCosineBand[shBand(i)];
-      for (int c = 0; c < 3; ++c) {
-        const double r = reference[p * 27 + i * 3 + c], d = test[p * 27 + i * 3 + c] - r;
-        err += a2 * d * d;
-        energy += a2 * r * r;
-      }
-    }
-  }
+  for (uint32_t p = 0; p < count; ++p)
+    if (!active || active[p])
+      irradianceErrorEnergy(test + static_cast<size_t>(p) * kProbeFloats, reference + static_cast<size_t>(p) * kProbeFloats,
+                            err, energy);
   return energy > 0 ? std::sqrt(err / energy) : 0.0;
 }
 

@@ -173,6 +173,16 @@ TEST(Stream, NoiseRuleStaysDriftFreeOver1000Frames) {
   EXPECT_LT(static_cast<double>(stillBytes) / 100.0 / count, 0.5);
 }
 
+// 128 grey probes: c00 = 1 in every channel and nothing else, but for the listed probes' c00.
+std::vector<float> greyProbes(std::initializer_list<std::pair<int, float>> dc) {
+  std::vector<float> p(128 * kProbeFloats, 0.0f);
+  for (int i = 0; i < 128; ++i)
+    for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = 1.0f;
+  for (const auto& [probe, value] : dc)
+    for (int c = 0; c < 3; ++c) p[probe * kProbeFloats + c] = value;
+  return p;
+}
+
 // The noise rule with a refinement interval: grey probes of c00 = 1 and σ = 0.01 (c = 2, so c·σ =
 // 0.02). A DC change d moves the irradiance-weighted RMS of withinNoise by d·√(3/7.9375) = 0.615 d
 // (DC weight 1 of 1 + 3·4/9 + 5/16 per channel): d = 0.05 (0.031) is a refinement, beyond c·σ and
@@ -182,10 +192,7 @@ TEST(Stream, NoiseRuleStaysDriftFreeOver1000Frames) {
 TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
   const StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
   const auto frameWith = [](float probe0, float probe4, float probe1) {
-    std::vector<float> p(128 * kProbeFloats, 0.0f);
-    for (int i = 0; i < 128; ++i)
-      for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = i == 0 ? probe0 : i == 4 ? probe4 : i == 1 ? probe1 : 1.0f;
-    return p;
+    return greyProbes({{0, probe0}, {4, probe4}, {1, probe1}});
   };
   const std::vector<float> noise(128, 0.01f);
   for (uint32_t interval : {4u, 0u}) {
@@ -233,12 +240,7 @@ TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
 // 0.05) keeps its confirmation while it waits for update 4.
 TEST(Stream, ConfirmationsKeepAOneUpdateExcursionNotNewLight) {
   const StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
-  const auto frameWith = [](float probe0, float probe4) {
-    std::vector<float> p(128 * kProbeFloats, 0.0f);
-    for (int i = 0; i < 128; ++i)
-      for (int c = 0; c < 3; ++c) p[i * kProbeFloats + c] = i == 0 ? probe0 : i == 4 ? probe4 : 1.0f;
-    return p;
-  };
+  const auto frameWith = [](float probe0, float probe4) { return greyProbes({{0, probe0}, {4, probe4}}); };
   const std::vector<float> noise(128, 0.01f);
   for (uint32_t confirmations : {1u, 0u}) {
     EncoderOptions options;
