@@ -441,7 +441,7 @@ void addBenchAdaptive(CLI::App* bench) {
       ->check(CLI::Range(0u, 1000u));
   adaptive->add_option("--oracle", ao->bench.oracleErrorRatios,
                        "also streams that know the truth and keep the held error within each of these x the full "
-                       "stream's (a floor on bytes)")
+                       "stream's (about the least bytes for that error)")
       ->delimiter(',')
       ->check(CLI::Range(0.5f, 100.0f));
   adaptive->add_option("--oracle-exponents", ao->bench.oracleExponents,

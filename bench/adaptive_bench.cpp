@@ -51,8 +51,8 @@ struct Moment {
 
 // The oracle stream's input for one update: the new estimate for the probes it re-sends, what the
 // decoder holds for the rest. It re-sends, largest error cut first, until the held volume's error
-// is within `ratio` × the full stream's (both against the truth): the fewest probes any rule that
-// sends estimates could re-send for that error.
+// is within `ratio` × the full stream's (both against the truth): in this update, the fewest probes
+// any rule that sends estimates could re-send for that error.
 void oracleSelect(const float* truth, const float* estimate, const uint8_t* active, const float* full,
                   const float* held, uint32_t count, float ratio, float exponent, std::vector<float>& out) {
   out.assign(held, held + static_cast<size_t>(count) * kProbeFloats);

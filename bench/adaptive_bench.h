@@ -32,8 +32,9 @@ struct AdaptiveBenchOptions {
   uint32_t confirmations = 0;        // and its EncoderOptions::confirmations
   uint32_t refinementInterval = 0;   // and its EncoderOptions::refinementInterval
   // Oracle streams, one per ratio: each knows the converged volume at every update and re-sends the
-  // fewest probes that keep the held error within ratio × the full stream's, a floor on what any
-  // rule that sends estimates needs for that error (costs a converged volume per moving update).
+  // fewest probes that keep the held error within ratio × the full stream's, update by update: about
+  // the least any rule that sends estimates needs for that error (costs a converged volume per
+  // moving update).
   std::vector<float> oracleErrorRatios;
   // and the weights of its probes' errors: each probe's error energy × its own energy^-exponent
   // (0: absolute, 1: relative, about 0.55: what gamma 2.2 leaves of it in an image); one stream per pair
