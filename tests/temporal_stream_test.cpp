@@ -183,6 +183,27 @@ std::vector<float> greyProbes(std::initializer_list<std::pair<int, float>> dc) {
   return p;
 }
 
+// A stream of grey probes (σ = 0.01 each) in an 8×4×4 zh3 layout of bricks of 4: step() encodes
+// one update of greyProbes(dc), has the decoder apply its frame and follow bit for bit, and returns
+// the bricks given a version (the sections of the frame).
+struct GreyStream {
+  StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
+  StreamEncoder enc;
+  StreamDecoder dec{layout};
+  std::vector<float> noise = std::vector<float>(128, 0.01f);
+  std::vector<uint8_t> frame;
+  std::string what;
+
+  GreyStream(const EncoderOptions& options, std::string name) : enc(layout, options), what(std::move(name)) {}
+  uint32_t step(std::initializer_list<std::pair<int, float>> dc) {
+    const uint32_t changed = enc.update(greyProbes(dc).data(), nullptr, noise.data());
+    enc.writeChangedFrame(frame);
+    EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok) << what;
+    expectSameState(enc, dec, what);
+    return changed;
+  }
+};
+
 // The noise rule with a refinement interval: grey probes of c00 = 1 and σ = 0.01 (c = 2, so c·σ =
 // 0.02). A DC change d moves the irradiance-weighted RMS of withinNoise by d·√(3/7.9375) = 0.615 d
 // (DC weight 1 of 1 + 3·4/9 + 5/16 per channel): d = 0.05 (0.031) is a refinement, beyond c·σ and
@@ -190,25 +211,15 @@ std::vector<float> greyProbes(std::initializer_list<std::pair<int, float>> dc) {
 // 1). With an interval of 4, refinements wait for update 4 (its frame sequence a multiple of 4) and
 // then both bricks' go in that one frame; new light goes at once. Without an interval all go at once.
 TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
-  const StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
-  const auto frameWith = [](float probe0, float probe4, float probe1) {
-    return greyProbes({{0, probe0}, {4, probe4}, {1, probe1}});
-  };
-  const std::vector<float> noise(128, 0.01f);
   for (uint32_t interval : {4u, 0u}) {
     EncoderOptions options;
     options.noiseScale = 2.0f;
     options.refinementInterval = interval;
-    StreamEncoder enc(layout, options);
-    StreamDecoder dec(layout);
-    std::vector<uint8_t> frame;
-    // Returns the bricks given a version (the sections of the frame).
+    GreyStream stream(options, "interval " + std::to_string(interval));
+    const StreamEncoder& enc = stream.enc;
+    const StreamDecoder& dec = stream.dec;
     const auto step = [&](float probe0, float probe4, float probe1) {
-      const uint32_t changed = enc.update(frameWith(probe0, probe4, probe1).data(), nullptr, noise.data());
-      enc.writeChangedFrame(frame);
-      EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
-      expectSameState(enc, dec, "interval " + std::to_string(interval));
-      return changed;
+      return stream.step({{0, probe0}, {4, probe4}, {1, probe1}});
     };
     EXPECT_EQ(step(1.0f, 1.0f, 1.0f), 2u);  // update 1: the first versions
     if (interval == 4) {
@@ -239,23 +250,13 @@ TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
 // goes on its first update. With a refinement interval of 4 as well, a confirmed refinement (d =
 // 0.05) keeps its confirmation while it waits for update 4.
 TEST(Stream, ConfirmationsKeepAOneUpdateExcursionNotNewLight) {
-  const StreamLayout layout = makeLayout(8, 4, 4, Representation::Zh3);
-  const auto frameWith = [](float probe0, float probe4) { return greyProbes({{0, probe0}, {4, probe4}}); };
-  const std::vector<float> noise(128, 0.01f);
   for (uint32_t confirmations : {1u, 0u}) {
     EncoderOptions options;
     options.noiseScale = 2.0f;
     options.confirmations = confirmations;
-    StreamEncoder enc(layout, options);
-    StreamDecoder dec(layout);
-    std::vector<uint8_t> frame;
-    const auto step = [&](float probe0, float probe4) {  // the bricks given a version
-      const uint32_t changed = enc.update(frameWith(probe0, probe4).data(), nullptr, noise.data());
-      enc.writeChangedFrame(frame);
-      EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok);
-      expectSameState(enc, dec, "confirmations " + std::to_string(confirmations));
-      return changed;
-    };
+    GreyStream stream(options, "confirmations " + std::to_string(confirmations));
+    const StreamDecoder& dec = stream.dec;
+    const auto step = [&](float probe0, float probe4) { return stream.step({{0, probe0}, {4, probe4}}); };
     const uint32_t kept = confirmations > 0 ? 0u : 1u;  // what a first update past c·σ sends
     EXPECT_EQ(step(1.0f, 1.0f), 2u);
     EXPECT_EQ(step(1.1f, 1.0f), kept);  // an excursion...
@@ -272,13 +273,12 @@ TEST(Stream, ConfirmationsKeepAOneUpdateExcursionNotNewLight) {
   options.noiseScale = 2.0f;
   options.confirmations = 1;
   options.refinementInterval = 4;
-  StreamEncoder enc(layout, options);
-  const auto changed = [&](float probe0) { return enc.update(frameWith(probe0, 1.0f).data(), nullptr, noise.data()); };
-  EXPECT_EQ(changed(1.0f), 2u);   // update 1
-  EXPECT_EQ(changed(1.05f), 0u);  // update 2: not confirmed
-  EXPECT_EQ(changed(1.05f), 0u);  // update 3: confirmed, a refinement: waits
-  EXPECT_EQ(changed(1.05f), 1u);  // update 4: goes
-  EXPECT_NEAR(enc.reconstruction()[0], 1.05f, 0.005f);
+  GreyStream stream(options, "confirmations 1, interval 4");
+  EXPECT_EQ(stream.step({{0, 1.0f}}), 2u);   // update 1
+  EXPECT_EQ(stream.step({{0, 1.05f}}), 0u);  // update 2: not confirmed
+  EXPECT_EQ(stream.step({{0, 1.05f}}), 0u);  // update 3: confirmed, a refinement: waits
+  EXPECT_EQ(stream.step({{0, 1.05f}}), 1u);  // update 4: goes
+  EXPECT_NEAR(stream.dec.probes()[0], 1.05f, 0.005f);
 }
 
 // Probes for the golden stream: deterministic, no randomness.
