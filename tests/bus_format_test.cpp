@@ -70,12 +70,12 @@ void reseal(std::vector<uint8_t>& m) {
 }
 
 TEST(BusFormat, VolumeMessageGoldenBytes) {
-  // Written out by hand from the format in bus_format.h (codec format 3); the CRC-32C is of bytes
+  // Written out by hand from the format in bus_format.h (codec format 4); the CRC-32C is of bytes
   // 0-11 and 16-79, computed independently.
   const uint8_t golden[] = {
-      0x50, 0x43, 0x42, 0x4d, 0x03, 0x01, 0x01, 0x00, 0x40, 0x00, 0x00, 0x00, 0x11, 0x95, 0x77, 0xc3,  // header
+      0x50, 0x43, 0x42, 0x4d, 0x03, 0x01, 0x01, 0x00, 0x40, 0x00, 0x00, 0x00, 0x0d, 0xc6, 0xa8, 0x97,  // header
       0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01, 0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11,  // epoch, time
-      0x03, 0x03, 0x04, 0x00, 0x10, 0x00, 0x04, 0x00, 0x10, 0x00, 0x00, 0x00,                          // layout, no offsets
+      0x04, 0x03, 0x04, 0x00, 0x10, 0x00, 0x04, 0x00, 0x10, 0x00, 0x00, 0x00,                          // layout, no offsets
       0x00, 0x00, 0x00, 0xc0, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xc0,                          // min
       0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xb0, 0x40,                          // max
       0x00, 0x00, 0x00, 0x00,                                                                          // offsets CRC
@@ -94,12 +94,12 @@ TEST(BusFormat, VolumeMessageGoldenBytes) {
   EXPECT_EQ(m.volume.layout.repr, Representation::Zh3);
   EXPECT_EQ(m.volume.bounds.max[2], 5.5f);
   EXPECT_EQ(m.volume.areaLights, (AreaLightRule{kAreaLightRuleVersion, 0.25f}));
-  // The same message from a build that wrote codec format 2 (its sections spelled otherwise) is
-  // refused, saying so, not misread.
+  // The same message from a build that wrote codec format 3 (no Rice-coded deltas; bare sections
+  // carry no version of their own) is refused, saying so, not misread.
   std::vector<uint8_t> older(std::begin(golden), std::end(golden));
-  older[32] = 2;
+  older[32] = 3;
   reseal(older);
-  EXPECT_NE(refusal(older).find("codec format version 2"), std::string::npos) << refusal(older);
+  EXPECT_NE(refusal(older).find("codec format version 3"), std::string::npos) << refusal(older);
 }
 
 TEST(BusFormat, BrickMessageRoundTripsAndItsSectionsDecode) {

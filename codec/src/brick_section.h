@@ -24,10 +24,11 @@ constexpr uint8_t kZstdMagic[4] = {0x28, 0xb5, 0x2f, 0xfd};
 std::span<const uint8_t> zstdFrameOf(uint8_t formatVersion, const uint8_t* data, size_t size,
                                      std::vector<uint8_t>& scratch);
 
-// Format 3 delta payloads open with a form byte (stream.h).
+// Format 3 and 4 delta payloads open with a form byte (stream.h).
 constexpr uint8_t kDeltaActiveMask = 0x01;   // an active mask follows; without, the base's is kept
 constexpr uint8_t kDeltaChangedList = 0x02;  // changed probes as u8 count + u8 indices, not a mask
 constexpr uint8_t kDeltaNarrowWide = 0x04;   // one byte per wide difference (every zig-zag < 256)
+constexpr uint8_t kDeltaRice = 0x08;         // format 4: the differences as Rice codes (rice_code.h), not byte planes
 
 inline uint32_t maskBytes(uint32_t probes) { return (probes + 7) / 8; }
 inline bool maskBit(const uint8_t* mask, uint32_t i) { return (mask[i >> 3] >> (i & 7)) & 1u; }
@@ -47,9 +48,12 @@ size_t maxRawSectionSize(const StreamLayout& layout, uint32_t brick);
 // Raw payloads (before compression). `active` has one byte per brick probe (0/1).
 void buildKeyframePayload(Representation repr, uint32_t probes, const uint8_t* active, const ProbeSymbols* symbols,
                           std::vector<uint8_t>& out);
-// A format 3 delta from (baseActive, base) to (active, next).
+// A format 4 delta from (baseActive, base) to (active, next), its differences in byte planes; and,
+// when `rice` is given and Rice codes spell them shorter, the same delta with Rice codes there (else
+// `rice` is left empty). Which of the two a section stores is the encoder's choice, as compression is.
 void buildDeltaPayload(Representation repr, uint32_t probes, const uint8_t* baseActive, const uint8_t* active,
-                       const ProbeSymbols* base, const ProbeSymbols* next, std::vector<uint8_t>& out);
+                       const ProbeSymbols* base, const ProbeSymbols* next, std::vector<uint8_t>& out,
+                       std::vector<uint8_t>* rice = nullptr);
 
 // Writes a format 3 section (header + possibly compressed payload) into `out`. `zstdContext` is a
 // ZSTD_CCtx*, or null to store the payload raw. `repr` is the brick's representation; it is written

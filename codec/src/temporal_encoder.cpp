@@ -37,6 +37,7 @@ struct StreamEncoder::Impl {
   // Scratch, sized for one brick.
   std::vector<ProbeSymbols> base, next;
   std::vector<uint8_t> baseActive, nextActive, raw;
+  std::vector<uint8_t> riceRaw, riceSection;  // a delta spelled with Rice codes, and its section
   std::vector<ProbeSymbols> candidates;  // per choice × brick probe, with an error bound
   std::vector<uint32_t> beyond;  // per probe: consecutive updates beyond c·σ not yet sent (EncoderOptions::confirmations)
 
@@ -216,10 +217,19 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
 
     // A brick that changed representation starts again from a keyframe (no symbol differences across them).
     if (switched) buildKeyframePayload(repr, n, s.nextActive.data(), s.next.data(), s.raw);
-    else buildDeltaPayload(repr, n, s.baseActive.data(), s.nextActive.data(), s.base.data(), s.next.data(), s.raw);
+    else
+      buildDeltaPayload(repr, n, s.baseActive.data(), s.nextActive.data(), s.base.data(), s.next.data(), s.raw,
+                        &s.riceRaw);
     ++s.versions[b];
-    writeSection(b, s.versions[b], switched ? SectionKind::Keyframe : SectionKind::Delta, repr, s.layout.repr, s.raw,
-                 s.options.zstdLevel, s.options.compress ? s.cctx : nullptr, s.deltas[b]);
+    const SectionKind kind = switched ? SectionKind::Keyframe : SectionKind::Delta;
+    void* const zstd = s.options.compress ? s.cctx : nullptr;
+    writeSection(b, s.versions[b], kind, repr, s.layout.repr, s.raw, s.options.zstdLevel, zstd, s.deltas[b]);
+    // The delta's differences as Rice codes, where those are shorter, stored instead when the section
+    // comes out shorter (byte planes compress where Rice codes do not: a large change of many probes).
+    if (!switched && !s.riceRaw.empty()) {
+      writeSection(b, s.versions[b], kind, repr, s.layout.repr, s.riceRaw, s.options.zstdLevel, zstd, s.riceSection);
+      if (s.riceSection.size() < s.deltas[b].size()) s.deltas[b].swap(s.riceSection);
+    }
     s.brickRepr[b] = repr;
     s.deltaIsKeyframe[b] = switched ? 1 : 0;
     s.keyframeValid[b] = 0;

@@ -8,16 +8,16 @@
 //   - a keyframe: the active mask and the records (record.h) of the active probes, or
 //   - a delta from the previous version: active mask, changed mask, and per changed probe the
 //     symbol differences (DC in the monotone code domain of rgb9e5.h, ratios in quantisation
-//     steps), zig-zag coded.
+//     steps), zig-zag coded, as Rice codes where those are shorter.
 // Payloads are split into byte planes and zstd-compressed (stored raw when that is smaller).
 // Inactive probes are never encoded. The encoder keeps exactly the state a decoder reaches, so
 // decoding is bit-identical to the encoder's reconstruction after every frame.
 //
 // Wire format, little-endian. Frame = header (32 bytes) + sections:
-//   header:  magic "PRBC" | u8 formatVersion (3; 1 and 2 are read) | u8 representation | u8 brickDim
+//   header:  magic "PRBC" | u8 formatVersion (4; 1 to 3 are read) | u8 representation | u8 brickDim
 //            | u8 flags (0) | u16 nx, ny, nz | u16 reserved (0) | u32 frameSequence | u32 sectionCount
 //            | u32 sectionBytes | u32 CRC-32C of the preceding 28 bytes
-//   section (format 3): varint brick | varint version | u8 kind (bits 0-1: 1 keyframe, 2 delta; bit 2:
+//   section (format 3 and 4): varint brick | varint version | u8 kind (bits 0-1: 1 keyframe, 2 delta; bit 2:
 //            the data is zstd-compressed; bit 3: 0; bits 4-7: the brick's representation when it is
 //            not the stream's, else 0) | varint storedSize | u32 CRC-32C of the header bytes before it
 //            and the data | data[storedSize]
@@ -25,17 +25,26 @@
 //            exactly one zstd frame without its 4-byte magic number, stating its content size (the
 //            raw size); nothing may follow it.
 //   payload: keyframe: active mask | byte planes of the active probes' records.
-//            delta (format 3): u8 form | active mask, when form bit 0 (else the base's is kept)
+//            delta (format 3 and 4): u8 form | active mask, when form bit 0 (else the base's is kept)
 //            | changed probes: u8 count and that many increasing u8 indices when form bit 1, else a
-//            changed mask | per wide symbol (DC codes; every one in fp16) a plane of the low bytes
-//            of its zig-zag difference and, unless form bit 2, a plane of the high bytes | per narrow
-//            symbol a plane of zig-zag differences. Each choice has one allowed spelling: the active
-//            mask only when it changed, the list only for bricks of at most 256 probes when it is
-//            shorter than the mask (1 + count < mask bytes), bit 2 exactly when every wide
-//            difference fits one byte, and a probe listed or masked as changed only when one of its
-//            differences is not 0; form bits 3-7 are 0. Anything else is refused
-//            (CodecStatus::NonCanonical). These rules are about the payload: whether it is stored raw
-//            or compressed, and zstd's own choices, are the encoder's.
+//            changed mask | the zig-zag differences of the changed probes' symbols, either
+//              - byte planes: per wide symbol (DC codes; every one in fp16) a plane of the low bytes
+//                and, unless form bit 2, a plane of the high bytes | per narrow symbol a plane; or
+//              - Rice codes (format 4, form bit 3): a bit stream, low bit first in each byte, of the
+//                wide parameter kw (4 bits) and the narrow one kn (3 bits), then per changed probe
+//                its wide differences under kw and its narrow ones under kn (rice_code.h in the
+//                codec's sources: quotient in unary and k low bits, or at a quotient of 8 eight ones
+//                and the value in 16 or 8 bits), zero bits to the end of the last byte.
+//            Each choice has one allowed spelling: the active mask only when it changed, the list
+//            only for bricks of at most 256 probes when it is shorter than the mask (1 + count < mask
+//            bytes), bit 2 exactly when the planes are used and every wide difference fits one
+//            byte, Rice codes only when they are shorter than the planes, each parameter the
+//            smallest of those that spell its differences in fewest bits, and a probe listed or
+//            masked as changed only when one of its differences is not 0; form bits 4-7 are 0 (3
+//            too in format 3). Anything else is refused (CodecStatus::NonCanonical). These rules are
+//            about the payload: whether it is stored raw or compressed, and zstd's own choices, are
+//            the encoder's; and so, in format 4, is byte planes where Rice codes are shorter (byte
+//            planes of a large change compress; Rice codes do not).
 // Format 1 and 2 sections: u32 brick | u32 version | u8 kind (bits 0-3: 1 keyframe, 2 delta; bits 4-7
 //            as above) | u8 compression (0 raw, 1 zstd with magic) | u32 rawSize | u32 storedSize
 //            | u32 CRC-32C of the preceding 18 bytes and the data | data; their deltas are active mask
@@ -50,8 +59,10 @@
 // hallucinating as before.
 // Format 3 differs from format 2 only in how sections and deltas are spelled (the varint header,
 // the delta's form byte); what they decode to is the same. A section header is 8 to 12 bytes instead
-// of 22 (at most 16), and a small delta drops its masks and high bytes. Format 1 and 2 frames still decode; a
-// carrier of bare sections (bus, wire) states the codec format and refuses another.
+// of 22 (at most 16), and a small delta drops its masks and high bytes. Format 4 differs from format 3
+// only in the Rice-coded differences (form bit 3): a few bits for each small difference where a byte
+// plane spends a byte. Frames of formats 1 to 3 still decode; a carrier of bare sections (bus, wire)
+// states the codec format and refuses another.
 #pragma once
 
 #include <cstddef>
@@ -66,9 +77,10 @@
 
 namespace probecast {
 
-constexpr uint8_t kFormatVersion = 3;         // what encoders write
+constexpr uint8_t kFormatVersion = 4;         // what encoders write
 constexpr uint8_t kOldestFormatVersion = 1;   // the oldest a decoder reads
 constexpr uint8_t kCompactSectionFormat = 3;  // the first format with varint section headers and delta forms
+constexpr uint8_t kRiceDeltaFormat = 4;       // the first format whose deltas may Rice-code their differences
 constexpr size_t kFrameHeaderSize = 32;
 constexpr size_t kFixedSectionHeaderSize = 22;  // formats 1 and 2
 constexpr int kMaxGridDim = 1024;
