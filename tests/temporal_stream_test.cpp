@@ -58,6 +58,7 @@ TEST_P(DriftFree, DecoderMatchesEncoderOver1000NoisyFrames) {
   std::mt19937 rng(1234);
   std::vector<uint8_t> active(count, 1), frame;
   uint32_t switches = 0;  // versions that moved a brick to another representation (error bound)
+  uint32_t riceDeltas = 0;
   for (int f = 0; f < 1000; ++f) {
     if (f % 50 == 0)
       for (int p = 0; p < count; ++p) active[p] = (rng() % 10) != 0;
@@ -67,6 +68,13 @@ TEST_P(DriftFree, DecoderMatchesEncoderOver1000NoisyFrames) {
     enc.update(probes.data(), active.data());
     for (uint32_t b = 0; b < before.size(); ++b) switches += enc.brickVersion(b) != before[b] && enc.deltaIsKeyframe(b);
     enc.writeChangedFrame(frame);
+    for (size_t at = kFrameHeaderSize; at < frame.size();) {  // deltas stored raw whose differences are Rice codes
+      SectionBytes b;
+      ASSERT_TRUE(locateSection(frame.data() + at, frame.size() - at, &b));
+      const uint8_t kind = frame[at + b.kindAt];
+      riceDeltas += (kind & 0x07) == 0x02 && b.storedSize > 0 && (frame[at + b.dataAt] & 0x08) != 0;
+      at += b.dataAt + b.storedSize;
+    }
     ASSERT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok) << "frame " << f;
     expectSameState(enc, dec, "frame " + std::to_string(f));
     if (f == 500) {
@@ -80,6 +88,8 @@ TEST_P(DriftFree, DecoderMatchesEncoderOver1000NoisyFrames) {
   }
   if (errorBound > 0) EXPECT_GT(switches, 2u);  // the bound moved bricks between representations
   else EXPECT_EQ(switches, 0u);
+  // Small differences went as Rice codes (format 4), so the checks above cover them too.
+  EXPECT_GT(riceDeltas, 100u);
   // The reconstruction follows the input: DC within the dead-zone's reach of the last frame.
   const std::vector<float> last = test::movingLightFrame(count, 999, 0.0f, rng);
   double num = 0, den = 0;
