@@ -455,6 +455,10 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_option("--scored-updates", ao->bench.scoredUpdates,
                        "images scored at the last this many updates of each phase (the loss averaged over them)")
       ->check(CLI::Range(1u, 1000u));
+  adaptive->add_option("--stream-seeds", ao->bench.streamSeeds,
+                       "the adaptive rule's streams are measured with this many seeds (--seed, --seed + 1, ...): "
+                       "each noise-aware figure's mean and standard error")
+      ->check(CLI::Range(1u, 1000u));
   addRepresentationOption(adaptive, ao->repr, "l1, zh3h, zh3, l2 or fp16");
   addJsonOption(adaptive, ao->json);
   adaptive->add_option("--chart", ao->chart, "SVG prefix: writes PREFIX_bytes.svg and PREFIX_jump.svg");

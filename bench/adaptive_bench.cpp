@@ -137,6 +137,39 @@ void addReconvergence(renderer::VulkanContext& context, const AdaptiveBenchOptio
 
 }  // namespace
 
+// The noise-aware stream of the adaptive rule over seeds: each figure per seed, its mean, and the
+// standard error of that mean (the spread between seeds is the bench's own noise).
+void addSeedSummary(const std::vector<nlohmann::json>& bySeed, const AdaptiveBenchOptions& o, AdaptiveBenchResult& r) {
+  const auto noiseStream = [](const nlohmann::json& rule) -> const nlohmann::json& { return rule["streams"][2]; };
+  const std::vector<std::pair<std::string, std::function<double(const nlohmann::json&)>>> figures = {
+      {"first_still_bytes_per_probe_frame", [](const nlohmann::json& s) { return s["first_still_bytes_per_probe_frame"].get<double>(); }},
+      {"moving_bytes_per_probe_frame", [](const nlohmann::json& s) { return s["moving_bytes_per_probe_frame"].get<double>(); }},
+      {"static_bytes_per_probe_frame", [](const nlohmann::json& s) { return s["static_bytes_per_probe_frame"].get<double>(); }},
+      {"psnr_loss_db_still", [](const nlohmann::json& s) { return s["psnr_loss_db"]["still"].get<double>(); }},
+      {"psnr_loss_db_moving", [](const nlohmann::json& s) { return s["psnr_loss_db"]["moving"].get<double>(); }},
+      {"psnr_loss_db_still_again", [](const nlohmann::json& s) { return s["psnr_loss_db"]["still_again"].get<double>(); }},
+      {"probe_error_rel_moving", [](const nlohmann::json& s) { return s["probe_error_rel"]["moving"].get<double>(); }}};
+  nlohmann::json& out = r.json["stream_seeds"];
+  out["seeds"] = nlohmann::json::array();
+  for (const nlohmann::json& rule : bySeed) out["seeds"].push_back(rule["seed"]);
+  out["rule"] = bySeed.front()["rule"];
+  out["stream"] = noiseStream(bySeed.front())["stream"];
+  r.table += fmt::format("noise-aware stream of the adaptive rule over seeds {}-{} (mean ± standard error):\n", o.seed,
+                         o.seed + bySeed.size() - 1);
+  for (const auto& [name, get] : figures) {
+    std::vector<double> v;
+    for (const nlohmann::json& rule : bySeed) v.push_back(get(noiseStream(rule)));
+    const double m = mean(v, 0, v.size());
+    double var = 0;
+    for (double x : v) var += (x - m) * (x - m);
+    const double se = std::sqrt(var / static_cast<double>(v.size() - 1) / static_cast<double>(v.size()));
+    out["figures"][name] = {{"per_seed", v}, {"mean", m}, {"standard_error", se}};
+    r.table += fmt::format("  {:<36} {:>8.3f} ± {:.3f}  (", name, m, se);
+    for (size_t i = 0; i < v.size(); ++i) r.table += fmt::format("{}{:.3f}", i ? " " : "", v[i]);
+    r.table += ")\n";
+  }
+}
+
 AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
@@ -233,11 +266,20 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     return b.rejectSigmas > 0 ? fmt::format("adaptive k={:g}", b.rejectSigmas) : fmt::format("w_min {:g}", b.wMin);
   };
   std::vector<imaging::ChartSeries> bytesSeries;
-  for (const BlendRule& rule : rules) {
-    say(fmt::format("adaptive bench: {}", ruleName(rule)));
+  // The adaptive rule again with each further seed: its figures per seed (the tables and charts
+  // are the first seed's).
+  std::vector<nlohmann::json> adaptiveBySeed;
+  const uint32_t streamSeeds = std::max(o.streamSeeds, 1u);
+  std::vector<std::pair<uint32_t, BlendRule>> runs;  // (seed, rule)
+  for (uint32_t extra = 0; extra < streamSeeds; ++extra)
+    for (const BlendRule& rule : rules)
+      if (extra == 0 || rule.rejectSigmas > 0) runs.push_back({o.seed + extra, rule});
+  for (const auto& [seed, rule] : runs) {
+    const bool firstSeed = seed == o.seed;
+    say(fmt::format("adaptive bench: {}{}", ruleName(rule), firstSeed ? "" : fmt::format(", seed {}", seed)));
     renderer::UpdaterOptions uo;
     uo.samplesPerProbe = o.samplesPerProbe;
-    uo.seed = o.seed;
+    uo.seed = seed;
     uo.minBlendWeight = rule.wMin;
     uo.rejectSigmas = rule.rejectSigmas;
     uo.neighbourHistory = rule.rejectSigmas > 0 ? o.neighbourHistory : 0.0f;
@@ -350,6 +392,10 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         worstLoss = std::max(worstLoss, meanLoss);
       }
       sj["worst_psnr_loss_db"] = worstLoss;
+      if (!firstSeed) {
+        ruleJson["streams"].push_back(sj);
+        continue;
+      }
       table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>10.2f}% {:>8.3f} dB\n", ruleName(rule),
                            s.name, mean(s.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),
                            sj["static_bytes_per_probe_frame"].get<double>(), 100 * ruleJson["flicker_rel"].get<double>(),
@@ -362,8 +408,11 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       for (uint32_t f = 1; f < frames; ++f) series.points.push_back({static_cast<double>(f), s.bytesPerProbe[f], ""});
       bytesSeries.push_back(std::move(series));
     }
-    j["rules"].push_back(ruleJson);
+    ruleJson["seed"] = seed;
+    if (rule.rejectSigmas > 0) adaptiveBySeed.push_back(ruleJson);
+    if (firstSeed) j["rules"].push_back(std::move(ruleJson));
   }
+  if (streamSeeds > 1) addSeedSummary(adaptiveBySeed, o, r);
   imaging::ChartSpec bytesSpec;
   bytesSpec.title = fmt::format("Wire bytes per probe per frame: light still, moving (updates {}-{}), still", o.stillUpdates,
                                 o.stillUpdates + o.movingUpdates);

@@ -47,6 +47,9 @@ struct AdaptiveBenchOptions {
   // at that update's light), the loss paired update by update and averaged: one image alone varies
   // by more than the 0.1 dB a noise-aware stream may lose.
   uint32_t scoredUpdates = 8;
+  // The adaptive rule's streams are measured with this many seeds (seed, seed + 1, ...; the fixed
+  // rules, tables and charts with the first): each noise-aware figure's mean and standard error.
+  uint32_t streamSeeds = 1;
   // Re-convergence after a light jump, ray budget against brute force (reconvergence.h).
   uint64_t raysPerUpdate = 0;        // 0 = active probes × samplesPerProbe
   float viewYfov = 0.03f;            // the viewer whose probes are scored (builtin:cornell 4³: 16 of 64 probes)
