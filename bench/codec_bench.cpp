@@ -321,11 +321,19 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
       size_t deltaBytes = 0, keyBytes = 0;
       double err = 0, energy = 0;
       bool driftFree = true;
+      std::vector<double> encodeNs, decodeNs;  // per probe, each frame after the first
       for (int f = 0; f < opt.frames; ++f) {
         const size_t at = static_cast<size_t>(f) * count * kProbeFloats;
+        const auto t0 = Clock::now();
         encoder.update(noisy.data() + at, nullptr);
         encoder.writeChangedFrame(frame);
+        const auto t1 = Clock::now();
         driftFree = driftFree && decoder.apply(frame.data(), frame.size()) == CodecStatus::Ok;
+        const auto t2 = Clock::now();
+        if (f > 0) {
+          encodeNs.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / count);
+          decodeNs.push_back(std::chrono::duration<double, std::nano>(t2 - t1).count() / count);
+        }
         if (f == 0) {
           keyBytes = frame.size();
           continue;
@@ -344,6 +352,8 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
                           {"bytes_per_probe_per_frame", perProbeFrame},
                           {"first_frame_bytes_per_probe", static_cast<double>(keyBytes) / count},
                           {"irradiance_rmse_rel_vs_clean", rmse},
+                          {"encode_ns_per_probe_median", session::median(encodeNs)},
+                          {"decode_ns_per_probe_median", session::median(decodeNs)},
                           {"drift_free", driftFree}};
       if (errorBound > 0.0f) {
         t["error_bound"] = errorBound;
@@ -397,12 +407,13 @@ CodecBenchResult runCodecBench(const CodecBenchOptions& opt) {
   table += zh3hTable;
   table += volumeTable;
   if (!temporal.empty()) {
-    table += fmt::format("\ntemporal ({} frames, 1024 probes, 1% noise): {:<6} {:>4} {:>14} {:>14}\n", opt.frames,
-                         "repr", "dz", "B/probe/frame", "E rmse (clean)");
+    table += fmt::format("\ntemporal ({} frames, 1024 probes, 1% noise): {:<6} {:>4} {:>14} {:>14} {:>12}\n", opt.frames,
+                         "repr", "dz", "B/probe/frame", "E rmse (clean)", "enc/dec ns");
     for (const auto& t : temporal)
-      table += fmt::format("{:>44} {:<6} {:>4} {:>14.3f} {:>13.2f}%{}{}\n", "", t["representation"].get<std::string>(),
-                           t["deadzone"].get<int>(), t["bytes_per_probe_per_frame"].get<double>(),
-                           100 * t["irradiance_rmse_rel_vs_clean"].get<double>(),
+      table += fmt::format("{:>44} {:<6} {:>4} {:>14.3f} {:>13.2f}% {:>6.0f}/{:<5.0f}{}{}\n", "",
+                           t["representation"].get<std::string>(), t["deadzone"].get<int>(),
+                           t["bytes_per_probe_per_frame"].get<double>(), 100 * t["irradiance_rmse_rel_vs_clean"].get<double>(),
+                           t["encode_ns_per_probe_median"].get<double>(), t["decode_ns_per_probe_median"].get<double>(),
                            t.contains("error_bound")
                                ? fmt::format("  error bound {:g}%, first frame {:.2f} B/probe, bricks {}",
                                              100 * t["error_bound"].get<double>(),

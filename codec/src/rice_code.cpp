@@ -1,4 +1,4 @@
-#include "rice_code.h"
+#include "probecast/codec/internal/rice_code.h"
 
 namespace probecast {
 
@@ -12,38 +12,35 @@ uint64_t riceBits(const uint16_t* values, size_t count, int k, int valueBits) {
 }
 
 int riceParameter(const uint16_t* values, size_t count, int parameterBits, int valueBits, uint64_t* bits) {
+  // One pass instead of one per k. A value of bit length L is escaped for k <= L - 4 (its quotient
+  // v >> k is 8 or more), spelled with quotient v >> k in 1..7 for L - 3 <= k < L, and with quotient 0
+  // for k >= L; so each k's bits are the escaped values' full spellings, every other value's 1 + k,
+  // and the quotients of the values in their middle band.
+  constexpr int kMaxK = 16;
+  uint64_t lengths[kMaxK + 2] = {};  // values per bit length 0..16
+  uint64_t quotients[kMaxK] = {};    // per k: the sum of v >> k over values with L - 3 <= k < L
+  for (size_t i = 0; i < count; ++i) {
+    const uint32_t v = values[i];
+    const int length = v == 0 ? 0 : 32 - __builtin_clz(v);
+    ++lengths[length];
+    for (int k = length > 3 ? length - 3 : 0; k < length; ++k) quotients[k] += v >> k;
+  }
+  const int ks = 1 << parameterBits;
   int best = 0;
-  uint64_t bestBits = riceBits(values, count, 0, valueBits);
-  for (int k = 1; k < (1 << parameterBits); ++k) {
-    const uint64_t b = riceBits(values, count, k, valueBits);
-    if (b < bestBits) {
+  uint64_t bestBits = 0;
+  uint64_t escaped = 0;  // values of bit length >= k + 4
+  for (int length = 4; length <= kMaxK; ++length) escaped += lengths[length];
+  for (int k = 0; k < ks; ++k) {
+    const uint64_t b = escaped * (kRiceEscapeQuotient + static_cast<uint64_t>(valueBits)) +
+                       (count - escaped) * (1 + static_cast<uint64_t>(k)) + quotients[k];
+    if (k == 0 || b < bestBits) {
       best = k;
       bestBits = b;
     }
+    if (k + 4 <= kMaxK) escaped -= lengths[k + 4];
   }
   *bits = bestBits;
   return best;
-}
-
-void BitWriter::put(uint32_t value, int bits) {
-  pending_ |= static_cast<uint64_t>(value & ((1u << bits) - 1u)) << pendingBits_;
-  pendingBits_ += bits;
-  while (pendingBits_ >= 8) {
-    out_.push_back(static_cast<uint8_t>(pending_));
-    pending_ >>= 8;
-    pendingBits_ -= 8;
-  }
-}
-
-void BitWriter::putRice(uint16_t value, int k, int valueBits) {
-  const uint32_t q = static_cast<uint32_t>(value) >> k;
-  if (q >= kRiceEscapeQuotient) {
-    put((1u << kRiceEscapeQuotient) - 1u, kRiceEscapeQuotient);
-    put(value, valueBits);
-    return;
-  }
-  put((1u << q) - 1u, static_cast<int>(q) + 1);  // q ones, then the zero
-  if (k > 0) put(value, k);
 }
 
 void BitWriter::flush() {

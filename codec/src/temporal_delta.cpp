@@ -4,7 +4,7 @@
 
 #include "brick_section.h"
 #include "byte_io.h"
-#include "rice_code.h"
+#include "probecast/codec/internal/rice_code.h"
 
 namespace probecast {
 namespace {

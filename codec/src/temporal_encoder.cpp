@@ -226,8 +226,10 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
     writeSection(b, s.versions[b], kind, repr, s.layout.repr, s.raw, s.options.zstdLevel, zstd, s.deltas[b]);
     // The delta's differences as Rice codes, where those are shorter, stored instead when the section
     // comes out shorter (byte planes compress where Rice codes do not: a large change of many probes).
+    // Rice codes are stored raw: zstd finds next to nothing in them, and compressing every delta twice
+    // would double the encoder's zstd time.
     if (!switched && !s.riceRaw.empty()) {
-      writeSection(b, s.versions[b], kind, repr, s.layout.repr, s.riceRaw, s.options.zstdLevel, zstd, s.riceSection);
+      writeSection(b, s.versions[b], kind, repr, s.layout.repr, s.riceRaw, s.options.zstdLevel, nullptr, s.riceSection);
       if (s.riceSection.size() < s.deltas[b].size()) s.deltas[b].swap(s.riceSection);
     }
     s.brickRepr[b] = repr;

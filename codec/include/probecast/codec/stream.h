@@ -32,8 +32,8 @@
 //                and, unless form bit 2, a plane of the high bytes | per narrow symbol a plane; or
 //              - Rice codes (format 4, form bit 3): a bit stream, low bit first in each byte, of the
 //                wide parameter kw (4 bits) and the narrow one kn (3 bits), then per changed probe
-//                its wide differences under kw and its narrow ones under kn (rice_code.h in the
-//                codec's sources: quotient in unary and k low bits, or at a quotient of 8 eight ones
+//                its wide differences under kw and its narrow ones under kn (internal/rice_code.h:
+//                quotient in unary and k low bits, or at a quotient of 8 eight ones
 //                and the value in 16 or 8 bits), zero bits to the end of the last byte.
 //            Each choice has one allowed spelling: the active mask only when it changed, the list
 //            only for bricks of at most 256 probes when it is shorter than the mask (1 + count < mask

@@ -1,4 +1,5 @@
-// Rice codes of a delta's symbol differences (format 4, stream.h) (private to the codec).
+// Rice codes of a delta's symbol differences (format 4, stream.h). Internal to the codec; here,
+// under probecast/codec/internal/, for its tests.
 //
 // A value v (a zig-zag difference) under parameter k is its quotient q = v >> k in unary (q one
 // bits, then a zero bit) and its k low bits; a quotient of kRiceEscapeQuotient or more is instead
@@ -29,8 +30,24 @@ int riceParameter(const uint16_t* values, size_t count, int parameterBits, int v
 class BitWriter {
  public:
   explicit BitWriter(std::vector<uint8_t>& out) : out_(out) {}
-  void put(uint32_t value, int bits);  // bits <= 24
-  void putRice(uint16_t value, int k, int valueBits);
+  void put(uint32_t value, int bits) {  // bits <= 24
+    pending_ |= static_cast<uint64_t>(value & ((1u << bits) - 1u)) << pendingBits_;
+    pendingBits_ += bits;
+    while (pendingBits_ >= 8) {
+      out_.push_back(static_cast<uint8_t>(pending_));
+      pending_ >>= 8;
+      pendingBits_ -= 8;
+    }
+  }
+  void putRice(uint16_t value, int k, int valueBits) {
+    const uint32_t q = static_cast<uint32_t>(value) >> k;
+    if (q >= kRiceEscapeQuotient) {  // eight ones, then the value in full
+      put((1u << kRiceEscapeQuotient) - 1u, kRiceEscapeQuotient);
+      put(value, valueBits);
+    } else {  // q ones, the zero, then the k low bits: at most 8 + 15 bits
+      put(((static_cast<uint32_t>(value) & ((1u << k) - 1u)) << (q + 1)) | ((1u << q) - 1u), static_cast<int>(q) + 1 + k);
+    }
+  }
   void flush();  // pads the last byte with zero bits
 
  private:
