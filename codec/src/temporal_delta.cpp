@@ -65,7 +65,7 @@ RiceSpelling riceSpelling(const DeltaSymbols& d) {
   return r;
 }
 
-// Format 4 spells the differences as Rice codes exactly when that is shorter than byte planes.
+// Format 4 allows Rice codes only where they are shorter than byte planes (and byte planes anywhere).
 bool riceIsShorter(const DeltaSymbols& d, const RiceSpelling& r) { return d.changed > 0 && r.bytes < d.planeBytes(); }
 
 void appendRice(const DeltaSymbols& d, const RiceSpelling& r, std::vector<uint8_t>& out) {
