@@ -2,15 +2,6 @@
 
 namespace probecast {
 
-uint64_t riceBits(const uint16_t* values, size_t count, int k, int valueBits) {
-  uint64_t bits = 0;
-  for (size_t i = 0; i < count; ++i) {
-    const uint32_t q = static_cast<uint32_t>(values[i]) >> k;
-    bits += q < kRiceEscapeQuotient ? q + 1 + static_cast<uint32_t>(k) : kRiceEscapeQuotient + static_cast<uint32_t>(valueBits);
-  }
-  return bits;
-}
-
 int riceParameter(const uint16_t* values, size_t count, int parameterBits, int valueBits, uint64_t* bits) {
   // One pass instead of one per k. A value of bit length L is escaped for k <= L - 4 (its quotient
   // v >> k is 8 or more), spelled with quotient v >> k in 1..7 for L - 3 <= k < L, and with quotient 0

@@ -20,9 +20,6 @@ constexpr int kRiceNarrowParameterBits = 3;  // k of the narrow differences: 0..
 constexpr int kRiceWideValueBits = 16;
 constexpr int kRiceNarrowValueBits = 8;
 
-// Bits that `values` take under parameter k (`valueBits` wide: 16 or 8).
-uint64_t riceBits(const uint16_t* values, size_t count, int k, int valueBits);
-
 // The parameter (0 .. 2^parameterBits − 1) under which `values` take the fewest bits, the smallest
 // such k on ties (so a set of values has one parameter); its bit count into *bits.
 int riceParameter(const uint16_t* values, size_t count, int parameterBits, int valueBits, uint64_t* bits);
