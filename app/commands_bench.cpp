@@ -10,6 +10,7 @@
 #include "edge_bench.h"
 #include "environment_bench.h"
 #include "probecast/codec/probe_file.h"
+#include "probecast/renderer/view_sets.h"
 #include "commands.h"
 #include "progress.h"
 #include "scene_options.h"
@@ -455,6 +456,14 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_option("--scored-updates", ao->bench.scoredUpdates,
                        "images scored at the last this many updates of each phase (the loss averaged over them)")
       ->check(CLI::Range(1u, 1000u));
+  adaptive->add_option("--scored-views", ao->bench.scoredViews,
+                       "views each scored image is made of: mono (the scene camera), stereo, lf:NxM or lfh:NxM "
+                       "around it; one PSNR over all their pixels")
+      ->check([](const std::string& text) {
+        renderer::ViewSetSpec spec;
+        std::string error;
+        return renderer::parseViewSet(text, spec, error) ? std::string() : error;
+      });
   adaptive->add_option("--stream-seeds", ao->bench.streamSeeds,
                        "the adaptive rule's streams are measured with this many seeds (--seed, --seed + 1, ...): "
                        "each noise-aware figure's mean and standard error")

@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <numeric>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -14,6 +15,7 @@
 #include "probecast/imaging/svg_chart.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/reference_camera.h"
+#include "probecast/renderer/view_sets.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/stats.h"
 #include "reconvergence.h"
@@ -154,6 +156,8 @@ void addSeedSummary(const std::vector<nlohmann::json>& bySeed, const AdaptiveBen
   for (const nlohmann::json& rule : bySeed) out["seeds"].push_back(rule["seed"]);
   out["rule"] = bySeed.front()["rule"];
   out["stream"] = noiseStream(bySeed.front())["stream"];
+  for (const nlohmann::json& rule : bySeed)
+    out["psnr_loss_db_per_update"].push_back(noiseStream(rule)["psnr_loss_db_per_update"]);
   r.table += fmt::format("noise-aware stream of the adaptive rule over seeds {}-{} (mean ± standard error):\n", o.seed,
                          o.seed + bySeed.size() - 1);
   for (const auto& [name, get] : figures) {
@@ -206,13 +210,31 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   moments[1].name = "moving";
   moments[2].name = "still_again";
   const renderer::CameraView camera = renderer::CameraView::fromScene(first);
+  renderer::ViewSetSpec viewSpec;
+  std::string viewError;
+  if (!renderer::parseViewSet(o.scoredViews, viewSpec, viewError))
+    throw std::invalid_argument("bench adaptive: scored views: " + viewError);
+  renderer::ViewSetOptions viewOptions;
+  viewOptions.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
+  const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(camera, viewSpec, viewOptions);
+  // Every scored view of a volume (the scene camera alone for mono, as a viewer sees it).
   const auto render = [&](const ProbeVolume& v, float t) {
     renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
     raster.setProbes(v);
-    return raster.render(raster.viewProjection(camera), camera.position);
+    if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono)
+      return std::vector<renderer::Image>{raster.render(raster.viewProjection(camera), camera.position)};
+    return raster.renderViews(views);
   };
-  // The truth at every t a scored update has: the view of a converged float volume.
-  std::map<float, renderer::Image> truthImages;
+  // One PSNR for a set of views: of their pixels together (the mean of the views' squared errors).
+  const auto psnrOf = [&](const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) {
+    double mse = 0;
+    for (size_t i = 0; i < images.size(); ++i)
+      mse += imaging::compareImages(images[i].rgb, truth[i].rgb, static_cast<int>(o.width), static_cast<int>(o.height)).mse;
+    mse /= static_cast<double>(images.size());
+    return mse > 0 ? 10.0 * std::log10(1.0 / mse) : HUGE_VAL;
+  };
+  // The truth at every t a scored update has: the views of a converged float volume.
+  std::map<float, std::vector<renderer::Image>> truthImages;
   std::map<float, std::vector<float>> truthProbes;  // and the converged volume itself
   const auto converge = [&](float t, bool withImage) {
     if (truthProbes.count(t) && (!withImage || truthImages.count(t))) return;
@@ -249,6 +271,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["confirmations"] = o.confirmations;
   j["refinement_interval"] = o.refinementInterval;
   j["change_history"] = o.changeHistory;
+  j["scored_views"] = o.scoredViews;
   j["metric"] = "flicker: median relative irradiance change per update over the last half of a still phase; PSNR of "
                 "the raster view against the one from a converged float volume (plain gamma 2.2); probe error: relative "
                 "irradiance RMSE of the held volume against that converged volume";
@@ -256,6 +279,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", first.name, o.dims[0],
                       o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
                       context.deviceName());
+  table += fmt::format("images: {} view{} ({}) at the last {} updates of each phase\n", views.size(),
+                       views.size() == 1 ? "" : "s", o.scoredViews, o.scoredUpdates);
   table += fmt::format("{:<14} {:<7} {:>9} {:>9} {:>9} {:>9} {:>11} {:>11}\n", "rule", "stream", "still B", "moving B",
                        "again B", "flicker", "held flick", "PSNR loss");
 
@@ -345,12 +370,9 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         for (size_t k = 0; k < streams.size(); ++k) {
           ProbeVolume held;
           streams[k].encoder->copyVolume(grid.bounds, held);
-          const renderer::Image img = render(held, tAt(f));
           probeError[k][m].push_back(irradianceRmseRel(held.probes.data(), truthProbes.at(tAt(f)).data(),
                                                        held.active.data(), count));
-          psnr[k][m].push_back(imaging::compareImages(img.rgb, truthImages.at(tAt(f)).rgb,
-                                                      static_cast<int>(o.width), static_cast<int>(o.height))
-                                   .psnrDb);
+          psnr[k][m].push_back(psnrOf(render(held, tAt(f)), truthImages.at(tAt(f))));
         }
       }
     }
@@ -389,6 +411,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         sj["probe_error_rel"][moments[m].name] = mean(probeError[k][m], 0, probeError[k][m].size());
         sj["psnr_loss_db"][moments[m].name] = meanLoss;
         sj["psnr_loss_standard_error_db"][moments[m].name] = se;
+        sj["psnr_loss_db_per_update"][moments[m].name] = loss;
         worstLoss = std::max(worstLoss, meanLoss);
       }
       sj["worst_psnr_loss_db"] = worstLoss;

@@ -47,6 +47,9 @@ struct AdaptiveBenchOptions {
   // at that update's light), the loss paired update by update and averaged: one image alone varies
   // by more than the 0.1 dB a noise-aware stream may lose.
   uint32_t scoredUpdates = 8;
+  // The views each scored image is made of ("mono": the scene camera; "stereo", "lf:NxM", "lfh:NxM"
+  // around it, view_sets.h): one PSNR over all their pixels.
+  std::string scoredViews = "mono";
   // The adaptive rule's streams are measured with this many seeds (seed, seed + 1, ...; the fixed
   // rules, tables and charts with the first): each noise-aware figure's mean and standard error.
   uint32_t streamSeeds = 1;
