@@ -464,6 +464,8 @@ void addBenchAdaptive(CLI::App* bench) {
         std::string error;
         return renderer::parseViewSet(text, spec, error) ? std::string() : error;
       });
+  adaptive->add_option("--truth-cache", ao->bench.truthCache,
+                       "directory keeping the converged volumes images are scored against, between runs");
   adaptive->add_option("--stream-seeds", ao->bench.streamSeeds,
                        "the adaptive rule's streams are measured with this many seeds (--seed, --seed + 1, ...): "
                        "each noise-aware figure's mean and standard error")

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <filesystem>
 #include <numeric>
 #include <stdexcept>
 
@@ -11,6 +12,7 @@
 
 #include "probecast/codec/irradiance_error.h"
 #include "probecast/codec/stream.h"
+#include "probecast/codec/probe_file.h"
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/imaging/svg_chart.h"
 #include "probecast/renderer/raster_client.h"
@@ -18,12 +20,17 @@
 #include "probecast/renderer/view_sets.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/stats.h"
+#include "harness.h"
 #include "reconvergence.h"
 #include "stability.h"
 #include "update_bench.h"
 
 namespace probecast::bench {
 namespace {
+
+// The converged volumes' recipe (the updater's settings below and its code): raise it when either
+// changes what they converge to, so --truth-cache files of the old one are not read.
+constexpr int kTruthVolumeVersion = 1;
 
 // One stream a rule's volumes go through: what it cost per frame, and what it holds.
 struct Stream {
@@ -238,13 +245,46 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   std::map<float, std::vector<float>> truthProbes;  // and the converged volume itself
   const auto converge = [&](float t, bool withImage) {
     if (truthProbes.count(t) && (!withImage || truthImages.count(t))) return;
-    say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
+    const scene::Scene sceneNow = sceneAt(t);
     renderer::UpdaterOptions ro;
     ro.samplesPerProbe = 512;
     ro.rejectSigmas = 0.0f;
     ro.seed = 4242;
-    renderer::ProbeUpdater u(context, sceneAt(t), grid, ro);
-    for (int k = 0; k < 16; ++k) u.update();
+    constexpr int kUpdates = 16;
+    // The cache's file for this volume: named by everything it is made of.
+    std::string path;
+    if (!o.truthCache.empty()) {
+      const nlohmann::json key = {{"truth_version", kTruthVolumeVersion},
+                                  {"scene_hash", sceneContentHash(sceneNow)},
+                                  {"grid", {o.dims[0], o.dims[1], o.dims[2]}},
+                                  {"spp", ro.samplesPerProbe},
+                                  {"updates", kUpdates},
+                                  {"seed", ro.seed}};
+      path = o.truthCache + "/truth_" + referenceKeyStem(key) + ".pcpv";
+      ProbeVolume stored;
+      std::string why;
+      if (std::filesystem::exists(path)) {
+        if (readProbeFile(path, stored, why) && stored.probes.size() == static_cast<size_t>(count) * kProbeFloats) {
+          if (withImage) truthImages.emplace(t, render(stored, t));
+          truthProbes.emplace(t, std::move(stored.probes));
+          return;
+        }
+        say(fmt::format("adaptive bench: {} unusable ({}); converging again", path, why.empty() ? "another grid" : why));
+      }
+    }
+    say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
+    renderer::ProbeUpdater u(context, sceneNow, grid, ro);
+    for (int k = 0; k < kUpdates; ++k) u.update();
+    if (!path.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(o.truthCache, ec);
+      std::string error;
+      // Written beside its name, then renamed: an interrupted run leaves no half file.
+      if (ec || !writeProbeFile(path + ".tmp", u.volume(), error))
+        throw std::runtime_error("--truth-cache " + o.truthCache + ": " + (ec ? ec.message() : error));
+      std::filesystem::rename(path + ".tmp", path, ec);
+      if (ec) throw std::runtime_error("--truth-cache " + path + ": " + ec.message());
+    }
     if (withImage) truthImages.emplace(t, render(u.volume(), t));
     truthProbes.emplace(t, u.volume().probes);
   };

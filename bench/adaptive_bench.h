@@ -50,6 +50,9 @@ struct AdaptiveBenchOptions {
   // The views each scored image is made of ("mono": the scene camera; "stereo", "lf:NxM", "lfh:NxM"
   // around it, view_sets.h): one PSNR over all their pixels.
   std::string scoredViews = "mono";
+  // A directory where the converged volumes are kept between runs (empty: none), each named by the
+  // scene's content, the grid and the converged volume's settings.
+  std::string truthCache;
   // The adaptive rule's streams are measured with this many seeds (seed, seed + 1, ...; the fixed
   // rules, tables and charts with the first): each noise-aware figure's mean and standard error.
   uint32_t streamSeeds = 1;
