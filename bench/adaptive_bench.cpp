@@ -3,16 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <map>
 #include <filesystem>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "probecast/codec/irradiance_error.h"
-#include "probecast/codec/stream.h"
 #include "probecast/codec/probe_file.h"
+#include "probecast/codec/stream.h"
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/imaging/svg_chart.h"
 #include "probecast/renderer/raster_client.h"
@@ -31,6 +31,29 @@ namespace {
 // The converged volumes' recipe (the updater's settings below and its code): raise it when either
 // changes what they converge to, so --truth-cache files of the old one are not read.
 constexpr int kTruthVolumeVersion = 1;
+
+// --truth-cache: a converged volume's file, named by everything it is made of.
+std::string truthCachePath(const std::string& dir, const scene::Scene& scene, const std::array<uint32_t, 3>& dims,
+                           const renderer::UpdaterOptions& ro, int updates) {
+  const nlohmann::json key = {{"truth_version", kTruthVolumeVersion},
+                              {"scene_hash", sceneContentHash(scene)},
+                              {"grid", {dims[0], dims[1], dims[2]}},
+                              {"spp", ro.samplesPerProbe},
+                              {"updates", updates},
+                              {"seed", ro.seed}};
+  return dir + "/truth_" + referenceKeyStem(key) + ".pcpv";
+}
+
+// The cached volume when its file is there and sound (checksum, values, `count` probes); a file
+// that is not is said so, and converged again by the caller.
+bool readTruth(const std::string& path, uint32_t count, ProbeVolume& out,
+               const std::function<void(const std::string&)>& say) {
+  if (!std::filesystem::exists(path)) return false;
+  std::string why;
+  if (readProbeFile(path, out, why) && out.probes.size() == static_cast<size_t>(count) * kProbeFloats) return true;
+  say(fmt::format("adaptive bench: {} unusable ({}); converging again", path, why.empty() ? "another grid" : why));
+  return false;
+}
 
 // One stream a rule's volumes go through: what it cost per frame, and what it holds.
 struct Stream {
@@ -251,26 +274,12 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     ro.rejectSigmas = 0.0f;
     ro.seed = 4242;
     constexpr int kUpdates = 16;
-    // The cache's file for this volume: named by everything it is made of.
-    std::string path;
-    if (!o.truthCache.empty()) {
-      const nlohmann::json key = {{"truth_version", kTruthVolumeVersion},
-                                  {"scene_hash", sceneContentHash(sceneNow)},
-                                  {"grid", {o.dims[0], o.dims[1], o.dims[2]}},
-                                  {"spp", ro.samplesPerProbe},
-                                  {"updates", kUpdates},
-                                  {"seed", ro.seed}};
-      path = o.truthCache + "/truth_" + referenceKeyStem(key) + ".pcpv";
-      ProbeVolume stored;
-      std::string why;
-      if (std::filesystem::exists(path)) {
-        if (readProbeFile(path, stored, why) && stored.probes.size() == static_cast<size_t>(count) * kProbeFloats) {
-          if (withImage) truthImages.emplace(t, render(stored, t));
-          truthProbes.emplace(t, std::move(stored.probes));
-          return;
-        }
-        say(fmt::format("adaptive bench: {} unusable ({}); converging again", path, why.empty() ? "another grid" : why));
-      }
+    const std::string path = o.truthCache.empty() ? std::string() : truthCachePath(o.truthCache, sceneNow, o.dims, ro, kUpdates);
+    ProbeVolume stored;
+    if (!path.empty() && readTruth(path, count, stored, say)) {
+      if (withImage) truthImages.emplace(t, render(stored, t));
+      truthProbes.emplace(t, std::move(stored.probes));
+      return;
     }
     say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
     renderer::ProbeUpdater u(context, sceneNow, grid, ro);
@@ -278,12 +287,10 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     if (!path.empty()) {
       std::error_code ec;
       std::filesystem::create_directories(o.truthCache, ec);
-      std::string error;
-      // Written beside its name, then renamed: an interrupted run leaves no half file.
-      if (ec || !writeProbeFile(path + ".tmp", u.volume(), error))
-        throw std::runtime_error("--truth-cache " + o.truthCache + ": " + (ec ? ec.message() : error));
-      std::filesystem::rename(path + ".tmp", path, ec);
-      if (ec) throw std::runtime_error("--truth-cache " + path + ": " + ec.message());
+      if (ec) throw std::runtime_error("--truth-cache " + o.truthCache + ": " + ec.message());
+      std::vector<uint8_t> bytes;
+      serializeProbeVolume(u.volume(), bytes);
+      writeFileAtomically(path, std::string(bytes.begin(), bytes.end()));
     }
     if (withImage) truthImages.emplace(t, render(u.volume(), t));
     truthProbes.emplace(t, u.volume().probes);

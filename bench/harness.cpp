@@ -170,19 +170,18 @@ nlohmann::json readJsonFile(const std::string& path) {
   return nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
 }
 
-// Writes `text` under a temporary name, then renames it into place: a reader sees all or nothing.
-void writeFileAtomically(const std::string& path, const std::string& text) {
+}  // namespace
+
+void writeFileAtomically(const std::string& path, const std::string& bytes) {
   {
-    std::ofstream out(path + ".tmp");
-    out << text;
-    if (!out) throw std::runtime_error("reference cache: cannot write " + path + ".tmp");
+    std::ofstream out(path + ".tmp", std::ios::binary);
+    out << bytes;
+    if (!out) throw std::runtime_error("cache: cannot write " + path + ".tmp");
   }
   std::error_code ec;
   std::filesystem::rename(path + ".tmp", path, ec);
-  if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
+  if (ec) throw std::runtime_error("cache: " + path + ": " + ec.message());
 }
-
-}  // namespace
 
 bool ReferenceCache::loadHalf(const nlohmann::json& key, const std::string& stem, int k, uint32_t seed, uint32_t spp,
                               renderer::Image& out, double& seconds, std::string& why) const {

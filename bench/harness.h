@@ -61,6 +61,9 @@ struct Reference {
 // The key in full (JSON) and its file stem (16 hex digits of its hash).
 nlohmann::json referenceKey(const scene::Scene& scene, const ReferenceRequest& request);
 std::string referenceKeyStem(const nlohmann::json& key);
+// Writes `bytes` under a temporary name, then renames it into place: a reader sees all or nothing.
+// Throws std::runtime_error naming the file when either fails.
+void writeFileAtomically(const std::string& path, const std::string& bytes);
 // A 64-bit hash of the loaded scene's content, as 16 hex digits.
 std::string sceneContentHash(const scene::Scene& scene);
 // $XDG_CACHE_HOME/probecast/references, else $HOME/.cache/probecast/references.
