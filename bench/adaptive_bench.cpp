@@ -180,7 +180,9 @@ void addSeedSummary(const std::vector<nlohmann::json>& bySeed, const AdaptiveBen
       {"psnr_loss_db_still", [](const nlohmann::json& s) { return s["psnr_loss_db"]["still"].get<double>(); }},
       {"psnr_loss_db_moving", [](const nlohmann::json& s) { return s["psnr_loss_db"]["moving"].get<double>(); }},
       {"psnr_loss_db_still_again", [](const nlohmann::json& s) { return s["psnr_loss_db"]["still_again"].get<double>(); }},
-      {"probe_error_rel_moving", [](const nlohmann::json& s) { return s["probe_error_rel"]["moving"].get<double>(); }}};
+      {"probe_error_rel_moving", [](const nlohmann::json& s) { return s["probe_error_rel"]["moving"].get<double>(); }},
+      {"probe_error_rel_per_probe_moving",
+       [](const nlohmann::json& s) { return s["probe_error_rel_per_probe"]["moving"].get<double>(); }}};
   nlohmann::json& out = r.json["stream_seeds"];
   out["seeds"] = nlohmann::json::array();
   for (const nlohmann::json& rule : bySeed) out["seeds"].push_back(rule["seed"]);
@@ -321,7 +323,9 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["scored_views"] = o.scoredViews;
   j["metric"] = "flicker: median relative irradiance change per update over the last half of a still phase; PSNR of "
                 "the raster view against the one from a converged float volume (plain gamma 2.2); probe error: relative "
-                "irradiance RMSE of the held volume against that converged volume";
+                "irradiance RMSE of the held volume against that converged volume (probe_error_rel: pooled over the "
+                "probes, so bright ones dominate; probe_error_rel_per_probe: each probe relative to its own energy, "
+                "RMS over the probes)";
   std::string& table = r.table;
   table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", first.name, o.dims[0],
                       o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
@@ -385,6 +389,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     std::vector<std::vector<std::vector<double>>> psnr(streams.size(), std::vector<std::vector<double>>(moments.size()));
     // probeError[stream][moment]: the held volume's relative irradiance RMSE against the converged one.
     std::vector<std::vector<std::vector<double>>> probeError = psnr;
+    // probeErrorEach[stream][moment]: the same, each probe relative to its own energy (dim ones count as much).
+    std::vector<std::vector<std::vector<double>>> probeErrorEach = psnr;
     std::vector<uint8_t> frame;
     for (uint32_t f = 0; f < frames; ++f) {
       if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) u.setScene(sceneAt(tAt(f)));
@@ -419,6 +425,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
           streams[k].encoder->copyVolume(grid.bounds, held);
           probeError[k][m].push_back(irradianceRmseRel(held.probes.data(), truthProbes.at(tAt(f)).data(),
                                                        held.active.data(), count));
+          probeErrorEach[k][m].push_back(irradianceRmseRelPerProbe(held.probes.data(), truthProbes.at(tAt(f)).data(),
+                                                                   held.active.data(), count));
           psnr[k][m].push_back(psnrOf(render(held, tAt(f)), truthImages.at(tAt(f))));
         }
       }
@@ -456,6 +464,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         const double se = loss.size() > 1 ? std::sqrt(var / static_cast<double>(loss.size() - 1) / static_cast<double>(loss.size())) : 0.0;
         sj["psnr_db"][moments[m].name] = mean(mine, 0, mine.size());
         sj["probe_error_rel"][moments[m].name] = mean(probeError[k][m], 0, probeError[k][m].size());
+        sj["probe_error_rel_per_probe"][moments[m].name] = mean(probeErrorEach[k][m], 0, probeErrorEach[k][m].size());
         sj["psnr_loss_db"][moments[m].name] = meanLoss;
         sj["psnr_loss_standard_error_db"][moments[m].name] = se;
         sj["psnr_loss_db_per_update"][moments[m].name] = loss;

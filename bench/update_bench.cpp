@@ -32,6 +32,21 @@ double irradianceRmseRel(const float* test, const float* reference, const uint8_
   return energy > 0 ? std::sqrt(err / energy) : 0.0;
 }
 
+double irradianceRmseRelPerProbe(const float* test, const float* reference, const uint8_t* active, uint32_t count) {
+  double sum = 0;
+  uint32_t probes = 0;
+  for (uint32_t p = 0; p < count; ++p) {
+    double err = 0, energy = 0;
+    if (active && !active[p]) continue;
+    irradianceErrorEnergy(test + static_cast<size_t>(p) * kProbeFloats, reference + static_cast<size_t>(p) * kProbeFloats,
+                          err, energy);
+    if (!(energy > 0)) continue;
+    sum += err / energy;
+    ++probes;
+  }
+  return probes > 0 ? std::sqrt(sum / probes) : 0.0;
+}
+
 UpdateBenchResult runUpdateBench(const UpdateBenchOptions& opt) {
   const auto say = [&](const std::string& s) {
     if (opt.progress) opt.progress(s);

@@ -35,5 +35,9 @@ UpdateBenchResult runUpdateBench(const UpdateBenchOptions& options);
 // Relative irradiance difference between two probe sets, exact over the sphere (SH orthonormality),
 // pooled over RGB and the probes where `active` is set.
 double irradianceRmseRel(const float* test, const float* reference, const uint8_t* active, uint32_t count);
+// The same difference taken relative to each probe's own energy, then the RMS over the probes (a
+// dim probe counts as much as a bright one, as in an image after tone mapping); probes without
+// energy in `reference` are left out.
+double irradianceRmseRelPerProbe(const float* test, const float* reference, const uint8_t* active, uint32_t count);
 
 }  // namespace probecast::bench

@@ -2,6 +2,9 @@
 // with samples.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "update_bench.h"
 
 namespace probecast::bench {
@@ -45,6 +48,24 @@ TEST(UpdateBench, DeviceMemoryDoesNotGrowWithSamples) {
   b.samplesPerProbe = 2048;
   renderer::ProbeUpdater ua(context, s, g, a), ub(context, s, g, b);
   EXPECT_EQ(ub.deviceBytes() - ua.deviceBytes(), (2048u - 64u) * 16u);
+}
+
+TEST(UpdateBench, PerProbeErrorCountsADimProbeAsMuchAsABrightOne) {
+  // Four probes, DC only (the bands' weights cancel in every ratio): a bright one 10 % off, a dim
+  // one 50 % off, an inactive one far off and a black one. Pooled, the bright probe's energy hides
+  // the dim one's error: sqrt((1 + 0.25) / (100 + 1)) = 0.111. Per probe: sqrt((0.1² + 0.5²) / 2) =
+  // 0.361; the inactive and the black probe are left out (counting the black one would give 0.294).
+  std::vector<float> test(4 * kProbeFloats, 0.0f), reference(4 * kProbeFloats, 0.0f);
+  const float dc[4][2] = {{11.0f, 10.0f}, {1.5f, 1.0f}, {50.0f, 1.0f}, {0.0f, 0.0f}};  // {test, reference}
+  for (int p = 0; p < 4; ++p)
+    for (int c = 0; c < 3; ++c) {
+      test[p * kProbeFloats + c] = dc[p][0];
+      reference[p * kProbeFloats + c] = dc[p][1];
+    }
+  const uint8_t active[4] = {1, 1, 0, 1};
+  EXPECT_NEAR(irradianceRmseRel(test.data(), reference.data(), active, 4), std::sqrt(1.25 / 101.0), 1e-6);
+  EXPECT_NEAR(irradianceRmseRelPerProbe(test.data(), reference.data(), active, 4), std::sqrt(0.13), 1e-6);
+  EXPECT_EQ(irradianceRmseRelPerProbe(test.data(), test.data(), nullptr, 4), 0.0);
 }
 
 }  // namespace
