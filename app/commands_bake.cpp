@@ -30,9 +30,9 @@ void addBakeCommand(CLI::App& app) {
                s.triangleCount(), context.deviceName(), g.dims[0], g.dims[1], g.dims[2], tr->tracer.spp,
                env ? env->name : "none");
     const renderer::ClassifyStats& cs = updater.classifyStats();
-    fmt::print("bake: {} of {} probes active ({} inside geometry at grid positions, {} left inactive); relocation {}: "
-               "{} moved, mean |offset| {:.3f} m, max {:.2f} cell, {} rounds, {:.1f} ms\n",
-               g.count() - cs.inactive, g.count(), cs.insideAtGrid, cs.inactive, tr->tracer.relocate ? "on" : "off",
+    fmt::print("bake: {} of {} probes active ({} light no surface, {} inside geometry at grid positions, {} left "
+               "inactive); relocation {}: {} moved, mean |offset| {:.3f} m, max {:.2f} cell, {} rounds, {:.1f} ms\n",
+               g.count() - cs.inactive, g.count(), cs.idle, cs.insideAtGrid, cs.inactive, tr->tracer.relocate ? "on" : "off",
                cs.moved, cs.meanOffsetMetres, cs.maxOffsetCells, cs.rounds, cs.milliseconds);
     for (uint32_t u = 0; u < *updates; ++u) {
       const renderer::UpdateStats st = updater.update();

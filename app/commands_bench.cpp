@@ -450,6 +450,8 @@ void addBenchAdaptive(CLI::App* bench) {
       ->delimiter(',')
       ->check(CLI::Range(0.0f, 2.0f));
   adaptive->add_option("--deadzone", ao->bench.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
+  adaptive->add_flag("--surface-probes-only,!--all-probes", ao->bench.surfaceProbesOnly,
+                     "trace and stream only the probes that light some surface (default on)");
   adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
                        "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")
       ->check(CLI::Range(0u, 100000u));

@@ -162,6 +162,7 @@ struct TracerOptions {
   float changeHistory = renderer::UpdaterOptions{}.changeHistory;
   float clamp = 16.0f;
   bool relocate = true;
+  bool surfaceProbesOnly = true;
   uint64_t raysPerUpdate = 0;
   void add(CLI::App* cmd) {
     addSppOption(cmd, spp);
@@ -187,6 +188,9 @@ struct TracerOptions {
     cmd->add_flag("--relocate,!--no-relocate", relocate,
                   "move probes inside or too close to geometry (up to 45 % of a cell per axis) instead of only "
                   "switching them off (default on)");
+    cmd->add_flag("--surface-probes-only,!--all-probes", surfaceProbesOnly,
+                  "trace and send only the probes that light some surface (a triangle passes through the cells "
+                  "around them); the others light no pixel and stay off (default on)");
   }
   renderer::UpdaterOptions options() const {
     renderer::UpdaterOptions o;
@@ -199,6 +203,7 @@ struct TracerOptions {
     o.changeHistory = changeHistory;
     o.indirectClamp = clamp;
     o.relocate = relocate;
+    o.surfaceProbesOnly = surfaceProbesOnly;
     o.raysPerUpdate = raysPerUpdate;
     return o;
   }

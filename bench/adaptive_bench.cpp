@@ -275,6 +275,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     ro.samplesPerProbe = 512;
     ro.rejectSigmas = 0.0f;
     ro.seed = 4242;
+    ro.surfaceProbesOnly = false;  // every probe: the streams are scored on the probes they hold
     constexpr int kUpdates = 16;
     const std::string path = o.truthCache.empty() ? std::string() : truthCachePath(o.truthCache, sceneNow, o.dims, ro, kUpdates);
     ProbeVolume stored;
@@ -315,6 +316,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["phases"] = {{"still", o.stillUpdates}, {"moving", o.movingUpdates}, {"still_again", o.stillUpdates},
                  {"light_step_t", o.lightStep}};
   j["representation"] = representationName(o.repr);
+  j["surface_probes_only"] = o.surfaceProbesOnly;
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
   j["confirmations"] = o.confirmations;
@@ -360,7 +362,9 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     uo.rejectSigmas = rule.rejectSigmas;
     uo.neighbourHistory = rule.rejectSigmas > 0 ? o.neighbourHistory : 0.0f;
     uo.changeHistory = rule.rejectSigmas > 0 ? o.changeHistory : 0.0f;
+    uo.surfaceProbesOnly = o.surfaceProbesOnly;
     renderer::ProbeUpdater u(context, first, grid, uo);
+    if (!j.contains("active_probes")) j["active_probes"] = count - u.classifyStats().inactive;  // the same for every rule
     std::vector<Stream> streams(3);
     streams[0].name = "full";  // every quantised change
     streams[1].name = "deadzone";

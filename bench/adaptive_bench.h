@@ -39,6 +39,9 @@ struct AdaptiveBenchOptions {
   // and the weights of its probes' errors: each probe's error energy × its own energy^-exponent
   // (0: absolute, 1: relative, about 0.55: what gamma 2.2 leaves of it in an image); one stream per pair
   std::vector<float> oracleExponents = {0.0f};
+  // The streamed rules' updaters trace only the probes that light a surface
+  // (UpdaterOptions::surfaceProbesOnly); the converged volumes hold every probe either way.
+  bool surfaceProbesOnly = true;
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;
   uint32_t jumpUpdates = 48;         // updates charted after the light jump

@@ -216,6 +216,7 @@ TEST_F(Updater, ProbeInsideClosedWallIsInactive) {
   g = ProbeGrid{{5, 1, 1}, {{0.0f, 0.0f, 0.0f}, {1.6f, 0.0f, 0.0f}}};  // x = 0, 0.4, 0.8, 1.2 (on the outer face: skip), 1.6
   UpdaterOptions o;
   o.samplesPerProbe = 64;
+  o.surfaceProbesOnly = false;  // probe 4 lights no surface (the shell's face lies on probe 3's plane): idle
   ProbeUpdater updater(*context_, s, g, o);
   EXPECT_EQ(updater.volume().active.data()[0], 1);  // room centre
   EXPECT_EQ(updater.volume().active.data()[2], 1);  // inside the room near the wall
@@ -596,9 +597,11 @@ TEST_F(Updater, OffsetsStayWithin45PercentOfACellAndFreeProbesNeverMove) {
   const ProbeGrid g = sceneGrid(s, {8, 8, 8});
   UpdaterOptions o;
   o.samplesPerProbe = 32;
+  o.surfaceProbesOnly = false;  // relocation alone: the probes far from every surface are classified too
   ProbeUpdater updater(*context_, s, g, o);
   const ProbeVolume& v = updater.volume();
   const ClassifyStats& st = updater.classifyStats();
+  EXPECT_EQ(st.idle, 0u);
   EXPECT_GT(st.moved, 0u);  // the boxes hold probes, and some sit near their faces
   EXPECT_LT(st.inactive, st.insideAtGrid);
   ASSERT_EQ(v.offsets.size(), g.count() * 3u);

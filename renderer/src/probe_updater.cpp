@@ -13,6 +13,7 @@
 #include "gpu_scene.h"
 #include "probe_history.h"
 #include "probe_relocation.h"
+#include "probe_surfaces.h"
 #include "ray_budget.h"
 #include "probecast/codec/probe_offsets.h"
 #include "vk_raytracing.h"
@@ -193,10 +194,17 @@ struct ProbeUpdater::Impl {
   void classify() {
     const auto t0 = std::chrono::steady_clock::now();
     classifyStats = ClassifyStats{};
-    std::vector<uint32_t> pending(volume.count());
-    std::iota(pending.begin(), pending.end(), 0u);
     std::vector<uint8_t>& active = volume.active;
     std::fill(active.begin(), active.end(), 1);
+    std::vector<uint32_t> pending;  // probes still to classify: those that light some surface
+    for (uint32_t p = 0; p < volume.count(); ++p) {
+      if (options.surfaceProbesOnly && !nearSurface[p]) {
+        active[p] = 0;
+        ++classifyStats.idle;
+      } else {
+        pending.push_back(p);
+      }
+    }
     volume.offsets.clear();
     const bool relocating = options.classify && options.relocate;
     RelocationRule rule;
@@ -284,11 +292,13 @@ struct ProbeUpdater::Impl {
   std::vector<uint32_t> triangleMaterial;
   void setGeometry(const scene::Scene& s) {
     uploadGpuScene(*d, s, gpu);
+    nearSurface = options.surfaceProbesOnly ? probesNearSurfaces(s, volume.grid) : std::vector<uint8_t>(volume.count(), 1);
     markClientLit(s);
     geometryPositions = s.positions;
     geometryIndices = s.indices;
   }
   SurfaceRecord surfaces;  // as of the last setScene
+  std::vector<uint8_t> nearSurface;  // per probe: lights some surface of the last geometry (probe_surfaces.h)
   // Whether `s` lights the probes differently from the scene last set (its geometry aside), and
   // keeps what it would compare next time.
   bool shadingChanged(const scene::Scene& s) {

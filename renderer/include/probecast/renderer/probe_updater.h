@@ -57,6 +57,10 @@ struct UpdaterOptions {
   float changeHistory = 8.0f;
   uint32_t seed = 1;
   bool classify = true;            // mark probes inside geometry inactive
+  // Mark inactive (idle) the probes that light no surface: no triangle passes through the cells
+  // around them, so no viewer's pixel and no other probe reads them (probe_surfaces.h). They get
+  // no rays and are never sent. false: every probe outside geometry is traced.
+  bool surfaceProbesOnly = true;
   uint32_t classifySamples = 64;
   float backFaceThreshold = 0.25f; // inside geometry above this back-face hit ratio (RTXGI's rule)
   // Relocation (with classify): a probe inside geometry moves through the nearest back face its
@@ -99,7 +103,8 @@ struct ClassifyStats {
   double milliseconds = 0.0;     // every classify round, rays and reduction
   uint32_t rounds = 0;           // classify dispatches
   uint32_t insideAtGrid = 0;     // probes inside geometry at their grid positions (inactive without relocation)
-  uint32_t inactive = 0;         // probes left inactive
+  uint32_t idle = 0;             // probes that light no surface (UpdaterOptions::surfaceProbesOnly), inactive
+  uint32_t inactive = 0;         // probes left inactive (the idle ones included)
   uint32_t moved = 0;            // active probes with a nonzero offset
   double meanOffsetMetres = 0.0; // mean |offset| of the moved probes
   double maxOffsetCells = 0.0;   // largest |offset component| / cell
