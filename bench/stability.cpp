@@ -242,6 +242,7 @@ WallLeak measureWallLeak(renderer::VulkanContext& context) {
     o.samplesPerProbe = 128;
     o.classify = classify;
     o.relocate = false;  // classification alone: probes in the wall switch off rather than move
+    o.surfaceProbesOnly = false;  // and only the probes inside geometry: the idle ones count as traced
     renderer::ProbeUpdater u(context, s, grid, o);
     u.update();
     u.update();
