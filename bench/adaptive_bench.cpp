@@ -62,6 +62,7 @@ struct Stream {
   bool withNoise = false;
   float oracleRatio = 0.0f;  // > 0: the oracle stream (oracleSelect)
   float oracleExponent = 0.0f;
+  std::vector<float> viewWeights;  // StreamEncoder::setViewWeights (empty: none)
   std::unique_ptr<StreamEncoder> encoder;
   std::vector<double> bytesPerProbe;  // per frame
   std::vector<float> held;            // what a subscriber holds after the frame before
@@ -300,6 +301,41 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   };
   for (const Moment& m : moments)
     for (uint32_t f = m.first; f <= m.frame; ++f) converge(tAt(f), true);
+  // The noise-aware stream's view weights (AdaptiveBenchOptions::viewWeights = "footprint"): each
+  // probe's share of the scored views, measured on the converged volume at the start: the views'
+  // squared change (after gamma) when that probe alone is made 20 % brighter.
+  std::vector<float> footprint;
+  if (o.viewWeights == "footprint") {
+    converge(tAt(0), false);
+    say("adaptive bench: each probe's footprint in the scored views");
+    const scene::Scene sceneNow = sceneAt(tAt(0));
+    renderer::RasterRenderer raster(context, sceneNow, o.width, o.height, renderer::RasterOptions{});
+    const auto seen = [&](const ProbeVolume& v) {
+      raster.setProbes(v);
+      if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono)
+        return std::vector<renderer::Image>{raster.render(raster.viewProjection(camera), camera.position)};
+      return raster.renderViews(views);
+    };
+    ProbeVolume v = makeProbeVolume(grid);
+    v.probes = truthProbes.at(tAt(0));
+    const std::vector<renderer::Image> base = seen(v);
+    const auto gamma = [](float x) { return std::isfinite(x) && x > 0.0f ? std::pow(static_cast<double>(x), 1.0 / 2.2) : 0.0; };
+    footprint.assign(count, 0.0f);
+    for (uint32_t p = 0; p < count; ++p) {
+      float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
+      if (std::all_of(c, c + kProbeFloats, [](float x) { return x == 0.0f; })) continue;  // inactive or black
+      for (int i = 0; i < kProbeFloats; ++i) c[i] *= 1.2f;
+      const std::vector<renderer::Image> bright = seen(v);
+      for (int i = 0; i < kProbeFloats; ++i) c[i] = truthProbes.at(tAt(0))[static_cast<size_t>(p) * kProbeFloats + i];
+      double sq = 0.0;
+      for (size_t k = 0; k < bright.size(); ++k)
+        for (size_t i = 0; i < bright[k].rgb.size(); ++i) {
+          const double d = gamma(bright[k].rgb[i]) - gamma(base[k].rgb[i]);
+          sq += d * d;
+        }
+      footprint[p] = static_cast<float>(sq);
+    }
+  }
   // The oracle stream needs the truth at every update.
   if (!o.oracleErrorRatios.empty())
     for (uint32_t f = 0; f < frames; ++f) converge(tAt(f), false);
@@ -317,6 +353,9 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                  {"light_step_t", o.lightStep}};
   j["representation"] = representationName(o.repr);
   j["surface_probes_only"] = o.surfaceProbesOnly;
+  j["view_weights"] = o.viewWeights;
+  if (!footprint.empty())
+    j["probes_that_change_no_pixel"] = std::count(footprint.begin(), footprint.end(), 0.0f);  // of the grid
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
   j["confirmations"] = o.confirmations;
@@ -375,6 +414,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].options.confirmations = o.confirmations;
     streams[2].options.refinementInterval = o.refinementInterval;
     streams[2].withNoise = true;
+    streams[2].viewWeights = footprint;
     for (float exponent : o.oracleExponents)
       for (float ratio : o.oracleErrorRatios) {
         Stream& s = streams.emplace_back();
@@ -383,7 +423,12 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         s.oracleExponent = exponent;
         s.options.deadzone = o.deadzone;
       }
-    for (Stream& s : streams) s.encoder = std::make_unique<StreamEncoder>(layout, s.options);
+    for (Stream& s : streams) {
+      s.encoder = std::make_unique<StreamEncoder>(layout, s.options);
+      // The views' own weights: a probe's active flag in this updater may differ from the truth's.
+      if (!s.viewWeights.empty() && !s.encoder->setViewWeights(s.viewWeights))
+        throw std::runtime_error("bench adaptive: no probe shows in the scored views");
+    }
     std::vector<float> oracleInput;
     std::vector<double> changes;
     std::vector<uint32_t> restarts;

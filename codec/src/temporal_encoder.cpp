@@ -39,6 +39,7 @@ struct StreamEncoder::Impl {
   std::vector<uint8_t> baseActive, nextActive, raw;
   std::vector<uint8_t> riceRaw, riceSection;  // a delta spelled with Rice codes, and its section
   std::vector<ProbeSymbols> candidates;  // per choice × brick probe, with an error bound
+  std::vector<float> viewScale;  // per probe: the noise rule's thresholds × this (setViewWeights); empty: 1
   std::vector<uint32_t> beyond;  // per probe: consecutive updates beyond c·σ not yet sent (EncoderOptions::confirmations)
 
   // The representation brick `b` is sent in this update (EncoderOptions::errorBound), its probes'
@@ -106,6 +107,33 @@ bool withinNoise(const float candidate[kProbeFloats], const float held[kProbeFlo
 }
 
 }  // namespace
+
+bool StreamEncoder::setViewWeights(std::span<const float> weights) {
+  Impl& s = *impl_;
+  if (weights.empty()) {
+    s.viewScale.clear();
+    return true;
+  }
+  if (weights.size() != probeCount(s.layout)) return false;
+  double sum = 0.0;
+  size_t seen = 0;
+  for (float w : weights) {
+    if (!std::isfinite(w) || w < 0.0f) return false;
+    if (w > 0.0f) {
+      sum += w;
+      ++seen;
+    }
+  }
+  if (seen == 0) return false;
+  const double mean = sum / static_cast<double>(seen);
+  s.viewScale.resize(weights.size());
+  for (size_t p = 0; p < weights.size(); ++p)
+    s.viewScale[p] = weights[p] > 0.0f ? static_cast<float>(std::clamp(std::cbrt(mean / weights[p]),
+                                                                       static_cast<double>(kViewScaleMin),
+                                                                       static_cast<double>(kViewScaleMax)))
+                                       : kViewScaleMax;
+  return true;
+}
 
 Representation StreamEncoder::Impl::chooseRepresentation(uint32_t b, const float* probes, const uint8_t* activeIn) {
   const uint32_t first = table.first[b], n = table.first[b + 1] - first;
@@ -177,7 +205,8 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
         else quantizeProbe(repr, probes + static_cast<size_t>(p) * kProbeFloats, previous, s.options.deadzone, &s.next[k]);
         // A change the input's own noise explains is not sent: keep what the decoder holds while
         // the would-be new version is within c·σ of it.
-        const float sigma = noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f;
+        const float sigma = (noise && std::isfinite(noise[p]) ? std::max(noise[p], 0.0f) : 0.0f) *
+                            (s.viewScale.empty() ? 1.0f : s.viewScale[p]);
         const bool moved = !previous || std::memcmp(&s.next[k], previous, sizeof(ProbeSymbols)) != 0;
         if (previous && sigma > 0.0f && s.options.noiseScale > 0.0f && moved) {
           float candidate[kProbeFloats];

@@ -201,6 +201,19 @@ class StreamEncoder {
   // negative or non-finite values count as 0). Returns the number of bricks given a new version.
   uint32_t update(const float* probes, const uint8_t* active, const float* noise = nullptr);
 
+  // With the noise rule: how much the viewers see of each probe, probeCount(layout) weights ≥ 0 (a
+  // probe's share of the views' pixels, or 1 in some view and 0 in none); empty: every probe alike.
+  // A probe of weight w is held within c·σ·(w / w̄)^(−1/3), w̄ the mean weight of the probes with
+  // one, within [kViewScaleMin, kViewScaleMax] × c·σ: the spacing of re-sends that spends bytes where
+  // the views show the held probes' lag (a lag that grows to t costs about w·t²/3 of the views'
+  // squared error and is re-sent about 1/t as often; the sum is least for t ∝ w^(−1/3)). A probe
+  // nobody sees (w = 0) takes the most. The other noise thresholds (2c·σ, 4c·σ) scale alike. Returns
+  // false and keeps the weights it had when the count is wrong or a weight is negative or not finite,
+  // or when no weight is positive.
+  bool setViewWeights(std::span<const float> weights);
+  static constexpr float kViewScaleMin = 0.5f;
+  static constexpr float kViewScaleMax = 4.0f;
+
   const StreamLayout& layout() const;
   uint32_t frameSequence() const;  // number of update() calls so far
   uint32_t brickVersion(uint32_t brick) const;
