@@ -253,6 +253,50 @@ TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
   }
 }
 
+// View weights (StreamEncoder::setViewWeights) on the grey probes above (σ = 0.01, c = 2; a DC change
+// d moves the RMS by 0.615 d). Probe 4 weighs 0 (nobody sees it: held within 4c·σ = 0.08); probe 1
+// weighs 64, whose scale (w̄/64)^(1/3) = 0.29 stops at the floor 0.5 (c·σ·0.5 = 0.01); the other 126
+// weigh 1 (w̄ = 190/127 = 1.50, scale 1.14: 0.023). d = 0.1 (0.061) on probes 0 and 4: probe 0 goes,
+// probe 4 is held; d = 0.03 (0.018) on probe 1 goes. Without weights probe 4 goes and probe 1 is
+// held. Weights that are refused leave the ones set before.
+TEST(Stream, ViewWeightsHoldWhatNobodySeesLonger) {
+  for (bool weighted : {true, false}) {
+    EncoderOptions options;
+    options.noiseScale = 2.0f;
+    GreyStream stream(options, weighted ? "weighted" : "plain");
+    std::vector<float> w(128, 1.0f);
+    w[4] = 0.0f;
+    w[1] = 64.0f;
+    if (weighted) {
+      ASSERT_TRUE(stream.enc.setViewWeights(w));
+      EXPECT_FALSE(stream.enc.setViewWeights(std::vector<float>(127, 1.0f)));  // not one per probe
+      EXPECT_FALSE(stream.enc.setViewWeights(std::vector<float>(128, 0.0f)));  // nobody sees anything
+      for (float bad : {-1.0f, NAN, INFINITY}) {
+        std::vector<float> b(128, 1.0f);
+        b[7] = bad;
+        EXPECT_FALSE(stream.enc.setViewWeights(b)) << bad;
+      }
+    }
+    EXPECT_EQ(stream.step({{0, 1.0f}, {4, 1.0f}, {1, 1.0f}}), 2u);
+    stream.step({{0, 1.1f}, {4, 1.1f}, {1, 1.03f}});
+    const float* held = stream.dec.probes();
+    EXPECT_NEAR(held[0], 1.1f, 0.005f) << stream.what;
+    EXPECT_NEAR(held[4 * kProbeFloats], weighted ? 1.0f : 1.1f, 0.005f) << stream.what;
+    EXPECT_NEAR(held[1 * kProbeFloats], weighted ? 1.03f : 1.0f, 0.005f) << stream.what;
+  }
+  // Clearing them (an empty list) makes every probe alike again.
+  EncoderOptions options;
+  options.noiseScale = 2.0f;
+  GreyStream stream(options, "cleared");
+  std::vector<float> w(128, 1.0f);
+  w[4] = 0.0f;
+  ASSERT_TRUE(stream.enc.setViewWeights(w));
+  ASSERT_TRUE(stream.enc.setViewWeights({}));
+  stream.step({{4, 1.0f}});
+  stream.step({{4, 1.1f}});
+  EXPECT_NEAR(stream.dec.probes()[4 * kProbeFloats], 1.1f, 0.005f);
+}
+
 // Confirmations, on the probes of the test above (c·σ = 0.02; a DC change d moves the RMS by 0.615 d):
 // d = 0.1 (0.061) is past c·σ but within 4c·σ (0.08), so with one confirmation it is kept for one
 // update and sent on the second in a row; one update's excursion that comes back is never sent;
