@@ -118,6 +118,40 @@ TEST(ProbeHub, EncodedOnceSameBytesForEverySubscriber) {
   EXPECT_FALSE(hub.nextFrame(a).has_value());  // holds everything now
 }
 
+// With the noise rule (c = 2, σ = 0.01: c·σ = 0.02), view weights hold what nobody sees longer: a
+// DC change of 0.1 (0.061 in the rule's irradiance-weighted RMS, within 4c·σ = 0.08) reaches the
+// probes of weight 1 (x < 8) and not those of weight 0; once the weights are cleared it reaches
+// every probe. Weights that nobody sees anything by (all 0) count as none.
+TEST(ProbeHub, ViewWeightsHoldTheProbesNobodySeesWithinFourCSigma) {
+  HubConfig config = rowConfig();
+  config.encoder.noiseScale = 2.0f;
+  ProbeHub hub(config);
+  const uint32_t count = 256;
+  const auto grey = [&](float dc) {
+    std::vector<float> p(static_cast<size_t>(count) * kProbeFloats, 0.0f);
+    for (uint32_t i = 0; i < count; ++i)
+      for (int c = 0; c < 3; ++c) p[static_cast<size_t>(i) * kProbeFloats + c] = dc;
+    return p;
+  };
+  const std::vector<float> noise(count, 0.01f);
+  std::vector<float> weights(count, 0.0f);
+  for (uint32_t i = 0; i < count; ++i) weights[i] = i % 16 < 8 ? 1.0f : 0.0f;
+  const auto heldDc = [&](uint32_t probe) { return hub.reconstruction().probes[static_cast<size_t>(probe) * kProbeFloats]; };
+  hub.publish(grey(1.0f).data(), nullptr, noise.data());
+  hub.setViewWeights(std::vector<float>(count, 0.0f));  // nobody sees anything: every probe alike
+  hub.publish(grey(1.1f).data(), nullptr, noise.data());
+  EXPECT_NEAR(heldDc(3), 1.1f, 0.005f);
+  EXPECT_NEAR(heldDc(12), 1.1f, 0.005f);
+  hub.setViewWeights(weights);
+  hub.publish(grey(1.2f).data(), nullptr, noise.data());
+  EXPECT_NEAR(heldDc(3), 1.2f, 0.005f);    // x = 3: seen
+  EXPECT_NEAR(heldDc(12), 1.1f, 0.005f);   // x = 12: nobody sees it
+  EXPECT_NEAR(heldDc(16 * 3 + 12), 1.1f, 0.005f);
+  hub.setViewWeights({});
+  hub.publish(grey(1.2f).data(), nullptr, noise.data());
+  EXPECT_NEAR(heldDc(12), 1.2f, 0.005f);
+}
+
 TEST(ProbeHub, AcksCountAppliedFramesAndRefuseFramesNeverSent) {
   ProbeHub hub(rowConfig());
   std::mt19937 rng(3);

@@ -161,6 +161,12 @@ void ProbeHub::publish(const ProbeVolume& volume) {
   publish(volume.probes.data(), volume.active.data(), volume.noise.empty() ? nullptr : volume.noise.data());
 }
 
+void ProbeHub::setViewWeights(std::span<const float> weights) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  StreamEncoder& encoder = encoderSource("setViewWeights").encoder();
+  if (!encoder.setViewWeights(weights)) encoder.setViewWeights({});
+}
+
 void ProbeHub::publish(const float* probes, const uint8_t* active, const float* noise) {
   std::vector<std::function<void()>> wakes;
   std::vector<BrickVersionBytes> made;

@@ -9,7 +9,7 @@
 
 namespace probecast::session {
 
-ProbeProducer::ProbeProducer(const service::HubConfig& hub) : hub_(hub) {}
+ProbeProducer::ProbeProducer(const service::HubConfig& hub) : hub_(hub), noiseRule_(hub.encoder.noiseScale > 0.0f) {}
 
 ProbeProducer::~ProbeProducer() {
   stop();
@@ -74,8 +74,13 @@ void ProbeProducer::step() {
     if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) t_ = t();  // what t() says once the loop ends
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene)
       updater_->setScene(loadSceneOrThrow(sceneSpec_, t()));
-    if (rayBudget_)  // the ray budget traces first what the subscribers can see now
-      updater_->setViewWeights(probeViewWeights(updater_->grid(), updater_->volume().offsets, hub_.subscriberViews()));
+    // The ray budget traces first what the subscribers can see now; the noise rule holds what none
+    // of them sees longer.
+    if (rayBudget_ || noiseRule_) {
+      std::vector<float> weights = probeViewWeights(updater_->grid(), updater_->volume().offsets, hub_.subscriberViews());
+      if (noiseRule_) hub_.setViewWeights(weights);
+      if (rayBudget_) updater_->setViewWeights(std::move(weights));
+    }
     const renderer::UpdateStats st = updater_->update();
     const auto t0 = Clock::now();
     hub_.publish(updater_->volume());

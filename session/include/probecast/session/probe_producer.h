@@ -126,6 +126,7 @@ class ProbeProducer {
   std::unique_ptr<renderer::ProbeUpdater> updater_;
   std::string sceneSpec_;
   bool rayBudget_ = false;  // the updater spends a ray budget: it is told the subscribers' views
+  bool noiseRule_ = false;  // the hub's encoder holds noise (EncoderOptions::noiseScale): and so is it
   Animation animation_;
   FrameGenerator generator_;
   std::vector<float> frame_;

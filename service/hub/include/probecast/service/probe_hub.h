@@ -133,6 +133,11 @@ class ProbeHub {
   // nothing published). Its areaLights are not read: the rule is the hub's (setAreaLightRule), as a
   // traced volume's samples say nothing of it.
   void publish(const ProbeVolume& volume);
+  // With the noise rule (EncoderOptions::noiseScale): how much the subscribers see of each probe,
+  // for the publishes after it (StreamEncoder::setViewWeights: a probe nobody sees is held within
+  // 4c·σ). Empty, or weights the encoder refuses (none positive: nobody looks at anything): every
+  // probe alike. Producer hubs only.
+  void setViewWeights(std::span<const float> weights);
   // Every brick version publish() makes, keyframe and delta, is handed to `output` (called on the
   // publishing thread, outside the hub's lock). Producer hubs only.
   using BusOutput = std::function<void(std::vector<BrickVersionBytes>)>;
