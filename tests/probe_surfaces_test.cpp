@@ -85,6 +85,13 @@ TEST(ProbeSurfaces, ATriangleReachesTheProbesOfTheCellsItCrosses) {
     ASSERT_EQ(near.size(), 4u);
     for (uint32_t p : near) EXPECT_TRUE(p % 4 == 3 && (p / 4) % 4 >= 1 && (p / 4) % 4 <= 2 && p / 16 >= 1 && p / 16 <= 2) << p;
   }
+  {  // Absurd but finite: a floor y = 1.5 reaching ±10³⁰ m: the probes at y = 1 and 2.
+    scene::Scene s;
+    scene::addQuad(s, {-1e30f, 1.5f, -1e30f}, {-1e30f, 1.5f, 1e30f}, {1e30f, 1.5f, 1e30f}, {1e30f, 1.5f, -1e30f}, 0);
+    const std::vector<uint32_t> near = nearList(s);
+    EXPECT_EQ(near.size(), 32u);
+    for (uint32_t p : near) EXPECT_TRUE((p / 4) % 4 == 1 || (p / 4) % 4 == 2) << p;
+  }
   {  // Non-finite positions are skipped, not spread over the grid.
     scene::Scene s;
     s.positions = {{NAN, 0, 0}, {1, 1, 1}, {2, 2, 2}};

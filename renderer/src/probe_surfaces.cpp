@@ -44,7 +44,8 @@ std::vector<uint8_t> probesNearSurfaces(const scene::Scene& scene, const ProbeGr
     const glm::vec3& p1 = scene.positions[scene.indices[3 * t + 1]];
     const glm::vec3& p2 = scene.positions[scene.indices[3 * t + 2]];
     const glm::vec3 tmin = glm::min(p0, glm::min(p1, p2)), tmax = glm::max(p0, glm::max(p1, p2));
-    if (!std::isfinite(tmin.x + tmin.y + tmin.z + tmax.x + tmax.y + tmax.z)) continue;
+    const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    if (!finite(tmin) || !finite(tmax)) continue;  // a corner that is nowhere lights no cell
     // Probes whose box can meet the triangle's bounding box: lo + (i ± 1) s against [tmin, tmax].
     uint32_t first[3], last[3];
     for (int a = 0; a < 3; ++a) {
