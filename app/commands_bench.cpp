@@ -453,9 +453,10 @@ void addBenchAdaptive(CLI::App* bench) {
   adaptive->add_flag("--surface-probes-only,!--all-probes", ao->bench.surfaceProbesOnly,
                      "trace and stream only the probes that light some surface (default on)");
   adaptive->add_option("--view-weights", ao->bench.viewWeights,
-                       "the noise-aware stream holds probes the scored views show little of longer: none, or footprint "
-                       "(each probe's measured share of their pixels)")
-      ->check(CLI::IsMember({"none", "footprint"}));
+                       "the noise-aware stream holds probes the scored views show little of longer: none, footprint "
+                       "(each probe's measured share of their pixels) or surface (the views' surfaces and the probes "
+                       "that light them, as a server can work them out)")
+      ->check(CLI::IsMember({"none", "footprint", "surface"}));
   adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
                        "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")
       ->check(CLI::Range(0u, 100000u));

@@ -18,8 +18,10 @@
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/view_sets.h"
+#include "probecast/session/probe_interest.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/stats.h"
+#include "probecast/session/viewer.h"
 #include "harness.h"
 #include "reconvergence.h"
 #include "stability.h"
@@ -415,6 +417,18 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].options.refinementInterval = o.refinementInterval;
     streams[2].withNoise = true;
     streams[2].viewWeights = footprint;
+    if (o.viewWeights == "surface") {
+      // What a server can work out from the views alone (session::probeViewFootprints).
+      std::vector<renderer::ViewInfo> scored = views;
+      if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono) {
+        const renderer::RasterRenderer raster(context, first, o.width, o.height, renderer::RasterOptions{});
+        scored.assign(1, renderer::ViewInfo{});
+        scored[0].viewProj = raster.viewProjection(camera);
+        scored[0].eye = camera.position;
+      }
+      const std::vector<View> seen = session::priorityViews(scored);
+      streams[2].viewWeights = session::probeViewFootprints(first, grid, u.volume().active, seen);
+    }
     for (float exponent : o.oracleExponents)
       for (float ratio : o.oracleErrorRatios) {
         Stream& s = streams.emplace_back();

@@ -42,9 +42,10 @@ struct AdaptiveBenchOptions {
   // The streamed rules' updaters trace only the probes that light a surface
   // (UpdaterOptions::surfaceProbesOnly); the converged volumes hold every probe either way.
   bool surfaceProbesOnly = true;
-  // The noise-aware stream's view weights (StreamEncoder::setViewWeights): "none", or "footprint":
+  // The noise-aware stream's view weights (StreamEncoder::setViewWeights): "none"; "footprint":
   // each probe's measured share of the scored views (at the start, on the converged volume; the
-  // raster renders the views once per probe).
+  // raster renders the views once per probe); or "surface": what a server can work out from the
+  // views alone (session::probeViewFootprints).
   std::string viewWeights = "none";
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/glm.hpp>
+
 namespace probecast::session {
 namespace {
 
@@ -38,6 +40,139 @@ std::vector<float> probeViewWeights(const ProbeGrid& grid, const std::vector<flo
       }
   }
   return weights;
+}
+
+}  // namespace probecast::session
+
+namespace probecast::session {
+namespace {
+
+struct ClipVertex {
+  glm::vec4 clip;
+  glm::vec3 world;
+};
+
+// The polygon's part in front of the near plane (Vulkan clip space: z > 0), Sutherland–Hodgman.
+size_t clipNear(const ClipVertex* in, size_t n, ClipVertex* out) {
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const ClipVertex& a = in[i];
+    const ClipVertex& b = in[(i + 1) % n];
+    const bool aIn = a.clip.z > 0.0f, bIn = b.clip.z > 0.0f;
+    if (aIn) out[m++] = a;
+    if (aIn != bIn) {
+      const float t = a.clip.z / (a.clip.z - b.clip.z);
+      out[m++] = {a.clip + t * (b.clip - a.clip), a.world + t * (b.world - a.world)};
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
+                                       std::span<const View> views, uint32_t width, uint32_t height) {
+  if (views.empty()) return {};
+  const uint32_t count = grid.count();
+  std::vector<float> footprint(count, 0.0f);
+  if (width == 0 || height == 0) return footprint;
+  const size_t pixels = static_cast<size_t>(width) * height;
+  std::vector<float> depth(pixels);    // clip z/w of the nearest surface (+inf: none)
+  std::vector<uint32_t> nearest(pixels);
+  std::vector<glm::vec3> point(pixels);
+  const uint32_t triangles = scene.triangleCount();
+  const glm::vec3 lo(grid.bounds.min[0], grid.bounds.min[1], grid.bounds.min[2]);
+  const glm::vec3 hi(grid.bounds.max[0], grid.bounds.max[1], grid.bounds.max[2]);
+  const glm::ivec3 dims(static_cast<int>(grid.dims[0]), static_cast<int>(grid.dims[1]), static_cast<int>(grid.dims[2]));
+  for (const View& v : views) {
+    if (!finiteView(v)) continue;
+    glm::mat4 viewProj;
+    std::copy(std::begin(v.viewProj), std::end(v.viewProj), &viewProj[0][0]);
+    const glm::vec3 eye(v.eye[0], v.eye[1], v.eye[2]);
+    std::fill(depth.begin(), depth.end(), INFINITY);
+    for (uint32_t t = 0; t < triangles; ++t) {
+      ClipVertex tri[3], poly[4];
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3& p = scene.positions[scene.indices[3 * t + k]];
+        tri[k] = {viewProj * glm::vec4(p, 1.0f), p};
+      }
+      const size_t n = clipNear(tri, 3, poly);
+      for (size_t f = 1; f + 1 < n; ++f) {  // the clipped polygon as a fan
+        const ClipVertex* c[3] = {&poly[0], &poly[f], &poly[f + 1]};
+        if (!(c[0]->clip.w > 0.0f && c[1]->clip.w > 0.0f && c[2]->clip.w > 0.0f)) continue;  // not a projection
+        glm::vec2 s[3];
+        float invW[3], z[3];
+        for (int k = 0; k < 3; ++k) {
+          invW[k] = 1.0f / c[k]->clip.w;
+          z[k] = c[k]->clip.z * invW[k];
+          s[k] = {(c[k]->clip.x * invW[k] * 0.5f + 0.5f) * static_cast<float>(width),
+                  (c[k]->clip.y * invW[k] * 0.5f + 0.5f) * static_cast<float>(height)};
+        }
+        const float area = (s[1].x - s[0].x) * (s[2].y - s[0].y) - (s[2].x - s[0].x) * (s[1].y - s[0].y);
+        if (!(std::fabs(area) > 0.0f) || !std::isfinite(area)) continue;
+        const float x0 = std::max(0.0f, std::floor(std::min({s[0].x, s[1].x, s[2].x})));
+        const float x1 = std::min(static_cast<float>(width) - 1.0f, std::ceil(std::max({s[0].x, s[1].x, s[2].x})));
+        const float y0 = std::max(0.0f, std::floor(std::min({s[0].y, s[1].y, s[2].y})));
+        const float y1 = std::min(static_cast<float>(height) - 1.0f, std::ceil(std::max({s[0].y, s[1].y, s[2].y})));
+        for (float y = y0; y <= y1; y += 1.0f)
+          for (float x = x0; x <= x1; x += 1.0f) {
+            const glm::vec2 q(x + 0.5f, y + 0.5f);
+            float b[3];
+            for (int k = 0; k < 3; ++k) {
+              const glm::vec2& e0 = s[(k + 1) % 3];
+              const glm::vec2& e1 = s[(k + 2) % 3];
+              b[k] = ((e1.x - e0.x) * (q.y - e0.y) - (q.x - e0.x) * (e1.y - e0.y)) / area;
+            }
+            if (b[0] < 0.0f || b[1] < 0.0f || b[2] < 0.0f) continue;
+            const float zw = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];  // z/w and 1/w are linear on the screen
+            const size_t i = static_cast<size_t>(y) * width + static_cast<size_t>(x);
+            if (!(zw < depth[i]) || zw > 1.0f) continue;  // hidden, or past the far plane
+            const float inv = b[0] * invW[0] + b[1] * invW[1] + b[2] * invW[2];
+            depth[i] = zw;
+            nearest[i] = t;
+            point[i] = (b[0] * invW[0] * c[0]->world + b[1] * invW[1] * c[1]->world + b[2] * invW[2] * c[2]->world) / inv;
+          }
+      }
+    }
+    // Each covered pixel's eight probes, weighted as the raster client weighs them without visibility.
+    for (size_t i = 0; i < pixels; ++i) {
+      if (!(depth[i] < INFINITY)) continue;
+      const uint32_t t = nearest[i];
+      const glm::vec3& a = scene.positions[scene.indices[3 * t]];
+      glm::vec3 ng = glm::cross(scene.positions[scene.indices[3 * t + 1]] - a, scene.positions[scene.indices[3 * t + 2]] - a);
+      const float len = glm::length(ng);
+      if (!(len > 0.0f)) continue;
+      ng /= len;
+      if (glm::dot(ng, eye - point[i]) < 0.0f) ng = -ng;  // the side the view sees
+      const glm::vec3 g = glm::clamp((point[i] - lo) / glm::max(hi - lo, glm::vec3(1e-6f)) * glm::vec3(dims - 1),
+                                     glm::vec3(0.0f), glm::vec3(dims - 1));
+      const glm::ivec3 base = glm::min(glm::ivec3(glm::floor(g)), glm::max(dims - 2, glm::ivec3(0)));
+      const glm::vec3 alpha = glm::clamp(g - glm::vec3(base), glm::vec3(0.0f), glm::vec3(1.0f));
+      float w[8];
+      uint32_t index[8];
+      float total = 0.0f;
+      for (int k = 0; k < 8; ++k) {
+        const glm::ivec3 off(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+        const glm::vec3 t3 = glm::mix(glm::vec3(1.0f) - alpha, alpha, glm::vec3(off));
+        const glm::ivec3 idx = glm::min(base + off, dims - 1);
+        index[k] = static_cast<uint32_t>(idx.x + dims.x * (idx.y + dims.y * idx.z));
+        w[k] = 0.0f;
+        const float trilinear = t3.x * t3.y * t3.z;
+        if (!(trilinear > 0.0f) || (!active.empty() && !active[index[k]])) continue;
+        float at[3];
+        grid.position(index[k], at);
+        const glm::vec3 toProbe = glm::vec3(at[0], at[1], at[2]) - point[i];
+        const float d = glm::length(toProbe);
+        const float facing = d > 1e-6f ? (glm::dot(toProbe / d, ng) + 1.0f) * 0.5f : 1.0f;
+        w[k] = (facing * facing + 0.2f) * trilinear;
+        total += w[k];
+      }
+      if (!(total > 0.0f)) continue;
+      for (int k = 0; k < 8; ++k)
+        if (w[k] > 0.0f) footprint[index[k]] += (w[k] / total) * (w[k] / total);
+    }
+  }
+  return footprint;
 }
 
 }  // namespace probecast::session

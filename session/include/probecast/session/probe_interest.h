@@ -8,6 +8,7 @@
 #include "probecast/codec/priority.h"
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/probe_volume.h"
+#include "probecast/scene/scene.h"
 
 namespace probecast::session {
 
@@ -16,5 +17,15 @@ namespace probecast::session {
 // else 0. Empty when there are no views: nobody's interest is known, every probe counts alike.
 // A view with non-finite numbers sees nothing.
 std::vector<float> probeViewWeights(const ProbeGrid& grid, const std::vector<float>& offsets, std::span<const View> views);
+
+// Per probe (grid order): how much of the views' pixels it lights, Σ over the pixels of its
+// normalised weight squared (what an error in that probe adds to the views' squared error, per
+// unit of the pixel's irradiance). Each view's nearest surfaces are found at width × height pixel
+// centres by a depth-buffered rasterisation of the scene's triangles on the CPU (Vulkan clip space,
+// as View holds it: clipped at the near plane z = 0, nothing past the far one), and each point is lit as the raster client does without visibility: the eight
+// probes of its grid cell, trilinear × backface ((cos + 1)/2)² + 0.2, the inactive ones left out.
+// Empty when there are no views. A view with non-finite numbers sees nothing.
+std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
+                                       std::span<const View> views, uint32_t width = 64, uint32_t height = 40);
 
 }  // namespace probecast::session
