@@ -1,6 +1,8 @@
 #include "probecast/session/probe_producer.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "probecast/session/probe_interest.h"
@@ -43,6 +45,9 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
   hub_.setAreaLightRule(areaLightRuleOf(options.areaLights));  // what the probes leave out for viewers
   sceneSpec_ = sceneSpec;
+  positions_ = first.positions;
+  indices_ = first.indices;
+  footprintsStale_ = true;
   rayBudget_ = options.raysPerUpdate > 0;
   animation_ = animation;
   t_ = animation.start;
@@ -72,14 +77,21 @@ void ProbeProducer::step() {
     const bool wasFrozen = frozen_;
     if (!wasFrozen && animation_.mode == Animation::Mode::PerStep) t_ = std::fmod(t_ + animation_.perStep, 1.0f);
     if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) t_ = t();  // what t() says once the loop ends
-    if (animation_.mode != Animation::Mode::Still && animation_.reloadScene)
-      updater_->setScene(loadSceneOrThrow(sceneSpec_, t()));
+    if (animation_.mode != Animation::Mode::Still && animation_.reloadScene) {
+      const scene::Scene next = loadSceneOrThrow(sceneSpec_, t());
+      updater_->setScene(next);
+      if (next.positions != positions_ || next.indices != indices_) {
+        positions_ = next.positions;
+        indices_ = next.indices;
+        footprintsStale_ = true;
+      }
+    }
     // The ray budget traces first what the subscribers can see now; the noise rule holds what none
     // of them sees longer.
     if (rayBudget_ || noiseRule_) {
-      std::vector<float> weights = probeViewWeights(updater_->grid(), updater_->volume().offsets, hub_.subscriberViews());
-      if (noiseRule_) hub_.setViewWeights(weights);
-      if (rayBudget_) updater_->setViewWeights(std::move(weights));
+      const std::vector<View> views = hub_.subscriberViews();
+      if (noiseRule_) hub_.setViewWeights(viewFootprints(views));
+      if (rayBudget_) updater_->setViewWeights(probeViewWeights(updater_->grid(), updater_->volume().offsets, views));
     }
     const renderer::UpdateStats st = updater_->update();
     const auto t0 = Clock::now();
@@ -103,6 +115,26 @@ void ProbeProducer::step() {
   } else {
     hub_.tick();
   }
+}
+
+std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views) {
+  const auto same = [](const std::vector<View>& a, const std::vector<View>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(View)) == 0);
+  };
+  if (!footprintsStale_ && same(views, footprintViews_)) return footprints_;
+  // At most kFootprintViews of them, evenly spread over the list (each costs a pass over the
+  // triangles): the others' probes are mostly the same ones.
+  constexpr size_t kFootprintViews = 16;
+  std::vector<View> sample;
+  for (size_t k = 0; k < std::min(views.size(), kFootprintViews); ++k)
+    sample.push_back(views[k * views.size() / std::min(views.size(), kFootprintViews)]);
+  scene::Scene geometry;
+  geometry.positions = positions_;
+  geometry.indices = indices_;
+  footprints_ = probeViewFootprints(geometry, updater_->grid(), updater_->volume().active, sample);
+  footprintViews_ = views;
+  footprintsStale_ = false;
+  return footprints_;
 }
 
 void ProbeProducer::loop(const Pacing& pacing, const std::atomic<bool>* interrupted,

@@ -127,6 +127,14 @@ class ProbeProducer {
   std::string sceneSpec_;
   bool rayBudget_ = false;  // the updater spends a ray budget: it is told the subscribers' views
   bool noiseRule_ = false;  // the hub's encoder holds noise (EncoderOptions::noiseScale): and so is it
+  // told how much of the subscribers' views each probe lights (probeViewFootprints), worked out
+  // again when the views or the geometry change.
+  std::vector<float> viewFootprints(const std::vector<View>& views);
+  std::vector<glm::vec3> positions_;  // the geometry traced (of the last scene set)
+  std::vector<uint32_t> indices_;
+  std::vector<View> footprintViews_;  // the views footprints_ is of
+  std::vector<float> footprints_;
+  bool footprintsStale_ = true;
   Animation animation_;
   FrameGenerator generator_;
   std::vector<float> frame_;
