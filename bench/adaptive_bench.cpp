@@ -253,19 +253,26 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   viewOptions.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
   const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(camera, viewSpec, viewOptions);
   // Every scored view of a volume (the scene camera alone for mono, as a viewer sees it).
-  const auto render = [&](const ProbeVolume& v, float t) {
-    renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
+  const auto renderWith = [&](renderer::RasterRenderer& raster, const ProbeVolume& v) {
     raster.setProbes(v);
     if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono)
       return std::vector<renderer::Image>{raster.render(raster.viewProjection(camera), camera.position)};
     return raster.renderViews(views);
   };
-  // One PSNR for a set of views: of their pixels together (the mean of the views' squared errors).
-  const auto psnrOf = [&](const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) {
+  const auto render = [&](const ProbeVolume& v, float t) {
+    renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
+    return renderWith(raster, v);
+  };
+  // The mean squared error of a set of views' pixels together (after gamma, as PSNR takes it).
+  const auto mseOf = [&](const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) {
     double mse = 0;
     for (size_t i = 0; i < images.size(); ++i)
       mse += imaging::compareImages(images[i].rgb, truth[i].rgb, static_cast<int>(o.width), static_cast<int>(o.height)).mse;
-    mse /= static_cast<double>(images.size());
+    return mse / static_cast<double>(images.size());
+  };
+  // One PSNR for a set of views: of their pixels together.
+  const auto psnrOf = [&](const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) {
+    const double mse = mseOf(images, truth);
     return mse > 0 ? 10.0 * std::log10(1.0 / mse) : HUGE_VAL;
   };
   // The truth at every t a scored update has: the views of a converged float volume.
@@ -312,30 +319,16 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     say("adaptive bench: each probe's footprint in the scored views");
     const scene::Scene sceneNow = sceneAt(tAt(0));
     renderer::RasterRenderer raster(context, sceneNow, o.width, o.height, renderer::RasterOptions{});
-    const auto seen = [&](const ProbeVolume& v) {
-      raster.setProbes(v);
-      if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono)
-        return std::vector<renderer::Image>{raster.render(raster.viewProjection(camera), camera.position)};
-      return raster.renderViews(views);
-    };
     ProbeVolume v = makeProbeVolume(grid);
     v.probes = truthProbes.at(tAt(0));
-    const std::vector<renderer::Image> base = seen(v);
-    const auto gamma = [](float x) { return std::isfinite(x) && x > 0.0f ? std::pow(static_cast<double>(x), 1.0 / 2.2) : 0.0; };
+    const std::vector<renderer::Image> base = renderWith(raster, v);
     footprint.assign(count, 0.0f);
     for (uint32_t p = 0; p < count; ++p) {
       float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
       if (std::all_of(c, c + kProbeFloats, [](float x) { return x == 0.0f; })) continue;  // inactive or black
       for (int i = 0; i < kProbeFloats; ++i) c[i] *= 1.2f;
-      const std::vector<renderer::Image> bright = seen(v);
+      footprint[p] = static_cast<float>(mseOf(renderWith(raster, v), base));  // weights count relative to each other
       for (int i = 0; i < kProbeFloats; ++i) c[i] = truthProbes.at(tAt(0))[static_cast<size_t>(p) * kProbeFloats + i];
-      double sq = 0.0;
-      for (size_t k = 0; k < bright.size(); ++k)
-        for (size_t i = 0; i < bright[k].rgb.size(); ++i) {
-          const double d = gamma(bright[k].rgb[i]) - gamma(base[k].rgb[i]);
-          sq += d * d;
-        }
-      footprint[p] = static_cast<float>(sq);
     }
   }
   // The oracle stream needs the truth at every update.

@@ -45,8 +45,8 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
   hub_.setAreaLightRule(areaLightRuleOf(options.areaLights));  // what the probes leave out for viewers
   sceneSpec_ = sceneSpec;
-  positions_ = first.positions;
-  indices_ = first.indices;
+  geometry_.positions = first.positions;
+  geometry_.indices = first.indices;
   footprintsStale_ = true;
   rayBudget_ = options.raysPerUpdate > 0;
   animation_ = animation;
@@ -80,9 +80,9 @@ void ProbeProducer::step() {
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene) {
       const scene::Scene next = loadSceneOrThrow(sceneSpec_, t());
       updater_->setScene(next);
-      if (next.positions != positions_ || next.indices != indices_) {
-        positions_ = next.positions;
-        indices_ = next.indices;
+      if (next.positions != geometry_.positions || next.indices != geometry_.indices) {
+        geometry_.positions = next.positions;
+        geometry_.indices = next.indices;
         footprintsStale_ = true;
       }
     }
@@ -128,10 +128,7 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
   std::vector<View> sample;
   for (size_t k = 0; k < std::min(views.size(), kFootprintViews); ++k)
     sample.push_back(views[k * views.size() / std::min(views.size(), kFootprintViews)]);
-  scene::Scene geometry;
-  geometry.positions = positions_;
-  geometry.indices = indices_;
-  footprints_ = probeViewFootprints(geometry, updater_->grid(), updater_->volume().active, sample);
+  footprints_ = probeViewFootprints(geometry_, updater_->grid(), updater_->volume().active, sample);
   footprintViews_ = views;
   footprintsStale_ = false;
   return footprints_;

@@ -130,8 +130,7 @@ class ProbeProducer {
   // told how much of the subscribers' views each probe lights (probeViewFootprints), worked out
   // again when the views or the geometry change.
   std::vector<float> viewFootprints(const std::vector<View>& views);
-  std::vector<glm::vec3> positions_;  // the geometry traced (of the last scene set)
-  std::vector<uint32_t> indices_;
+  scene::Scene geometry_;  // the triangles traced (positions and indices of the last scene set)
   std::vector<View> footprintViews_;  // the views footprints_ is of
   std::vector<float> footprints_;
   bool footprintsStale_ = true;
