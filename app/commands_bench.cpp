@@ -454,9 +454,10 @@ void addBenchAdaptive(CLI::App* bench) {
                      "trace and stream only the probes that light some surface (default on)");
   adaptive->add_option("--view-weights", ao->bench.viewWeights,
                        "the noise-aware stream holds probes the scored views show little of longer: none, footprint "
-                       "(each probe's measured share of their pixels) or surface (the views' surfaces and the probes "
-                       "that light them, as a server can work them out)")
-      ->check(CLI::IsMember({"none", "footprint", "surface"}));
+                       "(each probe's measured share of their pixels), surface (the views' surfaces and the probes "
+                       "that light them, as a server can work them out) or lit (surface, weighed by the light the "
+                       "volume holds, after gamma, at every update: what a producer does)")
+      ->check(CLI::IsMember({"none", "footprint", "surface", "lit"}));
   adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
                        "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")
       ->check(CLI::Range(0u, 100000u));

@@ -71,6 +71,20 @@ struct Stream {
   std::vector<double> heldChanges;    // per frame: its relative irradiance change (what a viewer sees flicker)
 };
 
+// Pearson's correlation of a and b, each value raised to `power` first (1/3: of the cube roots,
+// the scale the encoder's thresholds follow).
+double pearson(const std::vector<float>& a, const std::vector<float>& b, double power) {
+  const size_t n = std::min(a.size(), b.size());
+  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double x = std::pow(std::max<double>(a[i], 0.0), power), y = std::pow(std::max<double>(b[i], 0.0), power);
+    sa += x, sb += y, saa += x * x, sbb += y * y, sab += x * y;
+  }
+  const double dn = static_cast<double>(n);
+  const double cov = sab - sa * sb / dn, va = saa - sa * sa / dn, vb = sbb - sb * sb / dn;
+  return va > 0 && vb > 0 ? cov / std::sqrt(va * vb) : 0.0;
+}
+
 double mean(const std::vector<double>& v, size_t from, size_t to) {
   if (to <= from) return 0.0;
   return std::accumulate(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(to), 0.0) /
@@ -310,10 +324,26 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   };
   for (const Moment& m : moments)
     for (uint32_t f = m.first; f <= m.frame; ++f) converge(tAt(f), true);
+  // The scored views as a server knows them (what a subscriber sends), for the view weights a
+  // server works out itself (session/probe_interest.h): "surface" from the geometry the views show,
+  // "lit" also from the light the volume holds.
+  std::vector<View> serverViews;
+  {
+    std::vector<renderer::ViewInfo> scored = views;
+    if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono) {
+      const renderer::RasterRenderer raster(context, first, o.width, o.height, renderer::RasterOptions{});
+      scored.assign(1, renderer::ViewInfo{});
+      scored[0].viewProj = raster.viewProjection(camera);
+      scored[0].eye = camera.position;
+    }
+    serverViews = session::priorityViews(scored);
+  }
+  const session::SurfaceLighting firstLighting = session::surfaceLighting(first, scene::AreaLightOptions{});
   // The noise-aware stream's view weights (AdaptiveBenchOptions::viewWeights = "footprint"): each
   // probe's share of the scored views, measured on the converged volume at the start: the views'
   // squared change (after gamma) when that probe alone is made 20 % brighter.
   std::vector<float> footprint;
+  nlohmann::json footprintMatch;
   if (o.viewWeights == "footprint") {
     converge(tAt(0), false);
     say("adaptive bench: each probe's footprint in the scored views");
@@ -330,6 +360,18 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       footprint[p] = static_cast<float>(mseOf(renderWith(raster, v), base));  // weights count relative to each other
       for (int i = 0; i < kProbeFloats; ++i) c[i] = truthProbes.at(tAt(0))[static_cast<size_t>(p) * kProbeFloats + i];
     }
+    // How well the server's own estimates follow the measured weights (on the same converged volume).
+    std::vector<uint8_t> lit(count, 0);
+    for (uint32_t p = 0; p < count; ++p) {
+      const float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
+      lit[p] = std::any_of(c, c + kProbeFloats, [](float x) { return x != 0.0f; });
+    }
+    const std::vector<session::ViewSample> seen = session::sampleViewSurfaces(sceneNow, grid, lit, serverViews);
+    const std::pair<const char*, std::vector<float>> estimates[] = {
+        {"surface", session::probeViewFootprints(seen, count)},
+        {"lit", session::probeViewSensitivity(seen, firstLighting, v.probes, count)}};
+    for (const auto& [name, w] : estimates)
+      footprintMatch[name] = {{"pearson", pearson(w, footprint, 1.0)}, {"pearson_cube_roots", pearson(w, footprint, 1.0 / 3.0)}};
   }
   // The oracle stream needs the truth at every update.
   if (!o.oracleErrorRatios.empty())
@@ -351,6 +393,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["view_weights"] = o.viewWeights;
   if (!footprint.empty())
     j["probes_that_change_no_pixel"] = std::count(footprint.begin(), footprint.end(), 0.0f);  // of the grid
+  if (!footprintMatch.is_null()) j["view_weight_estimates_vs_footprint"] = footprintMatch;
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
   j["confirmations"] = o.confirmations;
@@ -410,18 +453,12 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].options.refinementInterval = o.refinementInterval;
     streams[2].withNoise = true;
     streams[2].viewWeights = footprint;
-    if (o.viewWeights == "surface") {
-      // What a server can work out from the views alone (session::probeViewFootprints).
-      std::vector<renderer::ViewInfo> scored = views;
-      if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono) {
-        const renderer::RasterRenderer raster(context, first, o.width, o.height, renderer::RasterOptions{});
-        scored.assign(1, renderer::ViewInfo{});
-        scored[0].viewProj = raster.viewProjection(camera);
-        scored[0].eye = camera.position;
-      }
-      const std::vector<View> seen = session::priorityViews(scored);
-      streams[2].viewWeights = session::probeViewFootprints(first, grid, u.volume().active, seen);
+    std::vector<session::ViewSample> seenSurfaces;
+    if (o.viewWeights == "surface" || o.viewWeights == "lit") {
+      seenSurfaces = session::sampleViewSurfaces(first, grid, u.volume().active, serverViews);
+      if (o.viewWeights == "surface") streams[2].viewWeights = session::probeViewFootprints(seenSurfaces, count);
     }
+    session::SurfaceLighting lighting = firstLighting;  // its lights follow the scene
     for (float exponent : o.oracleExponents)
       for (float ratio : o.oracleErrorRatios) {
         Stream& s = streams.emplace_back();
@@ -449,9 +486,16 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     std::vector<std::vector<std::vector<double>>> probeErrorEach = psnr;
     std::vector<uint8_t> frame;
     for (uint32_t f = 0; f < frames; ++f) {
-      if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) u.setScene(sceneAt(tAt(f)));
+      if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) {
+        const scene::Scene now = sceneAt(tAt(f));
+        u.setScene(now);
+        lighting.lights = now.lights;
+      }
       restarts.push_back(u.update().restartedProbes);
       const ProbeVolume& v = u.volume();
+      if (o.viewWeights == "lit" && !streams[2].encoder->setViewWeights(
+                                        session::probeViewSensitivity(seenSurfaces, lighting, v.probes, count)))
+        streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
       changes.push_back(previous.empty() ? 0.0 : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), count));
       previous = v.probes;
       for (Stream& s : streams) {

@@ -44,8 +44,10 @@ struct AdaptiveBenchOptions {
   bool surfaceProbesOnly = true;
   // The noise-aware stream's view weights (StreamEncoder::setViewWeights): "none"; "footprint":
   // each probe's measured share of the scored views (at the start, on the converged volume; the
-  // raster renders the views once per probe); or "surface": what a server can work out from the
-  // views alone (session::probeViewFootprints).
+  // raster renders the views once per probe); "surface": what a server can work out from the
+  // views' geometry alone (session::probeViewFootprints); "lit": that weighed by the light the
+  // updater's volume holds, recomputed every update (session::probeViewSensitivity), as the
+  // producer does.
   std::string viewWeights = "none";
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;

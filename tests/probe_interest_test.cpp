@@ -1,5 +1,7 @@
 // What the views show of each probe (session/probe_interest.h): probeViewFootprints on a wall seen
-// straight on, behind an occluder, from inside the scene, and with views that see nothing.
+// straight on, behind an occluder, from inside the scene, and with views that see nothing; and
+// probeViewSensitivity against its formula worked by hand (gamma, direct light, colour, textures,
+// bad coefficients).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +9,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "probecast/codec/sh.h"
 #include "probecast/session/probe_interest.h"
 
 namespace probecast::session {
@@ -112,6 +115,129 @@ TEST(ProbeInterest, ViewsThatSeeNothingWeighNothing) {
     ASSERT_EQ(w.size(), kGrid.count());
     for (float x : w) EXPECT_EQ(x, 0.0f);
   }
+}
+
+// Every probe holds the same uniform grey radiance r: E(n) = π · Y00 · (DC = r / Y00) = π r
+// (CODEC.md §1), so a white wall shows L = ρ/π · π r = r without other light.
+std::vector<float> uniformProbes(float r) {
+  std::vector<float> probes(static_cast<size_t>(kGrid.count()) * kProbeFloats, 0.0f);
+  for (uint32_t p = 0; p < kGrid.count(); ++p)
+    for (int c = 0; c < 3; ++c) probes[static_cast<size_t>(p) * kProbeFloats + c] = r / kY00;
+  return probes;
+}
+
+scene::Scene whiteWall() {
+  scene::Scene s = wall();
+  s.materials.emplace_back().baseColor = glm::vec3(1.0f);
+  return s;
+}
+
+TEST(ProbeInterest, SensitivityIsTheFootprintTimesTheGammaSlopeWorkedByHand) {
+  // With one light in every probe, each probe's part of a sample is ŵ · L, so its change after
+  // gamma is g′(L) · 0.2 · ŵ L = (0.2 / 2.2) L^(1/2.2) ŵ per channel: the sensitivity is
+  // 3 (0.2 / 2.2)² L^(2/2.2) times the footprint, for every probe.
+  const scene::Scene s = whiteWall();
+  const View v = straightOn();
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  ASSERT_EQ(seen.size(), 64u * 40u);
+  const std::vector<float> footprint = probeViewFootprints(seen, kGrid.count());
+  const SurfaceLighting lighting = surfaceLighting(s, {});
+  for (float r : {0.25f, 4.0f}) {
+    const std::vector<float> w = probeViewSensitivity(seen, lighting, uniformProbes(r), kGrid.count());
+    const double k = 3.0 * (0.2 / 2.2) * (0.2 / 2.2) * std::pow(r, 2.0 / 2.2);
+    for (uint32_t p = 0; p < kGrid.count(); ++p) EXPECT_NEAR(w[p], k * footprint[p], 1e-4 * k * footprint[p] + 1e-12) << p;
+  }
+}
+
+TEST(ProbeInterest, DirectLightMakesTheProbesCountLessAsGammaDoes) {
+  // A directional light straight onto the white wall with irradiance π r adds r to every sample,
+  // so L doubles and each sensitivity falls by g′(2L)² / g′(L)² = 2^(2/2.2 − 2).
+  scene::Scene s = whiteWall();
+  const float r = 0.5f;
+  s.lights.push_back({scene::LightType::Directional, {}, {0, 0, -1}, glm::vec3(1.0f), kPi * r});
+  const View v = straightOn();
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<float> dark = probeViewSensitivity(seen, surfaceLighting(wall(), {}), uniformProbes(r), kGrid.count());
+  scene::Scene unlit = s;
+  unlit.lights.clear();
+  const std::vector<float> without = probeViewSensitivity(seen, surfaceLighting(unlit, {}), uniformProbes(r), kGrid.count());
+  const std::vector<float> with = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(r), kGrid.count());
+  const double ratio = std::pow(2.0, 2.0 / 2.2 - 2.0);
+  for (uint32_t p = 0; p < kGrid.count(); ++p) {
+    EXPECT_NEAR(with[p], ratio * without[p], 1e-4 * without[p] + 1e-12) << p;
+    // A scene without materials counts its surfaces as glTF's default 0.8 grey: ρ^(2/2.2) less.
+    EXPECT_NEAR(dark[p], std::pow(0.8, 2.0 / 2.2) * without[p], 1e-4 * without[p] + 1e-12) << p;
+  }
+  // A light from behind the wall lights nothing the view sees.
+  s.lights[0].direction = {0, 0, 1};
+  EXPECT_EQ(probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(r), kGrid.count()), without);
+}
+
+TEST(ProbeInterest, ATextureCountsByItsMeanLinearColour) {
+  // Half the texels sRGB 255, half 0: a mean linear colour of 0.5, so L and each part halve and
+  // the sensitivity falls by 0.5^(2/2.2).
+  scene::Scene s = whiteWall();
+  scene::Texture& t = s.textures.emplace_back();
+  t.width = 2;
+  t.height = 2;
+  t.rgba = {255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255, 255};
+  const View v = straightOn();
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<float> plain = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(1.0f), kGrid.count());
+  s.materials[0].baseColorTexture = 0;
+  const SurfaceLighting lighting = surfaceLighting(s, {});
+  ASSERT_EQ(lighting.diffuse.size(), 1u);
+  EXPECT_NEAR(lighting.diffuse[0].x, 0.5f, 1e-6f);
+  const std::vector<float> textured = probeViewSensitivity(seen, lighting, uniformProbes(1.0f), kGrid.count());
+  for (uint32_t p = 0; p < kGrid.count(); ++p)
+    EXPECT_NEAR(textured[p], std::pow(0.5, 2.0 / 2.2) * plain[p], 1e-4 * plain[p] + 1e-12) << p;
+}
+
+TEST(ProbeInterest, ABrighterProbeCountsForMoreAndABrokenOneForNothing) {
+  const scene::Scene s = whiteWall();
+  const View v = straightOn();
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const SurfaceLighting lighting = surfaceLighting(s, {});
+  const std::vector<float> even = probeViewSensitivity(seen, lighting, uniformProbes(1.0f), kGrid.count());
+  std::vector<float> probes = uniformProbes(1.0f);
+  for (int c = 0; c < 3; ++c) probes[static_cast<size_t>(at(1, 1, 0)) * kProbeFloats + c] *= 4.0f;
+  const std::vector<float> bright = probeViewSensitivity(seen, lighting, probes, kGrid.count());
+  EXPECT_GT(bright[at(1, 1, 0)], 4.0f * even[at(1, 1, 0)]);  // (4/L)² with L up by less than 4×
+  EXPECT_LT(bright[at(0, 0, 0)], even[at(0, 0, 0)]);         // its neighbours' pixels got brighter
+  // A NaN or infinite coefficient makes that probe count as black, and nothing else non-finite.
+  probes[static_cast<size_t>(at(1, 1, 0)) * kProbeFloats + 13] = NAN;
+  probes[static_cast<size_t>(at(2, 2, 0)) * kProbeFloats + 0] = INFINITY;
+  const std::vector<float> broken = probeViewSensitivity(seen, lighting, probes, kGrid.count());
+  EXPECT_EQ(broken[at(1, 1, 0)], 0.0f);
+  EXPECT_EQ(broken[at(2, 2, 0)], 0.0f);
+  for (float x : broken) EXPECT_TRUE(std::isfinite(x));
+  EXPECT_GT(broken[at(0, 0, 0)], 0.0f);
+  // Too few coefficients for the grid: the probes past them count as black.
+  probes.resize(kProbeFloats);
+  const std::vector<float> short_ = probeViewSensitivity(seen, lighting, probes, kGrid.count());
+  ASSERT_EQ(short_.size(), kGrid.count());
+  EXPECT_GT(short_[0], 0.0f);
+  for (uint32_t p = 1; p < kGrid.count(); ++p) EXPECT_EQ(short_[p], 0.0f);
+}
+
+TEST(ProbeInterest, AClientAreaLightIsAddedAsTheViewersAddIt) {
+  // An emissive panel facing the wall, 0.5 m in front of it: client-lit, it adds its unshadowed
+  // Lambertian light to every sample, and every probe counts for less; off, the probes carry it.
+  scene::Scene s = whiteWall();
+  auto& lamp = s.materials.emplace_back();
+  lamp.baseColor = glm::vec3(0.0f);
+  lamp.emission = glm::vec3(10.0f);
+  scene::addQuad(s, {0.5f, 0.5f, 0.5f}, {0.5f, 1.5f, 0.5f}, {1.5f, 1.5f, 0.5f}, {1.5f, 0.5f, 0.5f}, 1);  // faces −z
+  const View v = straightOn();
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  scene::AreaLightOptions on;
+  on.enabled = true;
+  const SurfaceLighting lit = surfaceLighting(s, on);
+  ASSERT_EQ(lit.areaLights.lights.size(), 1u);
+  const std::vector<float> without = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(0.1f), kGrid.count());
+  const std::vector<float> with = probeViewSensitivity(seen, lit, uniformProbes(0.1f), kGrid.count());
+  for (uint32_t y = 0; y < 3; ++y)
+    for (uint32_t x = 0; x < 3; ++x) EXPECT_LT(with[at(x, y, 0)], without[at(x, y, 0)]) << x << " " << y;
 }
 
 }  // namespace

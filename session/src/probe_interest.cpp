@@ -6,6 +6,9 @@
 
 #include <glm/glm.hpp>
 
+#include "area_light_math.h"
+#include "probecast/codec/sh.h"
+
 namespace probecast::session {
 namespace {
 
@@ -70,12 +73,11 @@ size_t clipNear(const ClipVertex* in, size_t n, ClipVertex* out) {
 
 }  // namespace
 
-std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
-                                       std::span<const View> views, uint32_t width, uint32_t height) {
-  if (views.empty()) return {};
-  const uint32_t count = grid.count();
-  std::vector<float> footprint(count, 0.0f);
-  if (width == 0 || height == 0) return footprint;
+std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const ProbeGrid& grid,
+                                           std::span<const uint8_t> active, std::span<const View> views,
+                                           uint32_t width, uint32_t height) {
+  std::vector<ViewSample> samples;
+  if (width == 0 || height == 0) return samples;
   const size_t pixels = static_cast<size_t>(width) * height;
   std::vector<float> depth(pixels);    // clip z/w of the nearest surface (+inf: none)
   std::vector<uint32_t> nearest(pixels);
@@ -168,11 +170,133 @@ std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGri
         total += w[k];
       }
       if (!(total > 0.0f)) continue;
-      for (int k = 0; k < 8; ++k)
-        if (w[k] > 0.0f) footprint[index[k]] += (w[k] / total) * (w[k] / total);
+      ViewSample& sample = samples.emplace_back();
+      sample.point = point[i];
+      sample.normal = ng;
+      sample.material = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : 0;
+      for (int k = 0; k < 8; ++k) {
+        sample.probes[k] = index[k];
+        sample.weights[k] = w[k] / total;
+      }
     }
   }
+  return samples;
+}
+
+std::vector<float> probeViewFootprints(std::span<const ViewSample> samples, uint32_t probeCount) {
+  std::vector<float> footprint(probeCount, 0.0f);
+  for (const ViewSample& s : samples)
+    for (int k = 0; k < 8; ++k)
+      if (s.weights[k] > 0.0f && s.probes[k] < probeCount) footprint[s.probes[k]] += s.weights[k] * s.weights[k];
   return footprint;
+}
+
+std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
+                                       std::span<const View> views, uint32_t width, uint32_t height) {
+  if (views.empty()) return {};
+  return probeViewFootprints(sampleViewSurfaces(scene, grid, active, views, width, height), grid.count());
+}
+
+}  // namespace probecast::session
+
+namespace probecast::session {
+namespace {
+
+// The mean linear colour of an sRGB texture, over a grid of at most 64 × 64 texels.
+glm::vec3 meanLinear(const scene::Texture& t) {
+  if (t.width == 0 || t.height == 0 || t.rgba.size() < static_cast<size_t>(t.width) * t.height * 4) return glm::vec3(1.0f);
+  float decode[256];
+  for (int i = 0; i < 256; ++i) {
+    const float c = static_cast<float>(i) / 255.0f;
+    decode[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  }
+  const uint32_t stepX = std::max(1u, t.width / 64), stepY = std::max(1u, t.height / 64);
+  glm::dvec3 sum(0.0);
+  size_t n = 0;
+  for (uint32_t y = stepY / 2; y < t.height; y += stepY)
+    for (uint32_t x = stepX / 2; x < t.width; x += stepX) {
+      const uint8_t* texel = &t.rgba[(static_cast<size_t>(y) * t.width + x) * 4];
+      sum += glm::dvec3(decode[texel[0]], decode[texel[1]], decode[texel[2]]);
+      ++n;
+    }
+  return n ? glm::vec3(sum / static_cast<double>(n)) : glm::vec3(1.0f);
+}
+
+}  // namespace
+
+SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLightOptions& areaLights) {
+  SurfaceLighting out;
+  std::vector<glm::vec3> textureMean(scene.textures.size());
+  for (size_t i = 0; i < scene.textures.size(); ++i) textureMean[i] = meanLinear(scene.textures[i]);
+  const auto texture = [&](int32_t index) {
+    return index >= 0 && static_cast<size_t>(index) < textureMean.size() ? textureMean[index] : glm::vec3(1.0f);
+  };
+  for (const scene::Material& m : scene.materials) {
+    out.diffuse.push_back(m.baseColor * (1.0f - m.metallic) * texture(m.baseColorTexture));
+    out.emission.push_back(m.emission * texture(m.emissiveTexture));
+  }
+  out.lights = scene.lights;
+  out.areaLights = scene::extractAreaLights(scene, areaLights);
+  return out;
+}
+
+std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, const SurfaceLighting& lighting,
+                                        std::span<const float> probes, uint32_t probeCount) {
+  std::vector<float> sensitivity(probeCount, 0.0f);
+  const size_t usable = std::min<size_t>(probeCount, probes.size() / kProbeFloats);
+  for (const ViewSample& s : samples) {
+    const bool known = s.material < lighting.diffuse.size();
+    const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);  // glTF's default base colour
+    glm::vec3 radiance = known && s.material < lighting.emission.size() ? lighting.emission[s.material] : glm::vec3(0.0f);
+    // Direct light, without shadows: the Lambertian part of the raster client's sum.
+    for (const scene::Light& l : lighting.lights) {
+      glm::vec3 e = l.color * l.intensity;
+      glm::vec3 wi;
+      if (l.type == scene::LightType::Directional) {
+        wi = -l.direction;
+      } else {
+        const glm::vec3 toLight = l.position - s.point;
+        const float d2 = std::max(glm::dot(toLight, toLight), 1e-8f);
+        const float dist = std::sqrt(d2);
+        wi = toLight / dist;
+        e /= d2;
+        if (l.range > 0.0f) e *= std::pow(std::clamp(1.0f - std::pow(dist / l.range, 4.0f), 0.0f, 1.0f), 2.0f);
+        if (l.type == scene::LightType::Spot) {
+          const float lo = std::cos(l.outerConeAngle), hi = std::cos(l.innerConeAngle);
+          const float x = std::clamp((glm::dot(-wi, l.direction) - lo) / std::max(hi - lo, 1e-6f), 0.0f, 1.0f);
+          e *= x * x * (3.0f - 2.0f * x);
+        }
+      }
+      const float cosine = glm::dot(s.normal, wi);
+      if (cosine > 0.0f && std::isfinite(cosine)) radiance += rho / kPi * cosine * e;
+    }
+    for (const scene::AreaLight& a : lighting.areaLights.lights)
+      for (size_t c = 0; c + 2 < a.corners.size(); c += 3)
+        radiance += rho / kPi * a.radiance *
+                    arealight::triangleCosineSolidAngle(s.point, s.normal, a.corners[c], a.corners[c + 1], a.corners[c + 2]);
+    // The probes' diffuse light, each probe's part of it.
+    glm::vec3 part[8];
+    for (int k = 0; k < 8; ++k) {
+      part[k] = glm::vec3(0.0f);
+      if (!(s.weights[k] > 0.0f) || s.probes[k] >= usable) continue;
+      const float* c = probes.data() + static_cast<size_t>(s.probes[k]) * kProbeFloats;
+      if (!std::all_of(c, c + kProbeFloats, [](float x) { return std::isfinite(x); })) continue;
+      float e[3];
+      shEvalIrradiance(c, s.normal.x, s.normal.y, s.normal.z, e);
+      part[k] = s.weights[k] * rho / kPi * glm::max(glm::vec3(e[0], e[1], e[2]), glm::vec3(0.0f));
+      radiance += part[k];
+    }
+    // g′(L) = L^(1/2.2 − 1) / 2.2; each part is at most L, so g′ · part stays finite as L → 0.
+    glm::vec3 slope(0.0f);
+    for (int c = 0; c < 3; ++c)
+      if (radiance[c] > 0.0f && std::isfinite(radiance[c])) slope[c] = std::pow(radiance[c], 1.0f / 2.2f - 1.0f) / 2.2f;
+    for (int k = 0; k < 8; ++k) {
+      const glm::vec3 change = slope * 0.2f * part[k];
+      const float squared = glm::dot(change, change);
+      if (squared > 0.0f && std::isfinite(squared)) sensitivity[s.probes[k]] += squared;
+    }
+  }
+  return sensitivity;
 }
 
 }  // namespace probecast::session

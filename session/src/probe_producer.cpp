@@ -47,6 +47,10 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   sceneSpec_ = sceneSpec;
   geometry_.positions = first.positions;
   geometry_.indices = first.indices;
+  geometry_.triangleMaterial = first.triangleMaterial;
+  areaLights_ = options.areaLights;
+  lighting_ = surfaceLighting(first, areaLights_);
+  lightingMaterials_ = first.materials;
   footprintsStale_ = true;
   rayBudget_ = options.raysPerUpdate > 0;
   animation_ = animation;
@@ -80,10 +84,18 @@ void ProbeProducer::step() {
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene) {
       const scene::Scene next = loadSceneOrThrow(sceneSpec_, t());
       updater_->setScene(next);
-      if (next.positions != geometry_.positions || next.indices != geometry_.indices) {
+      if (next.positions != geometry_.positions || next.indices != geometry_.indices ||
+          next.triangleMaterial != geometry_.triangleMaterial) {
         geometry_.positions = next.positions;
         geometry_.indices = next.indices;
+        geometry_.triangleMaterial = next.triangleMaterial;
         footprintsStale_ = true;
+      }
+      if (next.materials != lightingMaterials_) {
+        lighting_ = surfaceLighting(next, areaLights_);
+        lightingMaterials_ = next.materials;
+      } else {
+        lighting_.lights = next.lights;
       }
     }
     // The ray budget traces first what the subscribers can see now; the noise rule holds what none
@@ -121,17 +133,20 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
   const auto same = [](const std::vector<View>& a, const std::vector<View>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(View)) == 0);
   };
-  if (!footprintsStale_ && same(views, footprintViews_)) return footprints_;
-  // At most kFootprintViews of them, evenly spread over the list (each costs a pass over the
-  // triangles): the others' probes are mostly the same ones.
-  constexpr size_t kFootprintViews = 16;
-  std::vector<View> sample;
-  for (size_t k = 0; k < std::min(views.size(), kFootprintViews); ++k)
-    sample.push_back(views[k * views.size() / std::min(views.size(), kFootprintViews)]);
-  footprints_ = probeViewFootprints(geometry_, updater_->grid(), updater_->volume().active, sample);
-  footprintViews_ = views;
-  footprintsStale_ = false;
-  return footprints_;
+  if (views.empty()) return {};
+  if (footprintsStale_ || !same(views, footprintViews_)) {
+    // At most kFootprintViews of them, evenly spread over the list (each costs a pass over the
+    // triangles): the others' probes are mostly the same ones.
+    constexpr size_t kFootprintViews = 16;
+    std::vector<View> sample;
+    for (size_t k = 0; k < std::min(views.size(), kFootprintViews); ++k)
+      sample.push_back(views[k * views.size() / std::min(views.size(), kFootprintViews)]);
+    viewSurfaces_ = sampleViewSurfaces(geometry_, updater_->grid(), updater_->volume().active, sample);
+    footprintViews_ = views;
+    footprintsStale_ = false;
+  }
+  // The light changes every update: weigh the surfaces by what the volume holds now.
+  return probeViewSensitivity(viewSurfaces_, lighting_, updater_->volume().probes, updater_->grid().count());
 }
 
 void ProbeProducer::loop(const Pacing& pacing, const std::atomic<bool>* interrupted,

@@ -1,13 +1,17 @@
 // Which probes viewers can see: the weight the updater's ray budget gives each probe for being
-// inside some subscriber's view (ProbeUpdater::setViewWeights).
+// inside some subscriber's view (ProbeUpdater::setViewWeights), and how much of the views each
+// probe lights (the noise rule's view weights, StreamEncoder::setViewWeights).
 #pragma once
 
 #include <span>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "probecast/codec/priority.h"
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/probe_volume.h"
+#include "probecast/scene/area_lights.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::session {
@@ -18,14 +22,50 @@ namespace probecast::session {
 // A view with non-finite numbers sees nothing.
 std::vector<float> probeViewWeights(const ProbeGrid& grid, const std::vector<float>& offsets, std::span<const View> views);
 
-// Per probe (grid order): how much of the views' pixels it lights, Σ over the pixels of its
+// The surfaces views show: one sample per pixel centre that some triangle covers, found by a
+// depth-buffered rasterisation of the scene's triangles on the CPU (Vulkan clip space, as View
+// holds it: clipped at the near plane z = 0, nothing past the far one), with the probes that light
+// it as the raster client weighs them without visibility: the eight probes of its grid cell,
+// trilinear × backface ((cos + 1)/2)² + 0.2, the inactive ones left out, normalised to sum 1.
+// A view with non-finite numbers sees nothing.
+struct ViewSample {
+  glm::vec3 point{0.0f};
+  glm::vec3 normal{0.0f, 1.0f, 0.0f};  // the triangle's geometric normal, on the viewer's side
+  uint32_t material = 0;               // Scene::triangleMaterial of the triangle (0 when the scene has none)
+  uint32_t probes[8] = {};
+  float weights[8] = {};               // sum 1 (a sample no active probe lights is left out)
+};
+std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const ProbeGrid& grid,
+                                           std::span<const uint8_t> active, std::span<const View> views,
+                                           uint32_t width = 64, uint32_t height = 40);
+
+// Per probe (grid order): how much of the views' pixels it lights, Σ over the samples of its
 // normalised weight squared (what an error in that probe adds to the views' squared error, per
-// unit of the pixel's irradiance). Each view's nearest surfaces are found at width × height pixel
-// centres by a depth-buffered rasterisation of the scene's triangles on the CPU (Vulkan clip space,
-// as View holds it: clipped at the near plane z = 0, nothing past the far one), and each point is lit as the raster client does without visibility: the eight
-// probes of its grid cell, trilinear × backface ((cos + 1)/2)² + 0.2, the inactive ones left out.
-// Empty when there are no views. A view with non-finite numbers sees nothing.
+// unit of the pixel's irradiance).
+std::vector<float> probeViewFootprints(std::span<const ViewSample> samples, uint32_t probeCount);
+// The same from the scene and the views (sampleViewSurfaces). Empty when there are no views.
 std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
                                        std::span<const View> views, uint32_t width = 64, uint32_t height = 40);
+
+// What a viewer adds to the probes' light at a surface, for probeViewSensitivity.
+struct SurfaceLighting {
+  std::vector<glm::vec3> diffuse;   // per material: base colour × (1 − metallic) × its texture's mean (linear)
+  std::vector<glm::vec3> emission;  // per material: emission × its texture's mean
+  std::vector<scene::Light> lights; // punctual, lit without shadows
+  scene::AreaLightSet areaLights;   // client area lights, lit without shadows (empty: none)
+};
+// Textures are averaged on a grid of at most 64 × 64 texels.
+SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLightOptions& areaLights);
+
+// Per probe (grid order): how much the views change, after the plain gamma 2.2 that images are
+// scored in, when that probe alone is made 20 % brighter: Σ over the samples and RGB of
+// (g′(L) · 0.2 · ŵ · ρ/π · E_p(n))², with g(L) = L^(1/2.2), ŵ the probe's weight at the sample, ρ
+// the diffuse colour, E_p(n) the probe's irradiance (clamped at 0) and L the sample's radiance as
+// a viewer shades it: emission + unshadowed direct light + ρ/π · Σ ŵ E(n) (glossy light left out).
+// A dim surface counts for more than a bright one, as gamma makes it; a probe's own brightness
+// counts squared. `probes`: kProbeFloats per probe, the light viewers hold. Non-finite
+// coefficients count as 0.
+std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, const SurfaceLighting& lighting,
+                                        std::span<const float> probes, uint32_t probeCount);
 
 }  // namespace probecast::session

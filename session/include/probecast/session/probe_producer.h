@@ -17,6 +17,7 @@
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
+#include "probecast/session/probe_interest.h"
 #include "probecast/service/bus_nats.h"
 #include "probecast/service/probe_hub.h"
 #include "probecast/service/server.h"
@@ -127,12 +128,16 @@ class ProbeProducer {
   std::string sceneSpec_;
   bool rayBudget_ = false;  // the updater spends a ray budget: it is told the subscribers' views
   bool noiseRule_ = false;  // the hub's encoder holds noise (EncoderOptions::noiseScale): and so is it
-  // told how much of the subscribers' views each probe lights (probeViewFootprints), worked out
-  // again when the views or the geometry change.
+  // told how much each probe changes the subscribers' views (probeViewSensitivity): the surfaces
+  // the views show are found again when the views or the geometry change, and weighed by the
+  // volume's light at every update.
   std::vector<float> viewFootprints(const std::vector<View>& views);
-  scene::Scene geometry_;  // the triangles traced (positions and indices of the last scene set)
-  std::vector<View> footprintViews_;  // the views footprints_ is of
-  std::vector<float> footprints_;
+  scene::Scene geometry_;  // the triangles traced (positions, indices, materials of the last scene set)
+  scene::AreaLightOptions areaLights_;      // the updater's: what viewers light themselves
+  SurfaceLighting lighting_;                // of the last scene set
+  std::vector<scene::Material> lightingMaterials_;  // the materials lighting_ is of
+  std::vector<View> footprintViews_;        // the views viewSurfaces_ are of
+  std::vector<ViewSample> viewSurfaces_;
   bool footprintsStale_ = true;
   Animation animation_;
   FrameGenerator generator_;
