@@ -326,7 +326,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     for (uint32_t f = m.first; f <= m.frame; ++f) converge(tAt(f), true);
   // The scored views as a server knows them (what a subscriber sends), for the view weights a
   // server works out itself (session/probe_interest.h): "surface" from the geometry the views show,
-  // "lit" also from the light the volume holds.
+  // "lit" also from the light the volume holds. Without probe offsets: the scored renders here
+  // draw every volume at the grid positions.
   std::vector<View> serverViews;
   {
     std::vector<renderer::ViewInfo> scored = views;
@@ -338,6 +339,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     }
     serverViews = session::priorityViews(scored);
   }
+  const glm::uvec2 sampleSize = session::footprintSampleSize(serverViews.size());  // as the producer samples them
   const session::SurfaceLighting firstLighting = session::surfaceLighting(first, scene::AreaLightOptions{});
   // The noise-aware stream's view weights (AdaptiveBenchOptions::viewWeights = "footprint"): each
   // probe's share of the scored views, measured on the converged volume at the start: the views'
@@ -366,7 +368,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       const float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
       lit[p] = std::any_of(c, c + kProbeFloats, [](float x) { return x != 0.0f; });
     }
-    const std::vector<session::ViewSample> seen = session::sampleViewSurfaces(sceneNow, grid, lit, serverViews);
+    const std::vector<session::ViewSample> seen =
+        session::sampleViewSurfaces(sceneNow, grid, lit, {}, serverViews, sampleSize.x, sampleSize.y);
     const std::pair<const char*, std::vector<float>> estimates[] = {
         {"surface", session::probeViewFootprints(seen, count)},
         {"lit", session::probeViewSensitivity(seen, firstLighting, v.probes, count)}};
@@ -455,7 +458,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     streams[2].viewWeights = footprint;
     std::vector<session::ViewSample> seenSurfaces;
     if (o.viewWeights == "surface" || o.viewWeights == "lit") {
-      seenSurfaces = session::sampleViewSurfaces(first, grid, u.volume().active, serverViews);
+      seenSurfaces = session::sampleViewSurfaces(first, grid, u.volume().active, {}, serverViews, sampleSize.x, sampleSize.y);
       if (o.viewWeights == "surface") streams[2].viewWeights = session::probeViewFootprints(seenSurfaces, count);
     }
     session::SurfaceLighting lighting = firstLighting;  // its lights follow the scene

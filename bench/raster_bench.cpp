@@ -10,6 +10,7 @@
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/codec/record.h"
 #include "probecast/renderer/view_sets.h"
+#include "probecast/session/probe_interest.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/viewer.h"
 #include "probecast/imaging/svg_chart.h"
@@ -155,6 +156,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   std::vector<imaging::ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
   table += fmt::format("\n{:<8} {:>6} {:>16} {:>16}\n", "views", "count", "per-view ms/view", "multiview ms/view");
   const renderer::ViewSetOptions vo = session::viewSetOptions(o.scene, o.width, o.height);
+  const session::SurfaceLighting lighting = session::surfaceLighting(o.scene, o.raster.areaLights);
   for (const std::string& name : o.viewSets) {
     renderer::ViewSetSpec spec;
     std::string error;
@@ -177,11 +179,37 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
     }
     row["shadow_ms"] = raster.timings().shadowMs;
     row["area_shadow_ms"] = raster.timings().areaShadowMs;
+    // What the same views cost a producer with the noise rule on the CPU (probe_interest.h, as
+    // ProbeProducer uses it): their surfaces when views change, their weights every update.
+    {
+      const std::vector<View> seen = session::spreadViews(session::priorityViews(views), session::kFootprintViews);
+      const glm::uvec2 size = session::footprintSampleSize(seen.size());
+      std::vector<double> surfacesMs, weightsMs;
+      std::vector<session::ViewSample> samples;
+      for (uint32_t k = 0; k < o.repeats; ++k) {
+        auto t0 = std::chrono::steady_clock::now();
+        samples = session::sampleViewSurfaces(o.scene, o.grid, volume.active, volume.offsets, seen, size.x, size.y);
+        auto t1 = std::chrono::steady_clock::now();
+        const std::vector<float> w = session::probeViewSensitivity(samples, lighting, volume.probes, o.grid.count());
+        auto t2 = std::chrono::steady_clock::now();
+        surfacesMs.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        weightsMs.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+      }
+      row["producer_view_weights"] = {{"views_sampled", seen.size()},
+                                      {"samples", samples.size()},
+                                      {"surfaces_ms_median", session::medianMidpoint(surfacesMs)},
+                                      {"weights_ms_median", session::medianMidpoint(weightsMs)}};
+    }
     json["view_sets"].push_back(row);
     table += fmt::format("{:<8} {:>6} {:>16.2f} {:>16.2f}\n", name, views.size(), perViewMs[0], perViewMs[1]);
     say(fmt::format("raster bench: {} done", name));
   }
   table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
+  table += "producer view weights on the CPU (up to 16 views): surfaces ms (when views change), weights ms (every update)\n";
+  for (const nlohmann::json& row : json["view_sets"])
+    table += fmt::format("  {:<8} {:>8.2f} {:>8.2f}\n", row["views"].get<std::string>(),
+                         row["producer_view_weights"]["surfaces_ms_median"].get<double>(),
+                         row["producer_view_weights"]["weights_ms_median"].get<double>());
   table += fmt::format("shadow maps: punctual {:.2f} ms, {} client area lights {:.2f} ms (drawn once per plan)\n",
                        raster.timings().shadowMs, raster.areaLights().lights.size(), raster.timings().areaShadowMs);
 

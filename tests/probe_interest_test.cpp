@@ -10,19 +10,14 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "probecast/codec/sh.h"
+#include "probecast/renderer/glossy_sh.h"
 #include "probecast/session/probe_interest.h"
+#include "view_test_support.h"
 
 namespace probecast::session {
 namespace {
 
-View toView(const glm::mat4& viewProj, const glm::vec3& eye) {
-  View v{};
-  std::memcpy(v.viewProj, &viewProj[0][0], sizeof v.viewProj);
-  v.eye[0] = eye.x;
-  v.eye[1] = eye.y;
-  v.eye[2] = eye.z;
-  return v;
-}
+using test::toView;
 
 // Orthographic, looking down −z from z = 20 at x, y in [−0.5, 2.5].
 View straightOn() {
@@ -103,6 +98,20 @@ TEST(ProbeInterest, AFloorThatPassesBehindTheEyeIsClippedNotLost) {
   EXPECT_EQ(above, 0.0f);
 }
 
+TEST(ProbeInterest, TheSampleGridKeepsItsBudgetOverTheViews) {
+  EXPECT_EQ(footprintSampleSize(1), glm::uvec2(256, 160));
+  EXPECT_EQ(footprintSampleSize(16), glm::uvec2(64, 40));
+  EXPECT_EQ(footprintSampleSize(0), glm::uvec2(256, 160));  // no views: as for one
+  for (size_t views : {2u, 3u, 5u, 7u, 16u, 256u, 40960u, 1000000u}) {
+    const glm::uvec2 size = footprintSampleSize(views);
+    EXPECT_GE(size.x, 1u);
+    EXPECT_GE(size.y, 1u);
+    if (size.y > 1) {
+      EXPECT_LE(size.x * size.y * views, kFootprintSamples) << views;
+    }
+  }
+}
+
 TEST(ProbeInterest, ViewsThatSeeNothingWeighNothing) {
   EXPECT_TRUE(probeViewFootprints(wall(), kGrid, {}, {}).empty());  // no views: nobody's interest known
   View away = straightOn();
@@ -132,41 +141,56 @@ scene::Scene whiteWall() {
   return s;
 }
 
+// The environment BRDF (A, B) where the straight-on view meets the wall: n·v near 1 and roughness 1
+// (glTF's default), the table's last texel (glossy_sh.h, as the raster client builds it). Uniform
+// probes give a prefiltered radiance of r (band 0 only, g_0 = 1), so a sample of diffuse colour ρ
+// and F0 shows L = r (ρ + F0 A + B).
+glm::vec2 envBrdfStraightOn() {
+  const std::vector<float> table = renderer::envBrdfTable(32, 256);
+  return {table[(31 * 32 + 31) * 2], table[(31 * 32 + 31) * 2 + 1]};
+}
+double glossyOfDielectric() {
+  const glm::vec2 ab = envBrdfStraightOn();
+  return 0.04 * ab.x + ab.y;
+}
+
 TEST(ProbeInterest, SensitivityIsTheFootprintTimesTheGammaSlopeWorkedByHand) {
   // With one light in every probe, each probe's part of a sample is ŵ · L, so its change after
   // gamma is g′(L) · 0.2 · ŵ L = (0.2 / 2.2) L^(1/2.2) ŵ per channel: the sensitivity is
-  // 3 (0.2 / 2.2)² L^(2/2.2) times the footprint, for every probe.
+  // 3 (0.2 / 2.2)² L^(2/2.2) times the footprint, for every probe, with L = r (1 + F0 A + B).
   const scene::Scene s = whiteWall();
   const View v = straightOn();
-  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   ASSERT_EQ(seen.size(), 64u * 40u);
   const std::vector<float> footprint = probeViewFootprints(seen, kGrid.count());
   const SurfaceLighting lighting = surfaceLighting(s, {});
   for (float r : {0.25f, 4.0f}) {
     const std::vector<float> w = probeViewSensitivity(seen, lighting, uniformProbes(r), kGrid.count());
-    const double k = 3.0 * (0.2 / 2.2) * (0.2 / 2.2) * std::pow(r, 2.0 / 2.2);
+    const double k = 3.0 * (0.2 / 2.2) * (0.2 / 2.2) * std::pow(r * (1.0 + glossyOfDielectric()), 2.0 / 2.2);
     for (uint32_t p = 0; p < kGrid.count(); ++p) EXPECT_NEAR(w[p], k * footprint[p], 1e-4 * k * footprint[p] + 1e-12) << p;
   }
 }
 
 TEST(ProbeInterest, DirectLightMakesTheProbesCountLessAsGammaDoes) {
   // A directional light straight onto the white wall with irradiance π r adds r to every sample,
-  // so L doubles and each sensitivity falls by g′(2L)² / g′(L)² = 2^(2/2.2 − 2).
+  // L = r (1 + G) with G = F0 A + B the glossy part, so each sensitivity falls by
+  // g′(L + r)² / g′(L)² = ((2 + G) / (1 + G))^(2/2.2 − 2).
   scene::Scene s = whiteWall();
   const float r = 0.5f;
   s.lights.push_back({scene::LightType::Directional, {}, {0, 0, -1}, glm::vec3(1.0f), kPi * r});
   const View v = straightOn();
-  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   const std::vector<float> dark = probeViewSensitivity(seen, surfaceLighting(wall(), {}), uniformProbes(r), kGrid.count());
   scene::Scene unlit = s;
   unlit.lights.clear();
   const std::vector<float> without = probeViewSensitivity(seen, surfaceLighting(unlit, {}), uniformProbes(r), kGrid.count());
   const std::vector<float> with = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(r), kGrid.count());
-  const double ratio = std::pow(2.0, 2.0 / 2.2 - 2.0);
+  const double g = glossyOfDielectric();
+  const double ratio = std::pow((2.0 + g) / (1.0 + g), 2.0 / 2.2 - 2.0);
   for (uint32_t p = 0; p < kGrid.count(); ++p) {
     EXPECT_NEAR(with[p], ratio * without[p], 1e-4 * without[p] + 1e-12) << p;
-    // A scene without materials counts its surfaces as glTF's default 0.8 grey: ρ^(2/2.2) less.
-    EXPECT_NEAR(dark[p], std::pow(0.8, 2.0 / 2.2) * without[p], 1e-4 * without[p] + 1e-12) << p;
+    // A scene without materials counts its surfaces as glTF's default 0.8 grey.
+    EXPECT_NEAR(dark[p], std::pow((0.8 + g) / (1.0 + g), 2.0 / 2.2) * without[p], 1e-4 * without[p] + 1e-12) << p;
   }
   // A light from behind the wall lights nothing the view sees.
   s.lights[0].direction = {0, 0, 1};
@@ -174,15 +198,15 @@ TEST(ProbeInterest, DirectLightMakesTheProbesCountLessAsGammaDoes) {
 }
 
 TEST(ProbeInterest, ATextureCountsByItsMeanLinearColour) {
-  // Half the texels sRGB 255, half 0: a mean linear colour of 0.5, so L and each part halve and
-  // the sensitivity falls by 0.5^(2/2.2).
+  // Half the texels sRGB 255, half 0: a mean linear colour of 0.5, so L and each part go from
+  // r (1 + G) to r (0.5 + G) and the sensitivity falls by ((0.5 + G) / (1 + G))^(2/2.2).
   scene::Scene s = whiteWall();
   scene::Texture& t = s.textures.emplace_back();
   t.width = 2;
   t.height = 2;
   t.rgba = {255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255, 255};
   const View v = straightOn();
-  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   const std::vector<float> plain = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(1.0f), kGrid.count());
   s.materials[0].baseColorTexture = 0;
   const SurfaceLighting lighting = surfaceLighting(s, {});
@@ -190,13 +214,34 @@ TEST(ProbeInterest, ATextureCountsByItsMeanLinearColour) {
   EXPECT_NEAR(lighting.diffuse[0].x, 0.5f, 1e-6f);
   const std::vector<float> textured = probeViewSensitivity(seen, lighting, uniformProbes(1.0f), kGrid.count());
   for (uint32_t p = 0; p < kGrid.count(); ++p)
-    EXPECT_NEAR(textured[p], std::pow(0.5, 2.0 / 2.2) * plain[p], 1e-4 * plain[p] + 1e-12) << p;
+    EXPECT_NEAR(textured[p], std::pow((0.5 + glossyOfDielectric()) / (1.0 + glossyOfDielectric()), 2.0 / 2.2) * plain[p],
+                1e-4 * plain[p] + 1e-12)
+        << p;
+}
+
+TEST(ProbeInterest, AMetalTakesOnlyTheGlossyTerm) {
+  // White metal: no diffuse light and F0 = 1, so L = r (A + B) against r (1 + 0.04 A + B).
+  scene::Scene s = whiteWall();
+  const View v = straightOn();
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
+  // The eye is 20 m away: every n·v is past 31.5/32, where the table's last texel answers.
+  for (const ViewSample& x : seen) ASSERT_GT(glm::dot(x.toEye, x.normal), 31.5f / 32.0f);
+  const std::vector<float> dielectric = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(1.0f), kGrid.count());
+  s.materials[0].metallic = 1.0f;
+  const SurfaceLighting metal = surfaceLighting(s, {});
+  EXPECT_EQ(metal.diffuse[0], glm::vec3(0.0f));
+  EXPECT_EQ(metal.specular[0], glm::vec3(1.0f));
+  const std::vector<float> shiny = probeViewSensitivity(seen, metal, uniformProbes(1.0f), kGrid.count());
+  const glm::vec2 ab = envBrdfStraightOn();
+  const double ratio = std::pow((ab.x + ab.y) / (1.0 + glossyOfDielectric()), 2.0 / 2.2);
+  for (uint32_t p = 0; p < kGrid.count(); ++p)
+    EXPECT_NEAR(shiny[p], ratio * dielectric[p], 1e-4 * dielectric[p] + 1e-12) << p;
 }
 
 TEST(ProbeInterest, ABrighterProbeCountsForMoreAndABrokenOneForNothing) {
   const scene::Scene s = whiteWall();
   const View v = straightOn();
-  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   const SurfaceLighting lighting = surfaceLighting(s, {});
   const std::vector<float> even = probeViewSensitivity(seen, lighting, uniformProbes(1.0f), kGrid.count());
   std::vector<float> probes = uniformProbes(1.0f);
@@ -229,7 +274,7 @@ TEST(ProbeInterest, AClientAreaLightIsAddedAsTheViewersAddIt) {
   lamp.emission = glm::vec3(10.0f);
   scene::addQuad(s, {0.5f, 0.5f, 0.5f}, {0.5f, 1.5f, 0.5f}, {1.5f, 1.5f, 0.5f}, {1.5f, 0.5f, 0.5f}, 1);  // faces −z
   const View v = straightOn();
-  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, std::span<const View>(&v, 1));
+  const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   scene::AreaLightOptions on;
   on.enabled = true;
   const SurfaceLighting lit = surfaceLighting(s, on);

@@ -2,12 +2,14 @@
 #include "probecast/session/probe_interest.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
 #include "area_light_math.h"
 #include "probecast/codec/sh.h"
+#include "probecast/renderer/glossy_sh.h"
 
 namespace probecast::session {
 namespace {
@@ -73,11 +75,31 @@ size_t clipNear(const ClipVertex* in, size_t n, ClipVertex* out) {
 
 }  // namespace
 
+std::vector<View> spreadViews(std::span<const View> views, size_t most) {
+  const size_t n = std::min(views.size(), most);
+  std::vector<View> out;
+  for (size_t k = 0; k < n; ++k) out.push_back(views[k * views.size() / n]);
+  return out;
+}
+
+glm::uvec2 footprintSampleSize(size_t views) {
+  const double perView = static_cast<double>(kFootprintSamples) / static_cast<double>(std::max<size_t>(views, 1));
+  const double height = std::max(1.0, std::floor(std::sqrt(perView / 1.6)));
+  return {static_cast<uint32_t>(std::max(1.0, std::floor(height * 1.6))), static_cast<uint32_t>(height)};
+}
+
 std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const ProbeGrid& grid,
-                                           std::span<const uint8_t> active, std::span<const View> views,
-                                           uint32_t width, uint32_t height) {
+                                           std::span<const uint8_t> active, std::span<const float> offsets,
+                                           std::span<const View> views, uint32_t width, uint32_t height) {
   std::vector<ViewSample> samples;
   if (width == 0 || height == 0) return samples;
+  const uint32_t count = grid.count();
+  const bool moved = offsets.size() == static_cast<size_t>(count) * 3 &&
+                     std::all_of(offsets.begin(), offsets.end(), [](float x) { return std::isfinite(x); });
+  float spacing = 0.0f;  // the smallest probe spacing, as the raster client takes it
+  for (int a = 0; a < 3; ++a)
+    if (grid.dims[a] > 1) spacing = spacing > 0.0f ? std::min(spacing, probeCellSize(grid, a)) : probeCellSize(grid, a);
+  if (!(spacing > 0.0f)) spacing = 1.0f;
   const size_t pixels = static_cast<size_t>(width) * height;
   std::vector<float> depth(pixels);    // clip z/w of the nearest surface (+inf: none)
   std::vector<uint32_t> nearest(pixels);
@@ -153,6 +175,7 @@ std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const Prob
       float w[8];
       uint32_t index[8];
       float total = 0.0f;
+      bool anyInFront = false;
       for (int k = 0; k < 8; ++k) {
         const glm::ivec3 off(k & 1, (k >> 1) & 1, (k >> 2) & 1);
         const glm::vec3 t3 = glm::mix(glm::vec3(1.0f) - alpha, alpha, glm::vec3(off));
@@ -163,16 +186,21 @@ std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const Prob
         if (!(trilinear > 0.0f) || (!active.empty() && !active[index[k]])) continue;
         float at[3];
         grid.position(index[k], at);
-        const glm::vec3 toProbe = glm::vec3(at[0], at[1], at[2]) - point[i];
+        glm::vec3 probe(at[0], at[1], at[2]);
+        if (moved) probe += glm::vec3(offsets[index[k] * 3], offsets[index[k] * 3 + 1], offsets[index[k] * 3 + 2]);
+        const glm::vec3 toProbe = probe - point[i];
         const float d = glm::length(toProbe);
         const float facing = d > 1e-6f ? (glm::dot(toProbe / d, ng) + 1.0f) * 0.5f : 1.0f;
+        anyInFront = anyInFront || glm::dot(toProbe, ng) > -1e-3f * spacing;
         w[k] = (facing * facing + 0.2f) * trilinear;
         total += w[k];
       }
-      if (!(total > 0.0f)) continue;
+      // Every probe behind the surface's plane: the raster client lights the point with none.
+      if (!(total > 0.0f) || !anyInFront) continue;
       ViewSample& sample = samples.emplace_back();
       sample.point = point[i];
       sample.normal = ng;
+      sample.toEye = glm::normalize(eye - point[i]);
       sample.material = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : 0;
       for (int k = 0; k < 8; ++k) {
         sample.probes[k] = index[k];
@@ -194,7 +222,7 @@ std::vector<float> probeViewFootprints(std::span<const ViewSample> samples, uint
 std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
                                        std::span<const View> views, uint32_t width, uint32_t height) {
   if (views.empty()) return {};
-  return probeViewFootprints(sampleViewSurfaces(scene, grid, active, views, width, height), grid.count());
+  return probeViewFootprints(sampleViewSurfaces(scene, grid, active, {}, views, width, height), grid.count());
 }
 
 }  // namespace probecast::session
@@ -222,6 +250,21 @@ glm::vec3 meanLinear(const scene::Texture& t) {
   return n ? glm::vec3(sum / static_cast<double>(n)) : glm::vec3(1.0f);
 }
 
+// As the raster client's table (raster_client.cpp), sampled with bilinear filtering.
+constexpr int kEnvBrdfSize = 32;
+
+glm::vec2 envBrdfAt(const SurfaceLighting& l, float nv, float roughness) {
+  const int n = l.envBrdfSize;
+  if (n <= 0 || l.envBrdf.size() < static_cast<size_t>(n) * n * 2) return glm::vec2(0.0f);
+  const float x = std::clamp(nv * static_cast<float>(n) - 0.5f, 0.0f, static_cast<float>(n - 1));
+  const float y = std::clamp(roughness * static_cast<float>(n) - 0.5f, 0.0f, static_cast<float>(n - 1));
+  const int x0 = std::min(static_cast<int>(x), n - 1), y0 = std::min(static_cast<int>(y), n - 1);
+  const int x1 = std::min(x0 + 1, n - 1), y1 = std::min(y0 + 1, n - 1);
+  const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+  const auto at = [&](int i, int j) { return glm::vec2(l.envBrdf[(j * n + i) * 2], l.envBrdf[(j * n + i) * 2 + 1]); };
+  return glm::mix(glm::mix(at(x0, y0), at(x1, y0), fx), glm::mix(at(x0, y1), at(x1, y1), fx), fy);
+}
+
 }  // namespace
 
 SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLightOptions& areaLights) {
@@ -231,10 +274,18 @@ SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLigh
   const auto texture = [&](int32_t index) {
     return index >= 0 && static_cast<size_t>(index) < textureMean.size() ? textureMean[index] : glm::vec3(1.0f);
   };
+  const renderer::GgxLobeFit fit = renderer::ggxLobeFit();
   for (const scene::Material& m : scene.materials) {
-    out.diffuse.push_back(m.baseColor * (1.0f - m.metallic) * texture(m.baseColorTexture));
+    const glm::vec3 base = m.baseColor * texture(m.baseColorTexture);
+    out.diffuse.push_back(base * (1.0f - m.metallic));
+    out.specular.push_back(glm::mix(glm::vec3(0.04f), base, m.metallic));
+    const std::array<double, 3> g = fit.evaluate(m.roughness);
+    out.lobe.emplace_back(static_cast<float>(g[1]), static_cast<float>(g[2]));
+    out.roughness.push_back(m.roughness);
     out.emission.push_back(m.emission * texture(m.emissiveTexture));
   }
+  out.envBrdfSize = kEnvBrdfSize;
+  out.envBrdf = renderer::envBrdfTable(kEnvBrdfSize, 256);
   out.lights = scene.lights;
   out.areaLights = scene::extractAreaLights(scene, areaLights);
   return out;
@@ -245,9 +296,17 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, con
   std::vector<float> sensitivity(probeCount, 0.0f);
   const size_t usable = std::min<size_t>(probeCount, probes.size() / kProbeFloats);
   for (const ViewSample& s : samples) {
-    const bool known = s.material < lighting.diffuse.size();
+    const bool known = s.material < lighting.diffuse.size() && s.material < lighting.specular.size() &&
+                       s.material < lighting.lobe.size() && s.material < lighting.roughness.size() &&
+                       s.material < lighting.emission.size();
     const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);  // glTF's default base colour
-    glm::vec3 radiance = known && s.material < lighting.emission.size() ? lighting.emission[s.material] : glm::vec3(0.0f);
+    glm::vec3 radiance = known ? lighting.emission[s.material] : glm::vec3(0.0f);
+    const float roughness = known ? lighting.roughness[s.material] : 1.0f;
+    const glm::vec2 lobe = known ? lighting.lobe[s.material] : glm::vec2(0.0f);
+    const float nv = std::clamp(glm::dot(s.normal, s.toEye), 0.0f, 1.0f);
+    const glm::vec2 ab = envBrdfAt(lighting, nv, roughness);
+    const glm::vec3 glossyScale = (known ? lighting.specular[s.material] : glm::vec3(0.04f)) * ab.x + ab.y;
+    const glm::vec3 r = glm::reflect(-s.toEye, s.normal);
     // Direct light, without shadows: the Lambertian part of the raster client's sum.
     for (const scene::Light& l : lighting.lights) {
       glm::vec3 e = l.color * l.intensity;
@@ -281,9 +340,17 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, con
       if (!(s.weights[k] > 0.0f) || s.probes[k] >= usable) continue;
       const float* c = probes.data() + static_cast<size_t>(s.probes[k]) * kProbeFloats;
       if (!std::all_of(c, c + kProbeFloats, [](float x) { return std::isfinite(x); })) continue;
-      float e[3];
+      float e[3], basis[kShCoeffs];
       shEvalIrradiance(c, s.normal.x, s.normal.y, s.normal.z, e);
-      part[k] = s.weights[k] * rho / kPi * glm::max(glm::vec3(e[0], e[1], e[2]), glm::vec3(0.0f));
+      // Prefiltered radiance toward r: band l scaled by the lobe's g_l (g_0 = 1).
+      shEvalBasis(r.x, r.y, r.z, basis);
+      glm::vec3 prefiltered(0.0f);
+      for (int i = 0; i < kShCoeffs; ++i) {
+        const float g = shBand(i) == 0 ? 1.0f : shBand(i) == 1 ? lobe.x : lobe.y;
+        prefiltered += g * basis[i] * glm::vec3(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
+      }
+      part[k] = s.weights[k] * (rho / kPi * glm::max(glm::vec3(e[0], e[1], e[2]), glm::vec3(0.0f)) +
+                                glm::max(prefiltered, glm::vec3(0.0f)) * glossyScale);
       radiance += part[k];
     }
     // g′(L) = L^(1/2.2 − 1) / 2.2; each part is at most L, so g′ · part stays finite as L → 0.

@@ -135,13 +135,10 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
   };
   if (views.empty()) return {};
   if (footprintsStale_ || !same(views, footprintViews_)) {
-    // At most kFootprintViews of them, evenly spread over the list (each costs a pass over the
-    // triangles): the others' probes are mostly the same ones.
-    constexpr size_t kFootprintViews = 16;
-    std::vector<View> sample;
-    for (size_t k = 0; k < std::min(views.size(), kFootprintViews); ++k)
-      sample.push_back(views[k * views.size() / std::min(views.size(), kFootprintViews)]);
-    viewSurfaces_ = sampleViewSurfaces(geometry_, updater_->grid(), updater_->volume().active, sample);
+    const std::vector<View> sampled = spreadViews(views, kFootprintViews);
+    const glm::uvec2 size = footprintSampleSize(sampled.size());
+    viewSurfaces_ = sampleViewSurfaces(geometry_, updater_->grid(), updater_->volume().active,
+                                       updater_->volume().offsets, sampled, size.x, size.y);
     footprintViews_ = views;
     footprintsStale_ = false;
   }

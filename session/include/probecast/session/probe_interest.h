@@ -22,22 +22,36 @@ namespace probecast::session {
 // A view with non-finite numbers sees nothing.
 std::vector<float> probeViewWeights(const ProbeGrid& grid, const std::vector<float>& offsets, std::span<const View> views);
 
+// At most `most` of `views`, evenly spread over the list. The producer samples kFootprintViews of
+// its subscribers' views: each costs a pass over the triangles, and neighbouring views show mostly
+// the same probes.
+std::vector<View> spreadViews(std::span<const View> views, size_t most);
+constexpr size_t kFootprintViews = 16;
+// The sample grid per view (16:10) for `views` views that keeps their samples together near
+// kFootprintSamples: 256 × 160 for one view, 64 × 40 for sixteen. Walls seen at a grazing angle
+// and thin ledges cover few pixels; too coarse a grid misses the probes that light them.
+constexpr uint32_t kFootprintSamples = 40960;
+glm::uvec2 footprintSampleSize(size_t views);
+
 // The surfaces views show: one sample per pixel centre that some triangle covers, found by a
 // depth-buffered rasterisation of the scene's triangles on the CPU (Vulkan clip space, as View
 // holds it: clipped at the near plane z = 0, nothing past the far one), with the probes that light
 // it as the raster client weighs them without visibility: the eight probes of its grid cell,
-// trilinear × backface ((cos + 1)/2)² + 0.2, the inactive ones left out, normalised to sum 1.
-// A view with non-finite numbers sees nothing.
+// trilinear × backface ((cos + 1)/2)² + 0.2 (towards each probe where it was traced: its grid
+// position plus `offsets`, xyz per probe, when they are given and finite), the inactive ones left
+// out, normalised to sum 1. A point whose probes all lie behind its surface's plane is left out,
+// as the client lights it with none of them. A view with non-finite numbers sees nothing.
 struct ViewSample {
   glm::vec3 point{0.0f};
   glm::vec3 normal{0.0f, 1.0f, 0.0f};  // the triangle's geometric normal, on the viewer's side
+  glm::vec3 toEye{0.0f, 1.0f, 0.0f};   // unit direction to the view's eye
   uint32_t material = 0;               // Scene::triangleMaterial of the triangle (0 when the scene has none)
   uint32_t probes[8] = {};
   float weights[8] = {};               // sum 1 (a sample no active probe lights is left out)
 };
 std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const ProbeGrid& grid,
-                                           std::span<const uint8_t> active, std::span<const View> views,
-                                           uint32_t width = 64, uint32_t height = 40);
+                                           std::span<const uint8_t> active, std::span<const float> offsets,
+                                           std::span<const View> views, uint32_t width = 64, uint32_t height = 40);
 
 // Per probe (grid order): how much of the views' pixels it lights, Σ over the samples of its
 // normalised weight squared (what an error in that probe adds to the views' squared error, per
@@ -47,24 +61,32 @@ std::vector<float> probeViewFootprints(std::span<const ViewSample> samples, uint
 std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGrid& grid, std::span<const uint8_t> active,
                                        std::span<const View> views, uint32_t width = 64, uint32_t height = 40);
 
-// What a viewer adds to the probes' light at a surface, for probeViewSensitivity.
+// What a viewer adds to the probes' light at a surface, and how it turns probes into light there,
+// for probeViewSensitivity.
 struct SurfaceLighting {
   std::vector<glm::vec3> diffuse;   // per material: base colour × (1 − metallic) × its texture's mean (linear)
+  std::vector<glm::vec3> specular;  // per material: F0 = mix(0.04, base colour × texture mean, metallic)
+  std::vector<glm::vec2> lobe;      // per material: the GGX lobe's band 1 and 2 scales at its roughness (glossy_sh.h)
+  std::vector<float> roughness;     // per material
   std::vector<glm::vec3> emission;  // per material: emission × its texture's mean
   std::vector<scene::Light> lights; // punctual, lit without shadows
   scene::AreaLightSet areaLights;   // client area lights, lit without shadows (empty: none)
+  std::vector<float> envBrdf;       // (A, B) over [roughness][n·v], envBrdfSize² texel centres (glossy_sh.h)
+  int envBrdfSize = 0;
 };
 // Textures are averaged on a grid of at most 64 × 64 texels.
 SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLightOptions& areaLights);
 
 // Per probe (grid order): how much the views change, after the plain gamma 2.2 that images are
 // scored in, when that probe alone is made 20 % brighter: Σ over the samples and RGB of
-// (g′(L) · 0.2 · ŵ · ρ/π · E_p(n))², with g(L) = L^(1/2.2), ŵ the probe's weight at the sample, ρ
-// the diffuse colour, E_p(n) the probe's irradiance (clamped at 0) and L the sample's radiance as
-// a viewer shades it: emission + unshadowed direct light + ρ/π · Σ ŵ E(n) (glossy light left out).
-// A dim surface counts for more than a bright one, as gamma makes it; a probe's own brightness
-// counts squared. `probes`: kProbeFloats per probe, the light viewers hold. Non-finite
-// coefficients count as 0.
+// (g′(L) · 0.2 · ŵ · I_p)², with g(L) = L^(1/2.2), ŵ the probe's weight at the sample, I_p the
+// light the raster client takes from the probe there (diffuse ρ/π · E_p(n) plus the split-sum
+// glossy term toward the reflected view direction, each clamped at 0) and L the sample's radiance
+// as the client shades it: emission + direct light without shadows (punctual and client area
+// lights, Lambertian) + Σ ŵ I. A dim surface counts for more than a bright one, as gamma makes it;
+// a probe's own brightness counts squared. `probes`: kProbeFloats per probe, the light viewers
+// hold. Non-finite coefficients count as 0; a material past the lists counts as glTF's default
+// (0.8 grey, rough, not metallic).
 std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, const SurfaceLighting& lighting,
                                         std::span<const float> probes, uint32_t probeCount);
 
