@@ -372,7 +372,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
         session::sampleViewSurfaces(sceneNow, grid, lit, {}, serverViews, sampleSize.x, sampleSize.y);
     const std::pair<const char*, std::vector<float>> estimates[] = {
         {"surface", session::probeViewFootprints(seen, count)},
-        {"lit", session::probeViewSensitivity(seen, firstLighting, v.probes, count)}};
+        {"lit", session::probeViewSensitivity(seen, session::sampleDirectLight(sceneNow, seen, firstLighting),
+                                              firstLighting, v.probes, count)}};
     for (const auto& [name, w] : estimates)
       footprintMatch[name] = {{"pearson", pearson(w, footprint, 1.0)}, {"pearson_cube_roots", pearson(w, footprint, 1.0 / 3.0)}};
   }
@@ -462,6 +463,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       if (o.viewWeights == "surface") streams[2].viewWeights = session::probeViewFootprints(seenSurfaces, count);
     }
     session::SurfaceLighting lighting = firstLighting;  // its lights follow the scene
+    std::vector<glm::vec3> direct;                      // sampleDirectLight, again when the lights move
+    if (!seenSurfaces.empty()) direct = session::sampleDirectLight(first, seenSurfaces, lighting);
     for (float exponent : o.oracleExponents)
       for (float ratio : o.oracleErrorRatios) {
         Stream& s = streams.emplace_back();
@@ -492,12 +495,15 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) {
         const scene::Scene now = sceneAt(tAt(f));
         u.setScene(now);
-        lighting.lights = now.lights;
+        if (!seenSurfaces.empty() && now.lights != lighting.lights) {
+          lighting.lights = now.lights;
+          direct = session::sampleDirectLight(now, seenSurfaces, lighting);
+        }
       }
       restarts.push_back(u.update().restartedProbes);
       const ProbeVolume& v = u.volume();
       if (o.viewWeights == "lit" && !streams[2].encoder->setViewWeights(
-                                        session::probeViewSensitivity(seenSurfaces, lighting, v.probes, count)))
+                                        session::probeViewSensitivity(seenSurfaces, direct, lighting, v.probes, count)))
         streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
       changes.push_back(previous.empty() ? 0.0 : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), count));
       previous = v.probes;

@@ -184,20 +184,24 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
     {
       const std::vector<View> seen = session::spreadViews(session::priorityViews(views), session::kFootprintViews);
       const glm::uvec2 size = session::footprintSampleSize(seen.size());
-      std::vector<double> surfacesMs, weightsMs;
+      std::vector<double> surfacesMs, directMs, weightsMs;
       std::vector<session::ViewSample> samples;
+      const auto since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
       for (uint32_t k = 0; k < o.repeats; ++k) {
-        auto t0 = std::chrono::steady_clock::now();
+        auto t0 = Clock::now();
         samples = session::sampleViewSurfaces(o.scene, o.grid, volume.active, volume.offsets, seen, size.x, size.y);
-        auto t1 = std::chrono::steady_clock::now();
-        const std::vector<float> w = session::probeViewSensitivity(samples, lighting, volume.probes, o.grid.count());
-        auto t2 = std::chrono::steady_clock::now();
-        surfacesMs.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-        weightsMs.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+        surfacesMs.push_back(since(t0));
+        t0 = Clock::now();
+        const std::vector<glm::vec3> direct = session::sampleDirectLight(o.scene, samples, lighting);
+        directMs.push_back(since(t0));
+        t0 = Clock::now();
+        const std::vector<float> w = session::probeViewSensitivity(samples, direct, lighting, volume.probes, o.grid.count());
+        weightsMs.push_back(since(t0));
       }
       row["producer_view_weights"] = {{"views_sampled", seen.size()},
                                       {"samples", samples.size()},
                                       {"surfaces_ms_median", session::medianMidpoint(surfacesMs)},
+                                      {"direct_light_ms_median", session::medianMidpoint(directMs)},
                                       {"weights_ms_median", session::medianMidpoint(weightsMs)}};
     }
     json["view_sets"].push_back(row);
@@ -205,10 +209,12 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
     say(fmt::format("raster bench: {} done", name));
   }
   table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
-  table += "producer view weights on the CPU (up to 16 views): surfaces ms (when views change), weights ms (every update)\n";
+  table += "producer view weights on the CPU (up to 16 views), ms: surfaces (when the views change), direct light "
+           "(when the lights move), weights (every update)\n";
   for (const nlohmann::json& row : json["view_sets"])
-    table += fmt::format("  {:<8} {:>8.2f} {:>8.2f}\n", row["views"].get<std::string>(),
+    table += fmt::format("  {:<8} {:>8.2f} {:>8.2f} {:>8.2f}\n", row["views"].get<std::string>(),
                          row["producer_view_weights"]["surfaces_ms_median"].get<double>(),
+                         row["producer_view_weights"]["direct_light_ms_median"].get<double>(),
                          row["producer_view_weights"]["weights_ms_median"].get<double>());
   table += fmt::format("shadow maps: punctual {:.2f} ms, {} client area lights {:.2f} ms (drawn once per plan)\n",
                        raster.timings().shadowMs, raster.areaLights().lights.size(), raster.timings().areaShadowMs);

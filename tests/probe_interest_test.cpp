@@ -135,6 +135,12 @@ std::vector<float> uniformProbes(float r) {
   return probes;
 }
 
+// probeViewSensitivity with the direct light of the scene's own lights (sampleDirectLight).
+std::vector<float> sensitivity(const scene::Scene& s, const std::vector<ViewSample>& seen, const SurfaceLighting& lighting,
+                               const std::vector<float>& probes) {
+  return probeViewSensitivity(seen, sampleDirectLight(s, seen, lighting), lighting, probes, kGrid.count());
+}
+
 scene::Scene whiteWall() {
   scene::Scene s = wall();
   s.materials.emplace_back().baseColor = glm::vec3(1.0f);
@@ -165,7 +171,7 @@ TEST(ProbeInterest, SensitivityIsTheFootprintTimesTheGammaSlopeWorkedByHand) {
   const std::vector<float> footprint = probeViewFootprints(seen, kGrid.count());
   const SurfaceLighting lighting = surfaceLighting(s, {});
   for (float r : {0.25f, 4.0f}) {
-    const std::vector<float> w = probeViewSensitivity(seen, lighting, uniformProbes(r), kGrid.count());
+    const std::vector<float> w = sensitivity(s, seen, lighting, uniformProbes(r));
     const double k = 3.0 * (0.2 / 2.2) * (0.2 / 2.2) * std::pow(r * (1.0 + glossyOfDielectric()), 2.0 / 2.2);
     for (uint32_t p = 0; p < kGrid.count(); ++p) EXPECT_NEAR(w[p], k * footprint[p], 1e-4 * k * footprint[p] + 1e-12) << p;
   }
@@ -180,11 +186,11 @@ TEST(ProbeInterest, DirectLightMakesTheProbesCountLessAsGammaDoes) {
   s.lights.push_back({scene::LightType::Directional, {}, {0, 0, -1}, glm::vec3(1.0f), kPi * r});
   const View v = straightOn();
   const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
-  const std::vector<float> dark = probeViewSensitivity(seen, surfaceLighting(wall(), {}), uniformProbes(r), kGrid.count());
+  const std::vector<float> dark = sensitivity(s, seen, surfaceLighting(wall(), {}), uniformProbes(r));
   scene::Scene unlit = s;
   unlit.lights.clear();
-  const std::vector<float> without = probeViewSensitivity(seen, surfaceLighting(unlit, {}), uniformProbes(r), kGrid.count());
-  const std::vector<float> with = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(r), kGrid.count());
+  const std::vector<float> without = sensitivity(s, seen, surfaceLighting(unlit, {}), uniformProbes(r));
+  const std::vector<float> with = sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(r));
   const double g = glossyOfDielectric();
   const double ratio = std::pow((2.0 + g) / (1.0 + g), 2.0 / 2.2 - 2.0);
   for (uint32_t p = 0; p < kGrid.count(); ++p) {
@@ -194,7 +200,64 @@ TEST(ProbeInterest, DirectLightMakesTheProbesCountLessAsGammaDoes) {
   }
   // A light from behind the wall lights nothing the view sees.
   s.lights[0].direction = {0, 0, 1};
-  EXPECT_EQ(probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(r), kGrid.count()), without);
+  EXPECT_EQ(sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(r)), without);
+}
+
+TEST(ProbeInterest, ThePunctualLightsCastShadows) {
+  const View v = straightOn();
+  // A directional light from +x, +z at 45°: the white wall gets E cos 45° = 0.7071 × π r, so
+  // ρ/π E = 0.7071 r where it is lit. A panel in the plane x = 2.7 (outside the view), z in [0, 1.7],
+  // shades every point of the wall with x > 1 (its ray to the light crosses x = 2.7 at z = 2.7 − x).
+  {
+    scene::Scene s = whiteWall();
+    const float r = 2.0f;
+    s.lights.push_back({scene::LightType::Directional, {}, glm::normalize(glm::vec3(-1, 0, -1)), glm::vec3(1.0f), kPi * r});
+    scene::addQuad(s, {2.7f, -1.0f, 0.0f}, {2.7f, -1.0f, 1.7f}, {2.7f, 3.0f, 1.7f}, {2.7f, 3.0f, 0.0f}, 0);
+    const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
+    const std::vector<glm::vec3> direct = sampleDirectLight(s, seen, surfaceLighting(s, {}));
+    ASSERT_EQ(direct.size(), seen.size());
+    int lit = 0, shaded = 0;
+    for (size_t i = 0; i < seen.size(); ++i) {
+      if (seen[i].point.x < 0.9f) {
+        EXPECT_NEAR(direct[i].x, 0.7071f * r, 1e-3f) << seen[i].point.x;
+        ++lit;
+      }
+      if (seen[i].point.x > 1.1f) {
+        EXPECT_EQ(direct[i].x, 0.0f) << seen[i].point.x;
+        ++shaded;
+      }
+    }
+    EXPECT_GT(lit, 500);
+    EXPECT_GT(shaded, 500);
+  }
+  // A point light at (1, 1, 2) and a square at z = 1.5 over x, y in [0.8, 1.2]: its shadow on the
+  // wall spans x, y in [0.2, 1.8] (4× from the light); outside it the wall gets I cos θ / d².
+  {
+    scene::Scene s = whiteWall();
+    const glm::vec3 at(1.0f, 1.0f, 2.0f);
+    s.lights.push_back({scene::LightType::Point, at, {}, glm::vec3(1.0f), 5.0f});
+    scene::addQuad(s, {0.8f, 0.8f, 1.5f}, {1.2f, 0.8f, 1.5f}, {1.2f, 1.2f, 1.5f}, {0.8f, 1.2f, 1.5f}, 0);
+    const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
+    const std::vector<glm::vec3> direct = sampleDirectLight(s, seen, surfaceLighting(s, {}));
+    int lit = 0, shaded = 0;
+    for (size_t i = 0; i < seen.size(); ++i) {
+      const glm::vec3 p = seen[i].point;
+      if (p.z > 0.1f) continue;  // the square itself
+      const float reach = std::max(std::fabs(p.x - 1.0f), std::fabs(p.y - 1.0f));
+      if (reach < 0.7f) {
+        EXPECT_EQ(direct[i].x, 0.0f) << p.x << " " << p.y;
+        ++shaded;
+      }
+      if (reach > 0.9f) {
+        const glm::vec3 d = at - p;
+        const float expected = 5.0f * d.z / std::pow(glm::length(d), 3.0f) / kPi;  // ρ/π · I cos θ / d²
+        EXPECT_NEAR(direct[i].x, expected, 1e-3f * expected) << p.x << " " << p.y;
+        ++lit;
+      }
+    }
+    EXPECT_GT(lit, 200);
+    EXPECT_GT(shaded, 200);
+  }
 }
 
 TEST(ProbeInterest, ATextureCountsByItsMeanLinearColour) {
@@ -207,12 +270,12 @@ TEST(ProbeInterest, ATextureCountsByItsMeanLinearColour) {
   t.rgba = {255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255, 255};
   const View v = straightOn();
   const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
-  const std::vector<float> plain = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(1.0f), kGrid.count());
+  const std::vector<float> plain = sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(1.0f));
   s.materials[0].baseColorTexture = 0;
   const SurfaceLighting lighting = surfaceLighting(s, {});
   ASSERT_EQ(lighting.diffuse.size(), 1u);
   EXPECT_NEAR(lighting.diffuse[0].x, 0.5f, 1e-6f);
-  const std::vector<float> textured = probeViewSensitivity(seen, lighting, uniformProbes(1.0f), kGrid.count());
+  const std::vector<float> textured = sensitivity(s, seen, lighting, uniformProbes(1.0f));
   for (uint32_t p = 0; p < kGrid.count(); ++p)
     EXPECT_NEAR(textured[p], std::pow((0.5 + glossyOfDielectric()) / (1.0 + glossyOfDielectric()), 2.0 / 2.2) * plain[p],
                 1e-4 * plain[p] + 1e-12)
@@ -226,12 +289,12 @@ TEST(ProbeInterest, AMetalTakesOnlyTheGlossyTerm) {
   const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   // The eye is 20 m away: every n·v is past 31.5/32, where the table's last texel answers.
   for (const ViewSample& x : seen) ASSERT_GT(glm::dot(x.toEye, x.normal), 31.5f / 32.0f);
-  const std::vector<float> dielectric = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(1.0f), kGrid.count());
+  const std::vector<float> dielectric = sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(1.0f));
   s.materials[0].metallic = 1.0f;
   const SurfaceLighting metal = surfaceLighting(s, {});
   EXPECT_EQ(metal.diffuse[0], glm::vec3(0.0f));
   EXPECT_EQ(metal.specular[0], glm::vec3(1.0f));
-  const std::vector<float> shiny = probeViewSensitivity(seen, metal, uniformProbes(1.0f), kGrid.count());
+  const std::vector<float> shiny = sensitivity(s, seen, metal, uniformProbes(1.0f));
   const glm::vec2 ab = envBrdfStraightOn();
   const double ratio = std::pow((ab.x + ab.y) / (1.0 + glossyOfDielectric()), 2.0 / 2.2);
   for (uint32_t p = 0; p < kGrid.count(); ++p)
@@ -243,23 +306,23 @@ TEST(ProbeInterest, ABrighterProbeCountsForMoreAndABrokenOneForNothing) {
   const View v = straightOn();
   const std::vector<ViewSample> seen = sampleViewSurfaces(s, kGrid, {}, {}, std::span<const View>(&v, 1));
   const SurfaceLighting lighting = surfaceLighting(s, {});
-  const std::vector<float> even = probeViewSensitivity(seen, lighting, uniformProbes(1.0f), kGrid.count());
+  const std::vector<float> even = sensitivity(s, seen, lighting, uniformProbes(1.0f));
   std::vector<float> probes = uniformProbes(1.0f);
   for (int c = 0; c < 3; ++c) probes[static_cast<size_t>(at(1, 1, 0)) * kProbeFloats + c] *= 4.0f;
-  const std::vector<float> bright = probeViewSensitivity(seen, lighting, probes, kGrid.count());
+  const std::vector<float> bright = sensitivity(s, seen, lighting, probes);
   EXPECT_GT(bright[at(1, 1, 0)], 4.0f * even[at(1, 1, 0)]);  // (4/L)² with L up by less than 4×
   EXPECT_LT(bright[at(0, 0, 0)], even[at(0, 0, 0)]);         // its neighbours' pixels got brighter
   // A NaN or infinite coefficient makes that probe count as black, and nothing else non-finite.
   probes[static_cast<size_t>(at(1, 1, 0)) * kProbeFloats + 13] = NAN;
   probes[static_cast<size_t>(at(2, 2, 0)) * kProbeFloats + 0] = INFINITY;
-  const std::vector<float> broken = probeViewSensitivity(seen, lighting, probes, kGrid.count());
+  const std::vector<float> broken = sensitivity(s, seen, lighting, probes);
   EXPECT_EQ(broken[at(1, 1, 0)], 0.0f);
   EXPECT_EQ(broken[at(2, 2, 0)], 0.0f);
   for (float x : broken) EXPECT_TRUE(std::isfinite(x));
   EXPECT_GT(broken[at(0, 0, 0)], 0.0f);
   // Too few coefficients for the grid: the probes past them count as black.
   probes.resize(kProbeFloats);
-  const std::vector<float> short_ = probeViewSensitivity(seen, lighting, probes, kGrid.count());
+  const std::vector<float> short_ = sensitivity(s, seen, lighting, probes);
   ASSERT_EQ(short_.size(), kGrid.count());
   EXPECT_GT(short_[0], 0.0f);
   for (uint32_t p = 1; p < kGrid.count(); ++p) EXPECT_EQ(short_[p], 0.0f);
@@ -279,8 +342,8 @@ TEST(ProbeInterest, AClientAreaLightIsAddedAsTheViewersAddIt) {
   on.enabled = true;
   const SurfaceLighting lit = surfaceLighting(s, on);
   ASSERT_EQ(lit.areaLights.lights.size(), 1u);
-  const std::vector<float> without = probeViewSensitivity(seen, surfaceLighting(s, {}), uniformProbes(0.1f), kGrid.count());
-  const std::vector<float> with = probeViewSensitivity(seen, lit, uniformProbes(0.1f), kGrid.count());
+  const std::vector<float> without = sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(0.1f));
+  const std::vector<float> with = sensitivity(s, seen, lit, uniformProbes(0.1f));
   for (uint32_t y = 0; y < 3; ++y)
     for (uint32_t x = 0; x < 3; ++x) EXPECT_LT(with[at(x, y, 0)], without[at(x, y, 0)]) << x << " " << y;
 }

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "area_light_math.h"
 #include "probecast/codec/sh.h"
@@ -73,6 +75,62 @@ size_t clipNear(const ClipVertex* in, size_t n, ClipVertex* out) {
   return m;
 }
 
+// The nearest surface at each pixel centre of a width × height view (Vulkan clip space: clipped at
+// the near plane z = 0, nothing past the far one): its clip z/w in `depth` (+inf: none), its
+// triangle and its world point. Every triangle counts as opaque.
+void rasterizeNearest(const scene::Scene& scene, const glm::mat4& viewProj, uint32_t width, uint32_t height,
+                      std::vector<float>& depth, std::vector<uint32_t>& nearest, std::vector<glm::vec3>& point) {
+  const size_t pixels = static_cast<size_t>(width) * height;
+  depth.assign(pixels, INFINITY);
+  nearest.resize(pixels);
+  point.resize(pixels);
+  const uint32_t triangles = scene.triangleCount();
+  for (uint32_t t = 0; t < triangles; ++t) {
+    ClipVertex tri[3], poly[4];
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& p = scene.positions[scene.indices[3 * t + k]];
+      tri[k] = {viewProj * glm::vec4(p, 1.0f), p};
+    }
+    const size_t n = clipNear(tri, 3, poly);
+    for (size_t f = 1; f + 1 < n; ++f) {  // the clipped polygon as a fan
+      const ClipVertex* c[3] = {&poly[0], &poly[f], &poly[f + 1]};
+      if (!(c[0]->clip.w > 0.0f && c[1]->clip.w > 0.0f && c[2]->clip.w > 0.0f)) continue;  // not a projection
+      glm::vec2 s[3];
+      float invW[3], z[3];
+      for (int k = 0; k < 3; ++k) {
+        invW[k] = 1.0f / c[k]->clip.w;
+        z[k] = c[k]->clip.z * invW[k];
+        s[k] = {(c[k]->clip.x * invW[k] * 0.5f + 0.5f) * static_cast<float>(width),
+                (c[k]->clip.y * invW[k] * 0.5f + 0.5f) * static_cast<float>(height)};
+      }
+      const float area = (s[1].x - s[0].x) * (s[2].y - s[0].y) - (s[2].x - s[0].x) * (s[1].y - s[0].y);
+      if (!(std::fabs(area) > 0.0f) || !std::isfinite(area)) continue;
+      const float x0 = std::max(0.0f, std::floor(std::min({s[0].x, s[1].x, s[2].x})));
+      const float x1 = std::min(static_cast<float>(width) - 1.0f, std::ceil(std::max({s[0].x, s[1].x, s[2].x})));
+      const float y0 = std::max(0.0f, std::floor(std::min({s[0].y, s[1].y, s[2].y})));
+      const float y1 = std::min(static_cast<float>(height) - 1.0f, std::ceil(std::max({s[0].y, s[1].y, s[2].y})));
+      for (float y = y0; y <= y1; y += 1.0f)
+        for (float x = x0; x <= x1; x += 1.0f) {
+          const glm::vec2 q(x + 0.5f, y + 0.5f);
+          float b[3];
+          for (int k = 0; k < 3; ++k) {
+            const glm::vec2& e0 = s[(k + 1) % 3];
+            const glm::vec2& e1 = s[(k + 2) % 3];
+            b[k] = ((e1.x - e0.x) * (q.y - e0.y) - (q.x - e0.x) * (e1.y - e0.y)) / area;
+          }
+          if (b[0] < 0.0f || b[1] < 0.0f || b[2] < 0.0f) continue;
+          const float zw = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];  // z/w and 1/w are linear on the screen
+          const size_t i = static_cast<size_t>(y) * width + static_cast<size_t>(x);
+          if (!(zw < depth[i]) || zw > 1.0f) continue;  // hidden, or past the far plane
+          const float inv = b[0] * invW[0] + b[1] * invW[1] + b[2] * invW[2];
+          depth[i] = zw;
+          nearest[i] = t;
+          point[i] = (b[0] * invW[0] * c[0]->world + b[1] * invW[1] * c[1]->world + b[2] * invW[2] * c[2]->world) / inv;
+        }
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<View> spreadViews(std::span<const View> views, size_t most) {
@@ -101,10 +159,9 @@ std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const Prob
     if (grid.dims[a] > 1) spacing = spacing > 0.0f ? std::min(spacing, probeCellSize(grid, a)) : probeCellSize(grid, a);
   if (!(spacing > 0.0f)) spacing = 1.0f;
   const size_t pixels = static_cast<size_t>(width) * height;
-  std::vector<float> depth(pixels);    // clip z/w of the nearest surface (+inf: none)
-  std::vector<uint32_t> nearest(pixels);
-  std::vector<glm::vec3> point(pixels);
-  const uint32_t triangles = scene.triangleCount();
+  std::vector<float> depth;  // clip z/w of the nearest surface (+inf: none)
+  std::vector<uint32_t> nearest;
+  std::vector<glm::vec3> point;
   const glm::vec3 lo(grid.bounds.min[0], grid.bounds.min[1], grid.bounds.min[2]);
   const glm::vec3 hi(grid.bounds.max[0], grid.bounds.max[1], grid.bounds.max[2]);
   const glm::ivec3 dims(static_cast<int>(grid.dims[0]), static_cast<int>(grid.dims[1]), static_cast<int>(grid.dims[2]));
@@ -113,51 +170,7 @@ std::vector<ViewSample> sampleViewSurfaces(const scene::Scene& scene, const Prob
     glm::mat4 viewProj;
     std::copy(std::begin(v.viewProj), std::end(v.viewProj), &viewProj[0][0]);
     const glm::vec3 eye(v.eye[0], v.eye[1], v.eye[2]);
-    std::fill(depth.begin(), depth.end(), INFINITY);
-    for (uint32_t t = 0; t < triangles; ++t) {
-      ClipVertex tri[3], poly[4];
-      for (int k = 0; k < 3; ++k) {
-        const glm::vec3& p = scene.positions[scene.indices[3 * t + k]];
-        tri[k] = {viewProj * glm::vec4(p, 1.0f), p};
-      }
-      const size_t n = clipNear(tri, 3, poly);
-      for (size_t f = 1; f + 1 < n; ++f) {  // the clipped polygon as a fan
-        const ClipVertex* c[3] = {&poly[0], &poly[f], &poly[f + 1]};
-        if (!(c[0]->clip.w > 0.0f && c[1]->clip.w > 0.0f && c[2]->clip.w > 0.0f)) continue;  // not a projection
-        glm::vec2 s[3];
-        float invW[3], z[3];
-        for (int k = 0; k < 3; ++k) {
-          invW[k] = 1.0f / c[k]->clip.w;
-          z[k] = c[k]->clip.z * invW[k];
-          s[k] = {(c[k]->clip.x * invW[k] * 0.5f + 0.5f) * static_cast<float>(width),
-                  (c[k]->clip.y * invW[k] * 0.5f + 0.5f) * static_cast<float>(height)};
-        }
-        const float area = (s[1].x - s[0].x) * (s[2].y - s[0].y) - (s[2].x - s[0].x) * (s[1].y - s[0].y);
-        if (!(std::fabs(area) > 0.0f) || !std::isfinite(area)) continue;
-        const float x0 = std::max(0.0f, std::floor(std::min({s[0].x, s[1].x, s[2].x})));
-        const float x1 = std::min(static_cast<float>(width) - 1.0f, std::ceil(std::max({s[0].x, s[1].x, s[2].x})));
-        const float y0 = std::max(0.0f, std::floor(std::min({s[0].y, s[1].y, s[2].y})));
-        const float y1 = std::min(static_cast<float>(height) - 1.0f, std::ceil(std::max({s[0].y, s[1].y, s[2].y})));
-        for (float y = y0; y <= y1; y += 1.0f)
-          for (float x = x0; x <= x1; x += 1.0f) {
-            const glm::vec2 q(x + 0.5f, y + 0.5f);
-            float b[3];
-            for (int k = 0; k < 3; ++k) {
-              const glm::vec2& e0 = s[(k + 1) % 3];
-              const glm::vec2& e1 = s[(k + 2) % 3];
-              b[k] = ((e1.x - e0.x) * (q.y - e0.y) - (q.x - e0.x) * (e1.y - e0.y)) / area;
-            }
-            if (b[0] < 0.0f || b[1] < 0.0f || b[2] < 0.0f) continue;
-            const float zw = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];  // z/w and 1/w are linear on the screen
-            const size_t i = static_cast<size_t>(y) * width + static_cast<size_t>(x);
-            if (!(zw < depth[i]) || zw > 1.0f) continue;  // hidden, or past the far plane
-            const float inv = b[0] * invW[0] + b[1] * invW[1] + b[2] * invW[2];
-            depth[i] = zw;
-            nearest[i] = t;
-            point[i] = (b[0] * invW[0] * c[0]->world + b[1] * invW[1] * c[1]->world + b[2] * invW[2] * c[2]->world) / inv;
-          }
-      }
-    }
+    rasterizeNearest(scene, viewProj, width, height, depth, nearest, point);
     // Each covered pixel's eight probes, weighted as the raster client weighs them without visibility.
     for (size_t i = 0; i < pixels; ++i) {
       if (!(depth[i] < INFINITY)) continue;
@@ -291,24 +304,115 @@ SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLigh
   return out;
 }
 
-std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, const SurfaceLighting& lighting,
-                                        std::span<const float> probes, uint32_t probeCount) {
-  std::vector<float> sensitivity(probeCount, 0.0f);
-  const size_t usable = std::min<size_t>(probeCount, probes.size() / kProbeFloats);
-  for (const ViewSample& s : samples) {
-    const bool known = s.material < lighting.diffuse.size() && s.material < lighting.specular.size() &&
-                       s.material < lighting.lobe.size() && s.material < lighting.roughness.size() &&
-                       s.material < lighting.emission.size();
-    const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);  // glTF's default base colour
+namespace {
+
+// A punctual light's own view of the scene, for shadows: the distance from the light to the
+// nearest surface at each texel of six cube faces (point and spot lights) or of one orthographic
+// view over the scene's bounds (directional lights, the distance along the light's direction).
+struct LightDepth {
+  bool directional = false;
+  glm::vec3 origin{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};
+  int faces = 0;
+  glm::mat4 viewProj[6];
+  std::vector<float> distance[6];
+  uint32_t size = 0;
+  float texel = 0.0f;  // world size of a texel (directional), or per metre of distance (cube faces)
+};
+
+LightDepth lightDepth(const scene::Scene& scene, const scene::Light& l) {
+  LightDepth d;
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec3& p : scene.positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  if (scene.positions.empty()) lo = hi = glm::vec3(0.0f);
+  const glm::vec3 centre = 0.5f * (lo + hi);
+  const float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+  std::vector<float> depth;
+  std::vector<uint32_t> nearest;
+  std::vector<glm::vec3> point;
+  const auto keep = [&](int f) {
+    d.distance[f].assign(depth.size(), INFINITY);
+    for (size_t i = 0; i < depth.size(); ++i)
+      if (depth[i] < INFINITY)
+        d.distance[f][i] = d.directional ? glm::dot(point[i] - d.origin, d.direction) : glm::length(point[i] - d.origin);
+  };
+  if (l.type == scene::LightType::Directional) {
+    d.directional = true;
+    d.direction = glm::normalize(l.direction);
+    d.origin = centre - d.direction * (2.0f * radius);
+    const glm::vec3 up = std::fabs(d.direction.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    d.size = 512;
+    d.texel = 2.0f * radius / static_cast<float>(d.size);
+    d.faces = 1;
+    d.viewProj[0] = glm::orthoRH_ZO(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
+                    glm::lookAt(d.origin, centre, up);
+    rasterizeNearest(scene, d.viewProj[0], d.size, d.size, depth, nearest, point);
+    keep(0);
+    return d;
+  }
+  d.origin = l.position;
+  d.size = 192;
+  d.texel = 2.0f / static_cast<float>(d.size);
+  d.faces = 6;
+  const float reach = glm::length(l.position - centre) + radius;
+  const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+  for (int f = 0; f < 6; ++f) {
+    d.viewProj[f] = glm::perspectiveRH_ZO(glm::half_pi<float>(), 1.0f, 1e-4f * reach, 2.0f * reach) *
+                    glm::lookAt(l.position, l.position + axes[f], ups[f]);
+    rasterizeNearest(scene, d.viewProj[f], d.size, d.size, depth, nearest, point);
+    keep(f);
+  }
+  return d;
+}
+
+// The fraction of 3 × 3 texels around x's texel whose nearest surface is no nearer the light than
+// x (less a bias of a few texels' size): 1 lit, 0 in shadow.
+float lightVisibility(const LightDepth& d, const glm::vec3& x) {
+  int face = 0;
+  float along;
+  if (d.directional) {
+    along = glm::dot(x - d.origin, d.direction);
+  } else {
+    const glm::vec3 v = x - d.origin, a = glm::abs(v);
+    face = a.x >= a.y && a.x >= a.z ? (v.x > 0 ? 0 : 1) : a.y >= a.z ? (v.y > 0 ? 2 : 3) : (v.z > 0 ? 4 : 5);
+    along = glm::length(v);
+  }
+  const glm::vec4 clip = d.viewProj[face] * glm::vec4(x, 1.0f);
+  if (!(clip.w > 0.0f)) return 1.0f;
+  const float n = static_cast<float>(d.size);
+  const float px = (clip.x / clip.w * 0.5f + 0.5f) * n, py = (clip.y / clip.w * 0.5f + 0.5f) * n;
+  if (!(px >= 0.0f && px < n && py >= 0.0f && py < n)) return 1.0f;  // outside what the light's view holds
+  const float bias = 3.0f * (d.directional ? d.texel : d.texel * along) + 1e-4f * along;
+  int lit = 0, all = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int tx = static_cast<int>(px) + dx, ty = static_cast<int>(py) + dy;
+      if (tx < 0 || ty < 0 || tx >= static_cast<int>(d.size) || ty >= static_cast<int>(d.size)) continue;
+      ++all;
+      lit += d.distance[face][static_cast<size_t>(ty) * d.size + static_cast<size_t>(tx)] >= along - bias;
+    }
+  return all ? static_cast<float>(lit) / static_cast<float>(all) : 1.0f;
+}
+
+}  // namespace
+
+std::vector<glm::vec3> sampleDirectLight(const scene::Scene& scene, std::span<const ViewSample> samples,
+                                         const SurfaceLighting& lighting) {
+  std::vector<glm::vec3> out(samples.size(), glm::vec3(0.0f));
+  std::vector<LightDepth> depths;
+  for (const scene::Light& l : lighting.lights) depths.push_back(lightDepth(scene, l));
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const ViewSample& s = samples[i];
+    const bool known = s.material < lighting.diffuse.size() && s.material < lighting.emission.size();
+    const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);
     glm::vec3 radiance = known ? lighting.emission[s.material] : glm::vec3(0.0f);
-    const float roughness = known ? lighting.roughness[s.material] : 1.0f;
-    const glm::vec2 lobe = known ? lighting.lobe[s.material] : glm::vec2(0.0f);
-    const float nv = std::clamp(glm::dot(s.normal, s.toEye), 0.0f, 1.0f);
-    const glm::vec2 ab = envBrdfAt(lighting, nv, roughness);
-    const glm::vec3 glossyScale = (known ? lighting.specular[s.material] : glm::vec3(0.04f)) * ab.x + ab.y;
-    const glm::vec3 r = glm::reflect(-s.toEye, s.normal);
-    // Direct light, without shadows: the Lambertian part of the raster client's sum.
-    for (const scene::Light& l : lighting.lights) {
+    // The Lambertian part of the raster client's sum over its lights.
+    for (size_t k = 0; k < lighting.lights.size(); ++k) {
+      const scene::Light& l = lighting.lights[k];
       glm::vec3 e = l.color * l.intensity;
       glm::vec3 wi;
       if (l.type == scene::LightType::Directional) {
@@ -327,12 +431,36 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, con
         }
       }
       const float cosine = glm::dot(s.normal, wi);
-      if (cosine > 0.0f && std::isfinite(cosine)) radiance += rho / kPi * cosine * e;
+      if (cosine > 0.0f && std::isfinite(cosine)) radiance += rho / kPi * cosine * e * lightVisibility(depths[k], s.point);
     }
     for (const scene::AreaLight& a : lighting.areaLights.lights)
       for (size_t c = 0; c + 2 < a.corners.size(); c += 3)
         radiance += rho / kPi * a.radiance *
                     arealight::triangleCosineSolidAngle(s.point, s.normal, a.corners[c], a.corners[c + 1], a.corners[c + 2]);
+    if (std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z)) out[i] = radiance;
+  }
+  return out;
+}
+
+std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std::span<const glm::vec3> direct,
+                                        const SurfaceLighting& lighting, std::span<const float> probes,
+                                        uint32_t probeCount) {
+  std::vector<float> sensitivity(probeCount, 0.0f);
+  const size_t usable = std::min<size_t>(probeCount, probes.size() / kProbeFloats);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const ViewSample& s = samples[i];
+    const bool known = s.material < lighting.diffuse.size() && s.material < lighting.specular.size() &&
+                       s.material < lighting.lobe.size() && s.material < lighting.roughness.size() &&
+                       s.material < lighting.emission.size();
+    const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);  // glTF's default base colour
+    glm::vec3 radiance(0.0f);  // emission and direct light, then the probes' light
+    const float roughness = known ? lighting.roughness[s.material] : 1.0f;
+    const glm::vec2 lobe = known ? lighting.lobe[s.material] : glm::vec2(0.0f);
+    const float nv = std::clamp(glm::dot(s.normal, s.toEye), 0.0f, 1.0f);
+    const glm::vec2 ab = envBrdfAt(lighting, nv, roughness);
+    const glm::vec3 glossyScale = (known ? lighting.specular[s.material] : glm::vec3(0.04f)) * ab.x + ab.y;
+    const glm::vec3 r = glm::reflect(-s.toEye, s.normal);
+    if (direct.size() == samples.size()) radiance += direct[i];
     // The probes' diffuse light, each probe's part of it.
     glm::vec3 part[8];
     for (int k = 0; k < 8; ++k) {
@@ -345,9 +473,9 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, con
       // Prefiltered radiance toward r: band l scaled by the lobe's g_l (g_0 = 1).
       shEvalBasis(r.x, r.y, r.z, basis);
       glm::vec3 prefiltered(0.0f);
-      for (int i = 0; i < kShCoeffs; ++i) {
-        const float g = shBand(i) == 0 ? 1.0f : shBand(i) == 1 ? lobe.x : lobe.y;
-        prefiltered += g * basis[i] * glm::vec3(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
+      for (int j = 0; j < kShCoeffs; ++j) {
+        const float g = shBand(j) == 0 ? 1.0f : shBand(j) == 1 ? lobe.x : lobe.y;
+        prefiltered += g * basis[j] * glm::vec3(c[3 * j], c[3 * j + 1], c[3 * j + 2]);
       }
       part[k] = s.weights[k] * (rho / kPi * glm::max(glm::vec3(e[0], e[1], e[2]), glm::vec3(0.0f)) +
                                 glm::max(prefiltered, glm::vec3(0.0f)) * glossyScale);

@@ -94,6 +94,7 @@ void ProbeProducer::step() {
       if (next.materials != lightingMaterials_) {
         lighting_ = surfaceLighting(next, areaLights_);
         lightingMaterials_ = next.materials;
+        directStale_ = true;
       } else {
         lighting_.lights = next.lights;
       }
@@ -141,9 +142,15 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
                                        updater_->volume().offsets, sampled, size.x, size.y);
     footprintViews_ = views;
     footprintsStale_ = false;
+    directStale_ = true;
   }
-  // The light changes every update: weigh the surfaces by what the volume holds now.
-  return probeViewSensitivity(viewSurfaces_, lighting_, updater_->volume().probes, updater_->grid().count());
+  if (directStale_ || direct_.size() != viewSurfaces_.size() || lighting_.lights != directLights_) {
+    direct_ = sampleDirectLight(geometry_, viewSurfaces_, lighting_);
+    directLights_ = lighting_.lights;
+    directStale_ = false;
+  }
+  // The probes' light changes every update: weigh the surfaces by what the volume holds now.
+  return probeViewSensitivity(viewSurfaces_, direct_, lighting_, updater_->volume().probes, updater_->grid().count());
 }
 
 void ProbeProducer::loop(const Pacing& pacing, const std::atomic<bool>* interrupted,

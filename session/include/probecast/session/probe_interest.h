@@ -69,25 +69,35 @@ struct SurfaceLighting {
   std::vector<glm::vec2> lobe;      // per material: the GGX lobe's band 1 and 2 scales at its roughness (glossy_sh.h)
   std::vector<float> roughness;     // per material
   std::vector<glm::vec3> emission;  // per material: emission × its texture's mean
-  std::vector<scene::Light> lights; // punctual, lit without shadows
-  scene::AreaLightSet areaLights;   // client area lights, lit without shadows (empty: none)
+  std::vector<scene::Light> lights; // punctual
+  scene::AreaLightSet areaLights;   // client area lights (empty: none)
   std::vector<float> envBrdf;       // (A, B) over [roughness][n·v], envBrdfSize² texel centres (glossy_sh.h)
   int envBrdfSize = 0;
 };
 // Textures are averaged on a grid of at most 64 × 64 texels.
 SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLightOptions& areaLights);
 
+// Per sample: what a viewer adds there to the probes' light, as its raster client shades it: the
+// material's emission, the Lambertian part of its punctual lights, in shadow where the light's own
+// view of the scene (a depth rasterisation on the CPU: six 192² cube faces for point and spot
+// lights, one 512² orthographic view over the scene for directional ones, 3 × 3 texels averaged)
+// finds a nearer surface, and of its client area lights, unshadowed. Worked out again when the
+// samples or the lights change; the probes' light changes every update.
+std::vector<glm::vec3> sampleDirectLight(const scene::Scene& scene, std::span<const ViewSample> samples,
+                                         const SurfaceLighting& lighting);
+
 // Per probe (grid order): how much the views change, after the plain gamma 2.2 that images are
 // scored in, when that probe alone is made 20 % brighter: Σ over the samples and RGB of
 // (g′(L) · 0.2 · ŵ · I_p)², with g(L) = L^(1/2.2), ŵ the probe's weight at the sample, I_p the
 // light the raster client takes from the probe there (diffuse ρ/π · E_p(n) plus the split-sum
 // glossy term toward the reflected view direction, each clamped at 0) and L the sample's radiance
-// as the client shades it: emission + direct light without shadows (punctual and client area
-// lights, Lambertian) + Σ ŵ I. A dim surface counts for more than a bright one, as gamma makes it;
-// a probe's own brightness counts squared. `probes`: kProbeFloats per probe, the light viewers
-// hold. Non-finite coefficients count as 0; a material past the lists counts as glTF's default
-// (0.8 grey, rough, not metallic).
-std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, const SurfaceLighting& lighting,
-                                        std::span<const float> probes, uint32_t probeCount);
+// as the client shades it: `direct` (sampleDirectLight, one per sample; left out when the sizes
+// differ) + Σ ŵ I. A dim surface counts for more than a bright one, as gamma makes it; a probe's
+// own brightness counts squared. `probes`: kProbeFloats per probe, the light viewers hold.
+// Non-finite coefficients count as 0; a material past the lists counts as glTF's default (0.8
+// grey, rough, not metallic).
+std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std::span<const glm::vec3> direct,
+                                        const SurfaceLighting& lighting, std::span<const float> probes,
+                                        uint32_t probeCount);
 
 }  // namespace probecast::session

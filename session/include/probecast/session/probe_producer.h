@@ -139,6 +139,9 @@ class ProbeProducer {
   std::vector<View> footprintViews_;        // the views viewSurfaces_ are of
   std::vector<ViewSample> viewSurfaces_;
   bool footprintsStale_ = true;
+  std::vector<glm::vec3> direct_;           // sampleDirectLight of viewSurfaces_ under directLights_
+  std::vector<scene::Light> directLights_;
+  bool directStale_ = true;
   Animation animation_;
   FrameGenerator generator_;
   std::vector<float> frame_;
