@@ -456,7 +456,7 @@ void addBenchAdaptive(CLI::App* bench) {
                        "the noise-aware stream holds probes the scored views show little of longer: none, footprint "
                        "(each probe's measured share of their pixels), surface (the views' surfaces and the probes "
                        "that light them, as a server can work them out) or lit (surface, weighed by the light the "
-                       "volume holds, after gamma, at every update: what a producer does)")
+                       "volume holds, after gamma, at every update, blended over updates: what a producer does)")
       ->check(CLI::IsMember({"none", "footprint", "surface", "lit"}));
   adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
                        "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")

@@ -464,6 +464,7 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
     }
     session::SurfaceLighting lighting = firstLighting;  // its lights follow the scene
     std::vector<glm::vec3> direct;                      // sampleDirectLight, again when the lights move
+    std::vector<float> litWeights;                      // blended over the updates, as the producer does
     if (!seenSurfaces.empty()) direct = session::sampleDirectLight(first, seenSurfaces, lighting);
     for (float exponent : o.oracleExponents)
       for (float ratio : o.oracleErrorRatios) {
@@ -502,9 +503,11 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
       }
       restarts.push_back(u.update().restartedProbes);
       const ProbeVolume& v = u.volume();
-      if (o.viewWeights == "lit" && !streams[2].encoder->setViewWeights(
-                                        session::probeViewSensitivity(seenSurfaces, direct, lighting, v.probes, count)))
-        streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
+      if (o.viewWeights == "lit") {
+        session::blendViewWeights(litWeights, session::probeViewSensitivity(seenSurfaces, direct, lighting, v.probes, count));
+        if (!streams[2].encoder->setViewWeights(litWeights))
+          streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
+      }
       changes.push_back(previous.empty() ? 0.0 : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), count));
       previous = v.probes;
       for (Stream& s : streams) {

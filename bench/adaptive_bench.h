@@ -46,8 +46,8 @@ struct AdaptiveBenchOptions {
   // each probe's measured share of the scored views (at the start, on the converged volume; the
   // raster renders the views once per probe); "surface": what a server can work out from the
   // views' geometry alone (session::probeViewFootprints); "lit": that weighed by the light the
-  // updater's volume holds, recomputed every update (session::probeViewSensitivity), as the
-  // producer does.
+  // updater's volume holds, recomputed every update (session::probeViewSensitivity) and blended
+  // over the updates (session::blendViewWeights), as the producer does.
   std::string viewWeights = "none";
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;

@@ -112,6 +112,21 @@ TEST(ProbeInterest, TheSampleGridKeepsItsBudgetOverTheViews) {
   }
 }
 
+TEST(ProbeInterest, WeightsBlendSlowlyAndKeepWhatIsBroken) {
+  std::vector<float> held;
+  blendViewWeights(held, std::vector<float>{1.0f, 2.0f, NAN, -1.0f});  // the first weights are taken as they are
+  EXPECT_EQ(held, (std::vector<float>{1.0f, 2.0f, 0.0f, 0.0f}));      // but nothing broken
+  blendViewWeights(held, std::vector<float>{33.0f, INFINITY, 32.0f, 64.0f});
+  EXPECT_FLOAT_EQ(held[0], 1.0f * 31.0f / 32.0f + 33.0f / 32.0f);  // 2
+  EXPECT_FLOAT_EQ(held[1], 2.0f);                                  // a non-finite weight changes nothing
+  EXPECT_FLOAT_EQ(held[2], 1.0f);
+  EXPECT_FLOAT_EQ(held[3], 2.0f);
+  blendViewWeights(held, std::vector<float>{5.0f, 6.0f}, 0.5f);  // another grid: started again
+  EXPECT_EQ(held, (std::vector<float>{5.0f, 6.0f}));
+  blendViewWeights(held, std::vector<float>{7.0f, 8.0f}, 0.5f);
+  EXPECT_EQ(held, (std::vector<float>{6.0f, 7.0f}));
+}
+
 TEST(ProbeInterest, ViewsThatSeeNothingWeighNothing) {
   EXPECT_TRUE(probeViewFootprints(wall(), kGrid, {}, {}).empty());  // no views: nobody's interest known
   View away = straightOn();

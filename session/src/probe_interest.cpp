@@ -494,4 +494,16 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std
   return sensitivity;
 }
 
+void blendViewWeights(std::vector<float>& held, std::span<const float> fresh, float rate) {
+  if (held.size() != fresh.size()) {
+    held.assign(fresh.begin(), fresh.end());
+    for (float& w : held)
+      if (!(std::isfinite(w) && w >= 0.0f)) w = 0.0f;
+    return;
+  }
+  const float keep = 1.0f - rate;
+  for (size_t p = 0; p < held.size(); ++p)
+    if (std::isfinite(fresh[p]) && fresh[p] >= 0.0f) held[p] = keep * held[p] + rate * fresh[p];
+}
+
 }  // namespace probecast::session

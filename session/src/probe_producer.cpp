@@ -49,6 +49,7 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   geometry_.indices = first.indices;
   geometry_.triangleMaterial = first.triangleMaterial;
   areaLights_ = options.areaLights;
+  viewWeights_.clear();
   lighting_ = surfaceLighting(first, areaLights_);
   lightingMaterials_ = first.materials;
   footprintsStale_ = true;
@@ -134,7 +135,10 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
   const auto same = [](const std::vector<View>& a, const std::vector<View>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(View)) == 0);
   };
-  if (views.empty()) return {};
+  if (views.empty()) {
+    viewWeights_.clear();
+    return {};
+  }
   if (footprintsStale_ || !same(views, footprintViews_)) {
     const std::vector<View> sampled = spreadViews(views, kFootprintViews);
     const glm::uvec2 size = footprintSampleSize(sampled.size());
@@ -149,8 +153,11 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
     directLights_ = lighting_.lights;
     directStale_ = false;
   }
-  // The probes' light changes every update: weigh the surfaces by what the volume holds now.
-  return probeViewSensitivity(viewSurfaces_, direct_, lighting_, updater_->volume().probes, updater_->grid().count());
+  // The probes' light changes every update: weigh the surfaces by what the volume holds now, and
+  // blend that into the weights slowly (blendViewWeights: one noisy update must not move them).
+  blendViewWeights(viewWeights_, probeViewSensitivity(viewSurfaces_, direct_, lighting_, updater_->volume().probes,
+                                                      updater_->grid().count()));
+  return viewWeights_;
 }
 
 void ProbeProducer::loop(const Pacing& pacing, const std::atomic<bool>* interrupted,

@@ -100,4 +100,13 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std
                                         const SurfaceLighting& lighting, std::span<const float> probes,
                                         uint32_t probeCount);
 
+// The weights a stream is given are a slow moving average of probeViewSensitivity: `held` ←
+// (1 − rate) · held + rate · `fresh`, or `fresh` itself when `held` is empty or of another size.
+// A non-finite or negative fresh weight leaves that probe's as it was. The producer blends at
+// kViewWeightBlend: worked out anew every update from the updater's noisy volume, the weights
+// moved a probe's threshold up and down from one update to the next and the held light strayed
+// (bench adaptive, seeds 1–5: 0.23 dB lost unblended, 0.07 dB blended, at the same bytes).
+constexpr float kViewWeightBlend = 1.0f / 32.0f;
+void blendViewWeights(std::vector<float>& held, std::span<const float> fresh, float rate = kViewWeightBlend);
+
 }  // namespace probecast::session

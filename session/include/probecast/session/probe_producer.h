@@ -129,8 +129,8 @@ class ProbeProducer {
   bool rayBudget_ = false;  // the updater spends a ray budget: it is told the subscribers' views
   bool noiseRule_ = false;  // the hub's encoder holds noise (EncoderOptions::noiseScale): and so is it
   // told how much each probe changes the subscribers' views (probeViewSensitivity): the surfaces
-  // the views show are found again when the views or the geometry change, and weighed by the
-  // volume's light at every update.
+  // the views show are found again when the views or the geometry change, weighed by the volume's
+  // light at every update, and blended into the weights slowly (blendViewWeights).
   std::vector<float> viewFootprints(const std::vector<View>& views);
   scene::Scene geometry_;  // the triangles traced (positions, indices, materials of the last scene set)
   scene::AreaLightOptions areaLights_;      // the updater's: what viewers light themselves
@@ -142,6 +142,7 @@ class ProbeProducer {
   std::vector<glm::vec3> direct_;           // sampleDirectLight of viewSurfaces_ under directLights_
   std::vector<scene::Light> directLights_;
   bool directStale_ = true;
+  std::vector<float> viewWeights_;          // what the hub is given: the sensitivities, blended over updates
   Animation animation_;
   FrameGenerator generator_;
   std::vector<float> frame_;
