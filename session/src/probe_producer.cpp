@@ -50,7 +50,7 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   geometry_.triangleMaterial = first.triangleMaterial;
   areaLights_ = options.areaLights;
   viewWeights_.clear();
-  lighting_ = surfaceLighting(first, areaLights_);
+  lighting_ = noiseRule_ ? surfaceLighting(first, areaLights_) : SurfaceLighting{};  // for the view weights only
   lightingMaterials_ = first.materials;
   footprintsStale_ = true;
   rayBudget_ = options.raysPerUpdate > 0;
@@ -92,11 +92,11 @@ void ProbeProducer::step() {
         geometry_.triangleMaterial = next.triangleMaterial;
         footprintsStale_ = true;
       }
-      if (next.materials != lightingMaterials_) {
+      if (noiseRule_ && next.materials != lightingMaterials_) {
         lighting_ = surfaceLighting(next, areaLights_);
         lightingMaterials_ = next.materials;
         directStale_ = true;
-      } else {
+      } else if (noiseRule_) {
         lighting_.lights = next.lights;
       }
     }
