@@ -313,7 +313,6 @@ struct LightDepth {
   bool directional = false;
   glm::vec3 origin{0.0f};
   glm::vec3 direction{0.0f, -1.0f, 0.0f};
-  int faces = 0;
   glm::mat4 viewProj[6];
   std::vector<float> distance[6];
   uint32_t size = 0;
@@ -346,7 +345,6 @@ LightDepth lightDepth(const scene::Scene& scene, const scene::Light& l) {
     const glm::vec3 up = std::fabs(d.direction.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
     d.size = 512;
     d.texel = 2.0f * radius / static_cast<float>(d.size);
-    d.faces = 1;
     d.viewProj[0] = glm::orthoRH_ZO(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                     glm::lookAt(d.origin, centre, up);
     rasterizeNearest(scene, d.viewProj[0], d.size, d.size, depth, nearest, point);
@@ -356,7 +354,6 @@ LightDepth lightDepth(const scene::Scene& scene, const scene::Light& l) {
   d.origin = l.position;
   d.size = 192;
   d.texel = 2.0f / static_cast<float>(d.size);
-  d.faces = 6;
   const float reach = glm::length(l.position - centre) + radius;
   const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
