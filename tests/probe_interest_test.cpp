@@ -288,8 +288,8 @@ TEST(ProbeInterest, ATextureCountsByItsMeanLinearColour) {
   const std::vector<float> plain = sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(1.0f));
   s.materials[0].baseColorTexture = 0;
   const SurfaceLighting lighting = surfaceLighting(s, {});
-  ASSERT_EQ(lighting.diffuse.size(), 1u);
-  EXPECT_NEAR(lighting.diffuse[0].x, 0.5f, 1e-6f);
+  ASSERT_EQ(lighting.materials.size(), 1u);
+  EXPECT_NEAR(lighting.materials[0].diffuse.x, 0.5f, 1e-6f);
   const std::vector<float> textured = sensitivity(s, seen, lighting, uniformProbes(1.0f));
   for (uint32_t p = 0; p < kGrid.count(); ++p)
     EXPECT_NEAR(textured[p], std::pow((0.5 + glossyOfDielectric()) / (1.0 + glossyOfDielectric()), 2.0 / 2.2) * plain[p],
@@ -307,8 +307,8 @@ TEST(ProbeInterest, AMetalTakesOnlyTheGlossyTerm) {
   const std::vector<float> dielectric = sensitivity(s, seen, surfaceLighting(s, {}), uniformProbes(1.0f));
   s.materials[0].metallic = 1.0f;
   const SurfaceLighting metal = surfaceLighting(s, {});
-  EXPECT_EQ(metal.diffuse[0], glm::vec3(0.0f));
-  EXPECT_EQ(metal.specular[0], glm::vec3(1.0f));
+  EXPECT_EQ(metal.materials[0].diffuse, glm::vec3(0.0f));
+  EXPECT_EQ(metal.materials[0].specular, glm::vec3(1.0f));
   const std::vector<float> shiny = sensitivity(s, seen, metal, uniformProbes(1.0f));
   const glm::vec2 ab = envBrdfStraightOn();
   const double ratio = std::pow((ab.x + ab.y) / (1.0 + glossyOfDielectric()), 2.0 / 2.2);

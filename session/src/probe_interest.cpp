@@ -290,12 +290,10 @@ SurfaceLighting surfaceLighting(const scene::Scene& scene, const scene::AreaLigh
   const renderer::GgxLobeFit fit = renderer::ggxLobeFit();
   for (const scene::Material& m : scene.materials) {
     const glm::vec3 base = m.baseColor * texture(m.baseColorTexture);
-    out.diffuse.push_back(base * (1.0f - m.metallic));
-    out.specular.push_back(glm::mix(glm::vec3(0.04f), base, m.metallic));
     const std::array<double, 3> g = fit.evaluate(m.roughness);
-    out.lobe.emplace_back(static_cast<float>(g[1]), static_cast<float>(g[2]));
-    out.roughness.push_back(m.roughness);
-    out.emission.push_back(m.emission * texture(m.emissiveTexture));
+    out.materials.push_back({base * (1.0f - m.metallic), glm::mix(glm::vec3(0.04f), base, m.metallic),
+                             m.emission * texture(m.emissiveTexture),
+                             glm::vec2(static_cast<float>(g[1]), static_cast<float>(g[2])), m.roughness});
   }
   out.envBrdfSize = kEnvBrdfSize;
   out.envBrdf = renderer::envBrdfTable(kEnvBrdfSize, 256);
@@ -404,9 +402,9 @@ std::vector<glm::vec3> sampleDirectLight(const scene::Scene& scene, std::span<co
   for (const scene::Light& l : lighting.lights) depths.push_back(lightDepth(scene, l));
   for (size_t i = 0; i < samples.size(); ++i) {
     const ViewSample& s = samples[i];
-    const bool known = s.material < lighting.diffuse.size() && s.material < lighting.emission.size();
-    const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);
-    glm::vec3 radiance = known ? lighting.emission[s.material] : glm::vec3(0.0f);
+    const SurfaceMaterial m = lighting.material(s.material);
+    const glm::vec3 rho = m.diffuse;
+    glm::vec3 radiance = m.emission;
     // The Lambertian part of the raster client's sum over its lights.
     for (size_t k = 0; k < lighting.lights.size(); ++k) {
       const scene::Light& l = lighting.lights[k];
@@ -446,16 +444,13 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std
   const size_t usable = std::min<size_t>(probeCount, probes.size() / kProbeFloats);
   for (size_t i = 0; i < samples.size(); ++i) {
     const ViewSample& s = samples[i];
-    const bool known = s.material < lighting.diffuse.size() && s.material < lighting.specular.size() &&
-                       s.material < lighting.lobe.size() && s.material < lighting.roughness.size() &&
-                       s.material < lighting.emission.size();
-    const glm::vec3 rho = known ? lighting.diffuse[s.material] : glm::vec3(0.8f);  // glTF's default base colour
+    const SurfaceMaterial m = lighting.material(s.material);
+    const glm::vec3 rho = m.diffuse;
+    const glm::vec2 lobe = m.lobe;
     glm::vec3 radiance(0.0f);  // emission and direct light, then the probes' light
-    const float roughness = known ? lighting.roughness[s.material] : 1.0f;
-    const glm::vec2 lobe = known ? lighting.lobe[s.material] : glm::vec2(0.0f);
     const float nv = std::clamp(glm::dot(s.normal, s.toEye), 0.0f, 1.0f);
-    const glm::vec2 ab = envBrdfAt(lighting, nv, roughness);
-    const glm::vec3 glossyScale = (known ? lighting.specular[s.material] : glm::vec3(0.04f)) * ab.x + ab.y;
+    const glm::vec2 ab = envBrdfAt(lighting, nv, m.roughness);
+    const glm::vec3 glossyScale = m.specular * ab.x + ab.y;
     const glm::vec3 r = glm::reflect(-s.toEye, s.normal);
     if (direct.size() == samples.size()) radiance += direct[i];
     // The probes' diffuse light, each probe's part of it.

@@ -63,12 +63,17 @@ std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGri
 
 // What a viewer adds to the probes' light at a surface, and how it turns probes into light there,
 // for probeViewSensitivity.
+struct SurfaceMaterial {
+  glm::vec3 diffuse{0.8f};           // base colour × (1 − metallic) × its texture's mean (linear)
+  glm::vec3 specular{0.04f};         // F0 = mix(0.04, base colour × texture mean, metallic)
+  glm::vec3 emission{0.0f};          // emission × its texture's mean
+  glm::vec2 lobe{0.0f};              // the GGX lobe's band 1 and 2 scales at its roughness (glossy_sh.h)
+  float roughness = 1.0f;
+};
 struct SurfaceLighting {
-  std::vector<glm::vec3> diffuse;   // per material: base colour × (1 − metallic) × its texture's mean (linear)
-  std::vector<glm::vec3> specular;  // per material: F0 = mix(0.04, base colour × texture mean, metallic)
-  std::vector<glm::vec2> lobe;      // per material: the GGX lobe's band 1 and 2 scales at its roughness (glossy_sh.h)
-  std::vector<float> roughness;     // per material
-  std::vector<glm::vec3> emission;  // per material: emission × its texture's mean
+  std::vector<SurfaceMaterial> materials;  // per scene material
+  // The material of index `m`; past the list, glTF's default (0.8 grey, rough, not metallic).
+  SurfaceMaterial material(uint32_t m) const { return m < materials.size() ? materials[m] : SurfaceMaterial{}; }
   std::vector<scene::Light> lights; // punctual
   scene::AreaLightSet areaLights;   // client area lights (empty: none)
   std::vector<float> envBrdf;       // (A, B) over [roughness][n·v], envBrdfSize² texel centres (glossy_sh.h)
@@ -94,8 +99,8 @@ std::vector<glm::vec3> sampleDirectLight(const scene::Scene& scene, std::span<co
 // as the client shades it: `direct` (sampleDirectLight, one per sample; left out when the sizes
 // differ) + Σ ŵ I. A dim surface counts for more than a bright one, as gamma makes it; a probe's
 // own brightness counts squared. `probes`: kProbeFloats per probe, the light viewers hold.
-// Non-finite coefficients count as 0; a material past the lists counts as glTF's default (0.8
-// grey, rough, not metallic).
+// Non-finite coefficients count as 0; a material past the list counts as SurfaceLighting::material
+// says.
 std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std::span<const glm::vec3> direct,
                                         const SurfaceLighting& lighting, std::span<const float> probes,
                                         uint32_t probeCount);
