@@ -417,9 +417,11 @@ void addBenchAdaptive(CLI::App* bench) {
   struct AdaptiveOptions {
     std::string json, chart, repr = "zh3";
     GridOptions grid{{4, 4, 4}, {}};
+    GpuOptions gpu;
     bench::AdaptiveBenchOptions bench;
   };
   auto ao = std::make_shared<AdaptiveOptions>();
+  ao->gpu.add(adaptive);
   adaptive->add_option("--scene", ao->bench.sceneSpec, "an animated scene (t moves its light)");
   ao->grid.add(adaptive, /*withBounds=*/false, 2, 64);
   adaptive->add_option("--spp", ao->bench.samplesPerProbe, "paths per probe per update")->check(CLI::Range(1u, 1u << 16));
@@ -497,6 +499,7 @@ void addBenchAdaptive(CLI::App* bench) {
     bench::AdaptiveBenchOptions o = ao->bench;
     o.dims = {ao->grid.dims[0], ao->grid.dims[1], ao->grid.dims[2]};
     o.repr = *parseRepresentation(ao->repr);
+    o.context = ao->gpu.context();
     o.command = commandLine();
     o.progress = progressLine;
     const bench::AdaptiveBenchResult r = bench::runAdaptiveBench(o);
