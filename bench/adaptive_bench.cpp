@@ -519,7 +519,8 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                        s.encoder->reconstruction(), count, s.oracleRatio, s.oracleExponent, oracleInput);
           input = oracleInput.data();
         }
-        const uint32_t changed = s.encoder->update(input, v.active.data(), s.withNoise ? v.noise.data() : nullptr);
+        const uint32_t changed = s.encoder->update(input, v.active.data(), s.withNoise ? v.noise.data() : nullptr,
+                                                   s.withNoise ? v.stillUpdates.data() : nullptr);
         s.encoder->writeChangedFrame(frame);
         // Frame 0 is the keyframe; a frame that changes no brick is never sent.
         s.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / count);

@@ -152,6 +152,41 @@ TEST(ProbeHub, ViewWeightsHoldTheProbesNobodySeesWithinFourCSigma) {
   EXPECT_NEAR(heldDc(12), 1.2f, 0.005f);
 }
 
+// A published volume's stillUpdates reach the encoder's refinement interval (4 here, c = 2, σ =
+// 0.01): a DC step of 0.05 (0.031 in the rule's RMS, between c·σ and 2c·σ) is a refinement and waits
+// for update 4 in probes still for 100 updates, but goes at once in those whose light changed 1
+// update ago (x < 8), and without stillUpdates every probe counts as still.
+TEST(ProbeHub, APublishedVolumesStillUpdatesReachTheRefinementInterval) {
+  for (bool given : {true, false}) {
+    HubConfig config = rowConfig();
+    config.encoder.noiseScale = 2.0f;
+    config.encoder.refinementInterval = 4;
+    ProbeHub hub(config);
+    ProbeVolume v = makeProbeVolume(gridOf(config.layout, config.bounds));
+    const uint32_t count = v.count();
+    const auto setDc = [&](float dc) {
+      for (uint32_t i = 0; i < count; ++i)
+        for (int c = 0; c < 3; ++c) v.probes[static_cast<size_t>(i) * kProbeFloats + c] = dc;
+    };
+    v.noise.assign(count, 0.01f);
+    if (given) {
+      v.stillUpdates.assign(count, 100);
+      for (uint32_t i = 0; i < count; ++i)
+        if (i % 16 < 8) v.stillUpdates[i] = 1;
+    }
+    const auto heldDc = [&](uint32_t probe) { return hub.reconstruction().probes[static_cast<size_t>(probe) * kProbeFloats]; };
+    setDc(1.0f);
+    hub.publish(v);  // update 1
+    setDc(1.05f);
+    hub.publish(v);  // update 2
+    EXPECT_NEAR(heldDc(3), given ? 1.05f : 1.0f, 0.005f) << "x = 3, stillUpdates given: " << given;
+    EXPECT_NEAR(heldDc(12), 1.0f, 0.005f) << "x = 12, stillUpdates given: " << given;
+    hub.publish(v);  // update 3
+    hub.publish(v);  // update 4: the interval
+    EXPECT_NEAR(heldDc(12), 1.05f, 0.005f) << "x = 12, stillUpdates given: " << given;
+  }
+}
+
 TEST(ProbeHub, AcksCountAppliedFramesAndRefuseFramesNeverSent) {
   ProbeHub hub(rowConfig());
   std::mt19937 rng(3);

@@ -415,6 +415,37 @@ TEST_F(Updater, AMovingLightIsFollowedWhenTheSceneSaysItChanged) {
   EXPECT_LT(error[1], 0.85 * error[0]);
 }
 
+TEST_F(Updater, StillUpdatesCountFromTheLastChangeOfTheScene) {
+  // ProbeVolume::stillUpdates: every active probe counts the updates since setScene last changed
+  // what lights it (restarts, which noise causes too, do not reset it); inactive probes hold 0.
+  // Setting an equal scene is no change.
+  const Scene s = cornellAt(0.0f);
+  const ProbeGrid g = sceneGrid(s, {4, 4, 4});
+  ProbeUpdater u(*context_, s, g, adaptiveAt32Samples(8.0f, 8.0f));
+  const auto expectAll = [&](uint32_t updates, const char* when) {
+    const ProbeVolume& v = u.volume();
+    ASSERT_EQ(v.stillUpdates.size(), g.count()) << when;
+    uint32_t active = 0;
+    for (uint32_t p = 0; p < g.count(); ++p) {
+      EXPECT_EQ(v.stillUpdates[p], v.active[p] ? updates : 0u) << when << ", probe " << p;
+      active += v.active[p];
+    }
+    EXPECT_GT(active, 0u);
+  };
+  uint32_t restarts = 0;
+  for (int k = 0; k < 24; ++k) restarts += u.update().restartedProbes;
+  expectAll(24, "24 still updates");
+  u.setScene(cornellAt(0.0f));
+  u.update();
+  expectAll(25, "the same scene set again");
+  u.setScene(cornellAt(0.5f));  // the light jumps
+  for (int k = 0; k < 3; ++k) restarts += u.update().restartedProbes;
+  expectAll(3, "3 updates after the light jumped");
+  EXPECT_GT(restarts, 0u);  // restarts happened, and reset nothing
+  std::string error;
+  EXPECT_TRUE(checkProbeVolume(u.volume(), error)) << error;
+}
+
 TEST_F(Updater, SettingTheSameSceneAgainChangesNothing) {
   // setScene with a scene equal to the one set is no change: no history is capped, and the volume
   // is bit for bit that of an updater left alone (same seed).

@@ -201,12 +201,14 @@ struct GreyStream {
   StreamEncoder enc;
   StreamDecoder dec{layout};
   std::vector<float> noise = std::vector<float>(128, 0.01f);
+  std::vector<uint32_t> stillUpdates;  // empty: none given
   std::vector<uint8_t> frame;
   std::string what;
 
   GreyStream(const EncoderOptions& options, std::string name) : enc(layout, options), what(std::move(name)) {}
   uint32_t step(std::initializer_list<std::pair<int, float>> dc) {
-    const uint32_t changed = enc.update(greyProbes(dc).data(), nullptr, noise.data());
+    const uint32_t changed = enc.update(greyProbes(dc).data(), nullptr, noise.data(),
+                                        stillUpdates.empty() ? nullptr : stillUpdates.data());
     enc.writeChangedFrame(frame);
     EXPECT_EQ(dec.apply(frame.data(), frame.size()), CodecStatus::Ok) << what;
     expectSameState(enc, dec, what);
@@ -251,6 +253,39 @@ TEST(Stream, RefinementsWaitForTheIntervalNewLightDoesNot) {
     EXPECT_EQ(enc.brickVersion(0), 3u);
     EXPECT_NEAR(dec.probes()[kProbeFloats], 1.1f, 0.005f);
   }
+}
+
+// A refinement is a change between c·σ and 2c·σ of a probe whose light held still for the whole
+// refinement interval (ProbeVolume::stillUpdates). Where a probe's light changed more recently (the
+// scene changed, or it restarted), such a change is the light moving on and goes at once. Same grey
+// probes (c·σ = 0.02; DC steps of 0.05 are within 2c·σ), interval 4, every probe still for 100
+// updates but probe 0 (brick 0), whose light changed: still for 2 updates at update 2, then 3, 4, 5.
+// Brick 1 (probe 4) is still and waits for update 4 as before.
+TEST(Stream, RefinementsOfProbesWhoseLightJustChangedGoAtOnce) {
+  EncoderOptions options;
+  options.noiseScale = 2.0f;
+  options.refinementInterval = 4;
+  GreyStream stream(options, "updates still");
+  stream.stillUpdates.assign(128, 100);
+  const auto step = [&](uint32_t still0, float probe0, float probe4) {
+    stream.stillUpdates[0] = still0;
+    return stream.step({{0, probe0}, {4, probe4}});
+  };
+  const auto held = [&](int probe) { return stream.dec.probes()[probe * kProbeFloats]; };
+  EXPECT_EQ(step(100, 1.0f, 1.0f), 2u);  // update 1: the first versions
+  EXPECT_EQ(step(2, 1.05f, 1.05f), 1u);  // update 2: probe 0's light changed: its change goes, probe 4's waits
+  EXPECT_NEAR(held(0), 1.05f, 0.005f);
+  EXPECT_NEAR(held(4), 1.0f, 0.005f);
+  EXPECT_EQ(step(3, 1.1f, 1.05f), 1u);   // update 3: still for 3 < 4: at once
+  EXPECT_NEAR(held(0), 1.1f, 0.005f);
+  EXPECT_EQ(step(4, 1.1f, 1.05f), 1u);   // update 4: the interval: probe 4's goes
+  EXPECT_NEAR(held(4), 1.05f, 0.005f);
+  EXPECT_EQ(step(5, 1.15f, 1.05f), 0u);  // update 5: probe 0 still for 5 >= 4: it waits
+  EXPECT_EQ(step(6, 1.15f, 1.05f), 0u);  // update 6
+  EXPECT_EQ(step(7, 1.15f, 1.05f), 0u);  // update 7
+  EXPECT_NEAR(held(0), 1.1f, 0.005f);
+  EXPECT_EQ(step(8, 1.15f, 1.05f), 1u);  // update 8: goes with the interval
+  EXPECT_NEAR(held(0), 1.15f, 0.005f);
 }
 
 // View weights (StreamEncoder::setViewWeights) on the grey probes above (σ = 0.01, c = 2; a DC change

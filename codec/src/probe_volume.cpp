@@ -70,6 +70,10 @@ bool checkProbeVolume(const ProbeVolume& v, std::string& error) {
   for (size_t i = 0; i < v.noise.size(); ++i)
     if (!(std::isfinite(v.noise[i]) && v.noise[i] >= 0.0f))
       return error = "probe volume: noise of probe " + std::to_string(i) + " is not a finite value >= 0", false;
+  if (!v.stillUpdates.empty() && v.stillUpdates.size() != count)
+    return error = "probe volume: stillUpdates of " + std::to_string(v.stillUpdates.size()) + " entries for " +
+                   std::to_string(count) + " probes (one each, or none)",
+           false;
   return checkAreaLightRule(v.areaLights, error) && checkProbeOffsets(v.grid, v.offsets, error);
 }
 

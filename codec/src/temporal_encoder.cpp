@@ -175,7 +175,8 @@ Representation StreamEncoder::Impl::chooseRepresentation(uint32_t b, const float
   return choices[pick];
 }
 
-uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, const float* noise) {
+uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, const float* noise,
+                              const uint32_t* stillUpdates) {
   Impl& s = *impl_;
   const uint32_t bricks = brickCount(s.layout);
   s.changedThisFrame.clear();
@@ -222,7 +223,10 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
             ++s.beyond[p];  // not confirmed yet: kept (the count is cleared when the probe is sent)
             s.next[k] = *previous;
           } else {
-            urgent = urgent || !withinNoise(candidate, held, 2.0f * s.options.noiseScale * sigma);
+            // Beyond 2c·σ it is new light; within, a refinement, unless the probe's light has not
+            // held still for the refinement interval (then it is the light moving on).
+            const bool still = stillUpdates == nullptr || stillUpdates[p] >= s.options.refinementInterval;
+            urgent = urgent || !still || !withinNoise(candidate, held, 2.0f * s.options.noiseScale * sigma);
           }
         } else if (moved) {
           urgent = true;  // no noise to weigh it against, or newly active
@@ -237,9 +241,9 @@ uint32_t StreamEncoder::update(const float* probes, const uint8_t* activeIn, con
       changed = changed || s.nextActive[k] != s.active[p] ||
                 std::memcmp(&s.next[k], &s.base[k], sizeof(ProbeSymbols)) != 0;
     }
-    // Refinements alone (changes between c·σ and 2c·σ: the estimate converging, not new light) wait
-    // for the next update whose sequence is a multiple of refinementInterval, and then go together,
-    // every brick's in one frame.
+    // Refinements alone (changes between c·σ and 2c·σ of still probes: the estimate converging,
+    // not new light) wait for the next update whose sequence is a multiple of refinementInterval,
+    // and then go together, every brick's in one frame.
     if (changed && !urgent && s.options.refinementInterval > 0 && s.frame % s.options.refinementInterval != 0)
       changed = false;
     if (!changed) continue;

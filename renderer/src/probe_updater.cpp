@@ -254,6 +254,7 @@ struct ProbeUpdater::Impl {
       std::fill_n(volume.probes.begin() + p * 27, 27, 0.0f);
       history[p] = ProbeHistory{};  // starts afresh if it becomes active again
       if (!volume.noise.empty()) volume.noise[p] = 0.0f;
+      if (!volume.stillUpdates.empty()) volume.stillUpdates[p] = 0;
     }
     uploadProbeList(activeList);
     summarizeClassification(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -375,6 +376,8 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
   if ((geometryChanged || surfacesChanged || shadingChanged) && s.options.changeHistory > 0.0f &&
       s.options.rejectSigmas > 0.0f)
     for (ProbeHistory& h : s.history) shortenHistory(h, s.options.changeHistory);
+  if (geometryChanged || surfacesChanged || shadingChanged)
+    std::fill(s.volume.stillUpdates.begin(), s.volume.stillUpdates.end(), 0u);
 }
 
 UpdateStats ProbeUpdater::update() {
@@ -421,6 +424,12 @@ UpdateStats ProbeUpdater::update() {
     s.dispatch(static_cast<uint32_t>(list.size()), 0, s.levelDirections, PT_MODE_TRACE,
                randomRotation(s.options.seed, s.volume.updates), 1);
     s.blendTraced(list, samples, stats);
+  }
+  // One more update of each active probe's light holding still (setScene starts the count again).
+  s.volume.stillUpdates.resize(s.volume.count(), 0);
+  for (uint32_t p = 0; p < s.volume.count(); ++p) {
+    uint32_t& still = s.volume.stillUpdates[p];
+    still = s.volume.active[p] ? std::max(still, still + 1) : 0;  // saturates
   }
   ++s.volume.updates;
   stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

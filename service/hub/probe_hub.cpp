@@ -158,7 +158,8 @@ void ProbeHub::publish(const ProbeVolume& volume) {
     if (volume.grid.dims[a] != config_.layout.grid[a])
       throw std::invalid_argument("published volume's grid differs from the hub's");
   setProbeOffsets(volume.offsets);
-  publish(volume.probes.data(), volume.active.data(), volume.noise.empty() ? nullptr : volume.noise.data());
+  publish(volume.probes.data(), volume.active.data(), volume.noise.empty() ? nullptr : volume.noise.data(),
+          volume.stillUpdates.empty() ? nullptr : volume.stillUpdates.data());
 }
 
 void ProbeHub::setViewWeights(std::span<const float> weights) {
@@ -167,13 +168,13 @@ void ProbeHub::setViewWeights(std::span<const float> weights) {
   if (!encoder.setViewWeights(weights)) encoder.setViewWeights({});
 }
 
-void ProbeHub::publish(const float* probes, const uint8_t* active, const float* noise) {
+void ProbeHub::publish(const float* probes, const uint8_t* active, const float* noise, const uint32_t* stillUpdates) {
   std::vector<std::function<void()>> wakes;
   std::vector<BrickVersionBytes> made;
   BusOutput output;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    encoderSource("publish").encoder().update(probes, active, noise);
+    encoderSource("publish").encoder().update(probes, active, noise, stillUpdates);
     ++frame_;
     publishedUs_ = nowUs();
     transcodedBehind_ = !transcoded_.empty();

@@ -73,6 +73,12 @@ struct ProbeVolume {
   // orthonormal SH coefficient's estimator has the same variance). Empty when unknown; 0 for
   // inactive probes. A stream encoder with a noise scale does not re-send changes within it.
   std::vector<float> noise;
+  // How long each probe's light has held still: updates since the scene last changed what may light
+  // it (the updater cannot tell which probes a change reaches, so a change counts for all of them;
+  // restarts, which noise causes too, do not count). Empty when unknown; 0 for inactive probes. A
+  // stream encoder with a refinement interval holds back refinements only of probes still for the
+  // whole interval (EncoderOptions::refinementInterval).
+  std::vector<uint32_t> stillUpdates;
   // Relocation: per probe, 3 floats (x, y, z) in metres added to grid.position(i), the position the
   // probe is traced at and interpolated from; empty = every probe at its grid position.
   std::vector<float> offsets;
@@ -88,7 +94,7 @@ ProbeVolume makeProbeVolume(const ProbeGrid& grid);
 // Checks what every consumer relies on: 1 to kMaxGridDim probes per axis and at most kMaxProbes,
 // finite bounds with max > min along every axis of two or more probes, 27 floats and one active
 // byte (0 or 1) per probe, every coefficient finite, `noise` empty or one finite value >= 0 per
-// probe, `offsets` empty or 3 finite floats per probe, each within half a cell on its axis
+// probe, `stillUpdates` empty or one per probe, `offsets` empty or 3 finite floats per probe, each within half a cell on its axis
 // (probeCellSize; 0 along an axis of one probe), and `areaLights` valid (checkAreaLightRule). False with the reason in `error`.
 bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 

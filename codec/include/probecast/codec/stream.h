@@ -126,7 +126,10 @@ struct EncoderOptions {
   // what the decoder holds: the estimate converging, not new light) gets a new version only on an
   // update whose frame sequence is a multiple of this, so each brick's refinements go together and
   // every brick's in the same frame (one frame header, not one per brick). A change beyond 2c·σ, a
-  // probe switching on or off, or one without noise goes at once. 0 = off.
+  // probe switching on or off, or one without noise goes at once. So does the change of a probe
+  // whose light has held still for fewer updates than the interval (ProbeVolume::stillUpdates, given
+  // to update): where light moves, a change within 2c·σ is the light moving on, not the estimate
+  // converging. 0 = off.
   uint32_t refinementInterval = 0;
   // With the noise rule: a probe that would be re-sent (beyond c·σ of what the decoder holds) is kept
   // until it has been beyond for this many updates more in a row, so an estimate's one-update
@@ -198,8 +201,11 @@ class StreamEncoder {
 
   // Ingests a frame: probeCount(layout) probes of 27 floats (sh.h layout) and one state byte each
   // (nonzero = active; null = all active), and optionally one noise value per probe (null: none;
-  // negative or non-finite values count as 0). Returns the number of bricks given a new version.
-  uint32_t update(const float* probes, const uint8_t* active, const float* noise = nullptr);
+  // negative or non-finite values count as 0) and how many updates each probe's light has held
+  // still (ProbeVolume::stillUpdates; null: unknown, every probe as if still for long). Returns the
+  // number of bricks given a new version.
+  uint32_t update(const float* probes, const uint8_t* active, const float* noise = nullptr,
+                  const uint32_t* stillUpdates = nullptr);
 
   // With the noise rule: how much the viewers see of each probe, probeCount(layout) weights ≥ 0 (a
   // probe's share of the views' pixels, or 1 in some view and 0 in none); empty: every probe alike.

@@ -125,10 +125,12 @@ class ProbeHub {
   void setAreaLightRule(const AreaLightRule& rule);
 
   // A new lighting frame (27 floats per probe, sh.h layout; active mask or null; per-probe noise
-  // or null, see EncoderOptions::noiseScale). Each changed brick gets a new version, encoded once.
-  // Wakes subscribers that wait for data. Producer hubs only (std::logic_error on an edge's).
-  void publish(const float* probes, const uint8_t* active, const float* noise = nullptr);
-  // The same for a volume (its noise too, when it has one, and its offsets: setProbeOffsets), which
+  // and updates still or null, see EncoderOptions::noiseScale and refinementInterval). Each changed
+  // brick gets a new version, encoded once. Wakes subscribers that wait for data. Producer hubs only
+  // (std::logic_error on an edge's).
+  void publish(const float* probes, const uint8_t* active, const float* noise = nullptr,
+               const uint32_t* stillUpdates = nullptr);
+  // The same for a volume (its noise and stillUpdates too, when it has them, and its offsets: setProbeOffsets), which
   // must pass checkProbeVolume and have the hub's grid size (std::invalid_argument otherwise,
   // nothing published). Its areaLights are not read: the rule is the hub's (setAreaLightRule), as a
   // traced volume's samples say nothing of it.
