@@ -72,6 +72,13 @@ TEST(ProbeVolume, CheckRefusesWhatNoConsumerCanUse) {
     v.noise[2] = bad;
     EXPECT_FALSE(checkProbeVolume(v, error)) << bad;
   }
+  v = good;
+  v.stillUpdates.assign(4, 0);  // one count per probe is fine
+  v.stillUpdates[1] = UINT32_MAX;
+  EXPECT_TRUE(checkProbeVolume(v, error)) << error;
+  v.stillUpdates.push_back(3);
+  EXPECT_FALSE(checkProbeVolume(v, error));
+  EXPECT_NE(error.find("stillUpdates"), std::string::npos) << error;
 }
 
 TEST(ProbeOffsets, CheckRefusesOffsetsNoViewerCanPlace) {
