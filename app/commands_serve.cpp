@@ -99,8 +99,9 @@ void addServeCommand(CLI::App& app) {
                     "Monte Carlo noise (0 = off; bench adaptive measures 2)")
       ->check(CLI::Range(0.0f, 1000.0f));
   serve->add_option("--refinement-interval", o->refinementInterval,
-                    "with --noise-scale: refinements (changes within twice the noise threshold) wait for the next "
-                    "update whose sequence is a multiple of this, every brick's going in that one frame (0 = at once)")
+                    "with --noise-scale: refinements (changes within twice the noise threshold of probes whose light "
+                    "held still this many updates) wait for the next update whose sequence is a multiple of this, "
+                    "every brick's going in that one frame (0 = at once)")
       ->check(CLI::Range(0u, 100000u));
   serve->add_option("--confirmations", o->confirmations,
                     "with --noise-scale: a probe past the noise threshold is re-sent once it has stayed past it this "

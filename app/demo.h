@@ -35,6 +35,7 @@ struct DemoOptions {
   std::string lightField = "lf:5x5";
   uint32_t settleUpdates = 24;  // updates with the light frozen before the comparison
   float noiseScale = 0.0f;      // the hub's noise rule (EncoderOptions::noiseScale); 0 = off
+  uint32_t refinementInterval = 0;  // with it: EncoderOptions::refinementInterval; 0 = off
   uint32_t referenceSpp = 256;
   uint64_t lightFieldBudget = 6 * 1024;  // bytes/s: the display sits on a thin link
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report

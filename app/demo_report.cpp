@@ -84,8 +84,12 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
       "is compared with the reference path tracer ({} samples per pixel).\n\n",
       report["scene"].get<std::string>(), report["grid"][0].get<int>(), report["grid"][1].get<int>(),
       report["grid"][2].get<int>(), o.spp, report["update_ms_median"].get<double>(), o.repr,
-      o.noiseScale > 0.0f ? fmt::format(" (a probe is re-sent only beyond {:g} standard errors of its noise)", o.noiseScale)
-                          : std::string(),
+      o.noiseScale > 0.0f
+          ? fmt::format(" (a probe is re-sent only beyond {:g} standard errors of its noise{})", o.noiseScale,
+                        o.refinementInterval > 0
+                            ? fmt::format("; refinements of still probes wait for every {}th update", o.refinementInterval)
+                            : std::string())
+          : std::string(),
       o.lightField,
       report["stream_seconds"].get<double>(), o.settleUpdates, o.referenceSpp);
   md +=
@@ -266,6 +270,7 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
   report["grid"] = {run.grid.dims[0], run.grid.dims[1], run.grid.dims[2]};
   report["representation"] = o.repr;
   report["noise_scale"] = o.noiseScale;
+  report["refinement_interval"] = o.refinementInterval;
   report["environment"] = !o.environment.file.empty() ? nlohmann::json(o.environment.file)
                           : !o.environment.sky.empty() ? nlohmann::json({{"sky", o.environment.sky}})
                                                        : nlohmann::json(nullptr);

@@ -39,6 +39,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   run.serverContext = std::make_unique<renderer::VulkanContext>(renderer::ContextOptions{});
   service::HubConfig hub = service::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1);
   hub.encoder.noiseScale = o.noiseScale;
+  hub.encoder.refinementInterval = o.refinementInterval;
   run.producer = std::make_unique<session::ProbeProducer>(hub);
   renderer::UpdaterOptions uo;
   uo.samplesPerProbe = o.spp;
