@@ -87,7 +87,8 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
       o.noiseScale > 0.0f
           ? fmt::format(" (a probe is re-sent only beyond {:g} standard errors of its noise{})", o.noiseScale,
                         o.refinementInterval > 0
-                            ? fmt::format("; refinements of still probes wait for every {}th update", o.refinementInterval)
+                            ? fmt::format("; refinements of still probes wait for every {}th update",
+                                          o.refinementInterval)
                             : std::string())
           : std::string(),
       o.lightField,

@@ -174,7 +174,9 @@ TEST(ProbeHub, APublishedVolumesStillUpdatesReachTheRefinementInterval) {
       for (uint32_t i = 0; i < count; ++i)
         if (i % 16 < 8) v.stillUpdates[i] = 1;
     }
-    const auto heldDc = [&](uint32_t probe) { return hub.reconstruction().probes[static_cast<size_t>(probe) * kProbeFloats]; };
+    const auto heldDc = [&](uint32_t probe) {
+      return hub.reconstruction().probes[static_cast<size_t>(probe) * kProbeFloats];
+    };
     setDc(1.0f);
     hub.publish(v);  // update 1
     setDc(1.05f);

@@ -94,8 +94,8 @@ ProbeVolume makeProbeVolume(const ProbeGrid& grid);
 // Checks what every consumer relies on: 1 to kMaxGridDim probes per axis and at most kMaxProbes,
 // finite bounds with max > min along every axis of two or more probes, 27 floats and one active
 // byte (0 or 1) per probe, every coefficient finite, `noise` empty or one finite value >= 0 per
-// probe, `stillUpdates` empty or one per probe, `offsets` empty or 3 finite floats per probe, each within half a cell on its axis
-// (probeCellSize; 0 along an axis of one probe), and `areaLights` valid (checkAreaLightRule). False with the reason in `error`.
+// probe, `stillUpdates` empty or one per probe, `offsets` empty or 3 finite floats per probe, each
+// within half a cell on its axis (probeCellSize; 0 along an axis of one probe), and `areaLights` valid (checkAreaLightRule). False with the reason in `error`.
 bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 
 // The volume as a viewer holds it after the codec: every probe through a `repr` record and back

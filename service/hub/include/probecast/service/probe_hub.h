@@ -130,10 +130,10 @@ class ProbeHub {
   // (std::logic_error on an edge's).
   void publish(const float* probes, const uint8_t* active, const float* noise = nullptr,
                const uint32_t* stillUpdates = nullptr);
-  // The same for a volume (its noise and stillUpdates too, when it has them, and its offsets: setProbeOffsets), which
-  // must pass checkProbeVolume and have the hub's grid size (std::invalid_argument otherwise,
-  // nothing published). Its areaLights are not read: the rule is the hub's (setAreaLightRule), as a
-  // traced volume's samples say nothing of it.
+  // The same for a volume (its noise and stillUpdates too, when it has them, and its offsets:
+  // setProbeOffsets), which must pass checkProbeVolume and have the hub's grid size
+  // (std::invalid_argument otherwise, nothing published). Its areaLights are not read: the rule is
+  // the hub's (setAreaLightRule), as a traced volume's samples say nothing of it.
   void publish(const ProbeVolume& volume);
   // With the noise rule (EncoderOptions::noiseScale): how much the subscribers see of each probe,
   // for the publishes after it (StreamEncoder::setViewWeights: a probe nobody sees is held within
