@@ -6,7 +6,6 @@
 // behind the viewers' scene and lights the references. Writes images, charts, report.md and
 // report.json to --out.
 #include <filesystem>
-#include <stdexcept>
 
 #include "commands.h"
 #include "demo.h"
@@ -30,10 +29,7 @@ void addDemoCommand(CLI::App& app) {
                    "as serve: a probe is not re-sent while its change stays within this many standard errors of its "
                    "Monte Carlo noise (0 = off)")
       ->check(CLI::Range(0.0f, 1000.0f));
-  demo->add_option("--refinement-interval", o->refinementInterval,
-                   "as serve: with --noise-scale, refinements of probes whose light held still that many updates "
-                   "wait for the next update whose sequence is a multiple of this (0 = at once)")
-      ->check(CLI::Range(0u, 100000u));
+  addRefinementIntervalOption(demo, o->refinementInterval);
   addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
   addVisibilityOption(demo, o->visibility);
   demo->add_option("--supersample", o->supersample,
@@ -43,8 +39,7 @@ void addDemoCommand(CLI::App& app) {
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
   o->environment.add(demo);
   demo->callback([o] {
-    if (o->refinementInterval > 0 && o->noiseScale <= 0.0f)
-      throw std::runtime_error("--refinement-interval holds back what --noise-scale calls refinements: give both");
+    checkRefinementInterval(o->refinementInterval, o->noiseScale);
     o->sky = o->environment.load();  // a bad map or sky fails here, before the server starts
     DemoRun run;
     run.wallStart = DemoClock::now();

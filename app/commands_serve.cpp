@@ -59,8 +59,7 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   }
   hub.encoder.noiseScale = o.noiseScale;
   hub.encoder.refinementInterval = o.refinementInterval;
-  if (o.refinementInterval > 0 && o.noiseScale <= 0.0f)
-    throw std::runtime_error("--refinement-interval holds back what --noise-scale calls refinements: give both");
+  checkRefinementInterval(o.refinementInterval, o.noiseScale);
   hub.encoder.confirmations = o.confirmations;
   if (o.confirmations > 0 && o.noiseScale <= 0.0f)
     throw std::runtime_error("--confirmations holds back what --noise-scale would re-send: give both");
@@ -98,11 +97,7 @@ void addServeCommand(CLI::App& app) {
                     "live: a probe is not re-sent while its change stays within this many standard errors of its "
                     "Monte Carlo noise (0 = off; bench adaptive measures 2)")
       ->check(CLI::Range(0.0f, 1000.0f));
-  serve->add_option("--refinement-interval", o->refinementInterval,
-                    "with --noise-scale: refinements (changes within twice the noise threshold of probes whose light "
-                    "held still this many updates) wait for the next update whose sequence is a multiple of this, "
-                    "every brick's going in that one frame (0 = at once)")
-      ->check(CLI::Range(0u, 100000u));
+  addRefinementIntervalOption(serve, o->refinementInterval);
   serve->add_option("--confirmations", o->confirmations,
                     "with --noise-scale: a probe past the noise threshold is re-sent once it has stayed past it this "
                     "many updates more (past 4x the threshold at once; 0 = at once; bench adaptive measures 1)")

@@ -152,6 +152,21 @@ inline CLI::Option* addRepresentationOption(CLI::App* cmd, std::string& repr, co
       allowFloat ? "{float,l1,zh3h,zh3,l2,fp16}" : "{l1,zh3h,zh3,l2,fp16}"));
 }
 
+// --refinement-interval K of serve and demo (EncoderOptions::refinementInterval), and its check once
+// parsed: it holds back what the noise rule calls refinements, so it needs --noise-scale.
+inline CLI::Option* addRefinementIntervalOption(CLI::App* cmd, uint32_t& interval) {
+  return cmd
+      ->add_option("--refinement-interval", interval,
+                   "with --noise-scale: refinements (changes within twice the noise threshold of probes whose "
+                   "light held still this many updates) wait for the next update whose sequence is a multiple of "
+                   "this, every brick's going in that one frame (0 = at once)")
+      ->check(CLI::Range(0u, 100000u));
+}
+inline void checkRefinementInterval(uint32_t interval, float noiseScale) {
+  if (interval > 0 && noiseScale <= 0.0f)
+    throw std::runtime_error("--refinement-interval holds back what --noise-scale calls refinements: give both");
+}
+
 struct TracerOptions {
   uint32_t spp = 128;
   uint32_t bounces = 4;
