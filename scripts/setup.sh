@@ -13,7 +13,7 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev openssl
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev
 )
-# Mesa >= 24 from bookworm-backports: lavapipe with ray tracing (see LAVAPIPE.md).
+# Mesa >= 24 from bookworm-backports: lavapipe with ray tracing (see docs/PLATFORM.md).
 MESA_MIN=24
 
 sudo_if_needed() {

@@ -228,7 +228,7 @@ vec3 shadowVisibility(uint i, vec3 p, vec3 n) {
   return layerVisibility(layer, p + n * (1.5 * texel));
 }
 
-// L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) (CODEC.md §1), clamped ≥ 0.
+// L2 SH irradiance E(n) = Σ Â_l c_lm Y_lm(n) (docs/CODEC.md §1), clamped ≥ 0.
 vec3 probeIrradiance(float c[28], vec3 n) {
   float x = n.x, y = n.y, z = n.z;
   float basis[9] = float[9](0.282094792 * PI, 0.488602512 * y * (2.0 * PI / 3.0), 0.488602512 * z * (2.0 * PI / 3.0),

@@ -45,7 +45,7 @@ TEST(EnvMap, TopRowIsUpAndCentreIsMinusZ) {
 }
 
 TEST(EnvMap, ConstantMapProjectsAndConvolvesToKnownAnswers) {
-  // CODEC.md §8.1: L = 1 → c00 = 2√π, E = π.
+  // docs/CODEC.md §8.1: L = 1 → c00 = 2√π, E = π.
   const EnvMap m = constantMap(128, 64, 1.0f);
   float p[kProbeFloats];
   projectToSh(m, p);

@@ -11,7 +11,7 @@ namespace {
 TEST(GlossySh, LobeScalesLimits) {
   // A nearly mirror lobe keeps every band (g_l → 1); the roughest lobe is a cos-weighted GGX of
   // α = 1, i.e. K ∝ cos θ on the hemisphere (D is constant for α = 1): g_1 = 2/3, g_2 = 1/4,
-  // the clamped-cosine ratios Â_l / Â_0 of CODEC.md §1.
+  // the clamped-cosine ratios Â_l / Â_0 of docs/CODEC.md §1.
   const auto sharp = ggxLobeScalesIntegrated(0.05);
   EXPECT_GT(sharp[1], 0.99);
   EXPECT_GT(sharp[2], 0.98);

@@ -1,4 +1,4 @@
-// Brick priority against hand-made frusta (CODEC.md §6).
+// Brick priority against hand-made frusta (docs/CODEC.md §6).
 #include <gtest/gtest.h>
 
 #include <cmath>

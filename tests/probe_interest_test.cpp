@@ -142,7 +142,7 @@ TEST(ProbeInterest, ViewsThatSeeNothingWeighNothing) {
 }
 
 // Every probe holds the same uniform grey radiance r: E(n) = π · Y00 · (DC = r / Y00) = π r
-// (CODEC.md §1), so a white wall shows L = ρ/π · π r = r without other light.
+// (docs/CODEC.md §1), so a white wall shows L = ρ/π · π r = r without other light.
 std::vector<float> uniformProbes(float r) {
   std::vector<float> probes(static_cast<size_t>(kGrid.count()) * kProbeFloats, 0.0f);
   for (uint32_t p = 0; p < kGrid.count(); ++p)

@@ -1,4 +1,4 @@
-// The Vulkan probe updater against analytic answers (CODEC.md §8), determinism, classification
+// The Vulkan probe updater against analytic answers (docs/CODEC.md §8), determinism, classification
 // and validation (zero messages). Runs on lavapipe in CI.
 #include <gtest/gtest.h>
 
@@ -65,7 +65,7 @@ ProbeGrid singleProbe(glm::vec3 p) {
 }
 
 TEST_F(Updater, ClosedEmissiveBoxGivesConstantRadiance) {
-  // Radiance L from every inner face, black albedo: c00 = 2√π L and the rest 0 (CODEC.md §8.1).
+  // Radiance L from every inner face, black albedo: c00 = 2√π L and the rest 0 (docs/CODEC.md §8.1).
   const glm::vec3 L(1.0f, 0.5f, 0.25f);
   Scene s;
   const uint32_t m = addMaterial(s, glm::vec3(0.0f), L);
@@ -106,7 +106,7 @@ TEST_F(Updater, EmissionTextureIsDecodedFromSrgb) {
 }
 
 TEST_F(Updater, HalfEmissiveBoxGivesHemisphereAnswer) {
-  // Radiance 1 for z > 0, 0 below (CODEC.md §8.2): c00 = √π, c10 = √(3π)/2, c20 = 0, E(+z) = π.
+  // Radiance 1 for z > 0, 0 below (docs/CODEC.md §8.2): c00 = √π, c10 = √(3π)/2, c20 = 0, E(+z) = π.
   Scene s;
   s = halfSplitBox([](int, bool upper) { return upper ? 1u : 0u; });
   s.materials.clear();

@@ -14,7 +14,7 @@ namespace probecast::renderer {
 namespace {
 
 TEST(RasterClient, ConstantProbeVolumeLightsWhitePlaneToTheAnalyticValue) {
-  // Radiance L from every direction: E = π L (CODEC.md §8.1), so a white Lambertian plane
+  // Radiance L from every direction: E = π L (docs/CODEC.md §8.1), so a white Lambertian plane
   // reflects albedo/π · E = L; the glossy split sum adds L · (F0·A + B) (the prefiltered constant
   // radiance is L whatever the lobe), F0 = 0.04, (A, B) from the environment-BRDF table at
   // roughness 1 and n·v ≈ 1 (its last texel; the sampler clamps there). No lights, no emission.

@@ -33,7 +33,7 @@ TEST(Record, RepresentationNamesRoundTrip) {
 }
 
 TEST(Rgb9e5, KnownAnswers) {
-  // CODEC.md §8.5.
+  // docs/CODEC.md §8.5.
   const float a[3] = {1.0f, 0.5f, 0.25f};
   EXPECT_EQ(rgb9e5Encode(a), 0x81010100u);
   const float b[3] = {3.14159f, 1.0f, 0.001f};
@@ -109,7 +109,7 @@ TEST(HalfFloat, KnownValuesAndRoundTrip) {
 float ratio(const Probe& p, int i, int c) { return p[i * 3 + c] / p[c]; }
 
 TEST(RatioBounds, NonNegativeMixturesNeverBreakThem) {
-  // CODEC.md §3 / §8.6: for f >= 0 the ratios stay within the tight bounds.
+  // docs/CODEC.md §3 / §8.6: for f >= 0 the ratios stay within the tight bounds.
   std::mt19937 rng(9);
   const float eps = 1e-5f;
   for (int trial = 0; trial < 5000; ++trial) {
@@ -134,7 +134,7 @@ TEST(RatioBounds, NonNegativeMixturesNeverBreakThem) {
 class RecordRoundTrip : public ::testing::TestWithParam<Representation> {};
 
 TEST_P(RecordRoundTrip, EncodeDecodeEncodeIsEncode) {
-  // CODEC.md §8.6: encode∘decode∘encode = encode, decoding to the probe's function (for zh3h the
+  // docs/CODEC.md §8.6: encode∘decode∘encode = encode, decoding to the probe's function (for zh3h the
   // per-probe form: the per-pixel form's band is a correction, not the function).
   const Representation repr = GetParam();
   std::mt19937 rng(13);
@@ -194,7 +194,7 @@ INSTANTIATE_TEST_SUITE_P(AllRepresentations, RecordRoundTrip, ::testing::ValuesI
                          [](const auto& p) { return std::string(representationName(p.param)); });
 
 TEST(Record, RatioErrorWithinHalfStep) {
-  // CODEC.md §4: worst-case ratio error ≈ 0.0068 (L1), 0.0076 (L2 m≠0), 0.0088 (zonal m=0).
+  // docs/CODEC.md §4: worst-case ratio error ≈ 0.0068 (L1), 0.0076 (L2 m≠0), 0.0088 (zonal m=0).
   std::mt19937 rng(17);
   float worst[3] = {0, 0, 0};
   for (int trial = 0; trial < 3000; ++trial) {

@@ -1,4 +1,4 @@
-// SH basis, projection, irradiance and convention conversions against CODEC.md §1 and §8.
+// SH basis, projection, irradiance and convention conversions against docs/CODEC.md §1 and §8.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,7 +35,7 @@ Probe projectFunction(const std::function<void(const float d[3], float rgb[3])>&
 }
 
 TEST(ShBasis, ConstantsMatchClosedForms) {
-  // CODEC.md §1: sqrt((2l+1)/(4π)) times the polynomial factors.
+  // docs/CODEC.md §1: sqrt((2l+1)/(4π)) times the polynomial factors.
   EXPECT_NEAR(kY00, 0.5 / std::sqrt(M_PI), 1e-7);
   EXPECT_NEAR(kY1, std::sqrt(3.0 / (4.0 * M_PI)), 1e-7);
   EXPECT_NEAR(kY2, 0.5 * std::sqrt(15.0 / M_PI), 1e-7);
@@ -54,7 +54,7 @@ TEST(ShBasis, IndexOrderAndPolynomials) {
 }
 
 TEST(ShBasis, DeltaTowardOneTwoThreeMatchesKnownAnswer) {
-  // CODEC.md §8.3: coefficients of a unit delta are Y(d), d = normalize(1, 2, 3).
+  // docs/CODEC.md §8.3: coefficients of a unit delta are Y(d), d = normalize(1, 2, 3).
   const float inv = 1.0f / std::sqrt(14.0f);
   const float one[3] = {1, 1, 1};
   const Probe p = test::deltaProbe(1 * inv, 2 * inv, 3 * inv, one);
@@ -66,7 +66,7 @@ TEST(ShBasis, DeltaTowardOneTwoThreeMatchesKnownAnswer) {
 }
 
 TEST(ShBasis, ConstantRadianceProjectsToDcOnly) {
-  // CODEC.md §8.1: L = 1 → c00 = 2√π, all else 0; E = π everywhere.
+  // docs/CODEC.md §8.1: L = 1 → c00 = 2√π, all else 0; E = π everywhere.
   const Probe p = projectFunction([](const float*, float rgb[3]) { rgb[0] = rgb[1] = rgb[2] = 1.0f; }, 20000);
   EXPECT_NEAR(p[0], 3.5449077f, 1e-4f);
   for (int i = 1; i < kShCoeffs; ++i) EXPECT_NEAR(p[i * 3], 0.0f, 1e-3f) << i;
@@ -80,7 +80,7 @@ TEST(ShBasis, ConstantRadianceProjectsToDcOnly) {
 }
 
 TEST(ShBasis, UpperHemisphereKnownAnswer) {
-  // CODEC.md §8.2: radiance 1 for z > 0 → c00 = √π, c10 = √(3π)/2, c20 = 0;
+  // docs/CODEC.md §8.2: radiance 1 for z > 0 → c00 = √π, c10 = √(3π)/2, c20 = 0;
   // E(+z) = π, E(−z) = 0, E(equator) = π/2.
   const Probe p = projectFunction(
       [](const float d[3], float rgb[3]) { rgb[0] = rgb[1] = rgb[2] = d[2] > 0.0f ? 1.0f : 0.0f; }, 200000);
@@ -128,7 +128,7 @@ TEST(ShBasis, CondonShortleyRoundTripAndSigns) {
 }
 
 TEST(ShBasis, BandEnergyIsRotationInvariant) {
-  // CODEC.md §8.6. Rotating every lobe of a sum of deltas rotates the function.
+  // docs/CODEC.md §8.6. Rotating every lobe of a sum of deltas rotates the function.
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (int trial = 0; trial < 10; ++trial) {

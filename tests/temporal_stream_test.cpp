@@ -396,10 +396,10 @@ std::string hex(const std::vector<uint8_t>& bytes) {
 }
 
 TEST(Stream, GoldenBytes) {
-  // A 2×2×1 grid, one brick, l1, stored raw. Pins the format of stream.h (CODEC.md §7) byte for
+  // A 2×2×1 grid, one brick, l1, stored raw. Pins the format of stream.h (docs/CODEC.md §7) byte for
   // byte: frame 0 keyframe of 4 probes (probe 3 inactive), frame 1 delta of probe 2. CRCs are
   // CRC-32C (crc32c_test pins its known answers).
-  // Derivation of the first record: DC (1, 0.5, 0.25) → RGB9E5 0x81010100 (CODEC.md §8.5);
+  // Derivation of the first record: DC (1, 0.5, 0.25) → RGB9E5 0x81010100 (docs/CODEC.md §8.5);
   // R ratio of c11: 0.3 / 1 / √3 · 127 = 22.0 → 0x16; G ratio of c10: 0.2 / 0.5 / √3 · 127 = 29.3 → 0x1d.
   const StreamLayout layout = makeLayout(2, 2, 1, Representation::L1, 2);
   EncoderOptions options;

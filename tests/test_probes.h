@@ -16,7 +16,7 @@ using Probe = std::array<float, kProbeFloats>;
 Probe deltaProbe(float x, float y, float z, const float rgb[3]);
 
 // A random non-negative radiance function: a sum of `lobes` weighted deltas plus ambient.
-// Every such probe satisfies the ratio bounds of CODEC.md §3.
+// Every such probe satisfies the ratio bounds of docs/CODEC.md §3.
 Probe randomNonNegativeProbe(std::mt19937& rng, int lobes, float ambient);
 
 // Uniform random unit vector.

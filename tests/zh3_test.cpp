@@ -1,4 +1,4 @@
-// ZH3 axis, stored and hallucinated zonal coefficients (CODEC.md §2, §8.3-8.4).
+// ZH3 axis, stored and hallucinated zonal coefficients (docs/CODEC.md §2, §8.3-8.4).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +14,7 @@ namespace {
 using test::Probe;
 
 TEST(Zh3, HallucinationMatchesCurve) {
-  // CODEC.md §8.4: c20'/c00 = 0.08 r + 0.6 r².
+  // docs/CODEC.md §8.4: c20'/c00 = 0.08 r + 0.6 r².
   EXPECT_NEAR(zh3HallucinationCurve(0.5f), 0.19f, 1e-6f);
   EXPECT_NEAR(zh3HallucinationCurve(1.0f), 0.68f, 1e-6f);
   EXPECT_NEAR(zh3HallucinationCurve(1.5f), 1.47f, 1e-6f);
@@ -22,7 +22,7 @@ TEST(Zh3, HallucinationMatchesCurve) {
 }
 
 TEST(Zh3, DeltaAxisAndStoredCoefficient) {
-  // CODEC.md §8.3: on its own axis a delta has c20'/c00 = √5 and z = 1.
+  // docs/CODEC.md §8.3: on its own axis a delta has c20'/c00 = √5 and z = 1.
   const float inv = 1.0f / std::sqrt(14.0f);
   const float d[3] = {1 * inv, 2 * inv, 3 * inv};
   const float one[3] = {1, 1, 1};
@@ -55,7 +55,7 @@ TEST(Zh3, ExpansionReproducesZonalFunctions) {
 }
 
 TEST(Zh3, HallucinationUnderestimatesDeltaButKeepsAxis) {
-  // For a delta r = √3: hallucinated c20'/c00 = 1.938564 against the true √5 (CODEC.md §8.4).
+  // For a delta r = √3: hallucinated c20'/c00 = 1.938564 against the true √5 (docs/CODEC.md §8.4).
   const float one[3] = {1, 1, 1};
   Probe p = test::deltaProbe(0, 0, 1, one);
   zh3HallucinateInPlace(p.data());
@@ -66,7 +66,7 @@ TEST(Zh3, HallucinationUnderestimatesDeltaButKeepsAxis) {
 }
 
 TEST(Zh3, HallucinationAddsNothingWithoutDirectionality) {
-  // CODEC.md §8.6: r = 0 → no L2. A constant probe has no L1 at all.
+  // docs/CODEC.md §8.6: r = 0 → no L2. A constant probe has no L1 at all.
   Probe p{};
   for (int c = 0; c < 3; ++c) p[c] = 2.0f;
   p[12] = 0.3f;  // some L2 that the hallucination must replace with zeros

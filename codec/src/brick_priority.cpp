@@ -1,4 +1,4 @@
-// Brick priority: frusta, distance, change and age (CODEC.md §6).
+// Brick priority: frusta, distance, change and age (docs/CODEC.md §6).
 #include <algorithm>
 #include <cfloat>
 #include <cmath>

@@ -1,4 +1,4 @@
-// Grid/brick layout, frame header, and the section format (CODEC.md §7).
+// Grid/brick layout, frame header, and the section format (docs/CODEC.md §7).
 #include <algorithm>
 #include <cassert>
 #include <cstring>

@@ -1,4 +1,4 @@
-// Ratio quantisation of SH probes against the decoded DC (CODEC.md §3-4), closed loop.
+// Ratio quantisation of SH probes against the decoded DC (docs/CODEC.md §3-4), closed loop.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>

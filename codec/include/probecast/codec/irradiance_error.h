@@ -1,4 +1,4 @@
-// Irradiance error of SH probes, as `probecast bench codec` reports it (CODEC.md): relative RMSE,
+// Irradiance error of SH probes, as `probecast bench codec` reports it (docs/CODEC.md): relative RMSE,
 // RGB pooled, no clamping. Irradiance is E(n) = Σ_l Â_l Σ_m c_lm Y_lm(n) (shEvalIrradiance).
 #pragma once
 

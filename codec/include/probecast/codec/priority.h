@@ -1,4 +1,4 @@
-// Brick priority for a subscriber (CODEC.md §6): which bricks to send first under a byte budget.
+// Brick priority for a subscriber (docs/CODEC.md §6): which bricks to send first under a byte budget.
 //
 // Units: positions in metres (world space), matrices column-major (m[col * 4 + row]) mapping
 // world to Vulkan clip space (x, y in [-w, w], z in [0, w]).

@@ -1,4 +1,4 @@
-// Per-probe records ("ratio encoding", CODEC.md §3-4) and the representations a stream carries.
+// Per-probe records ("ratio encoding", docs/CODEC.md §3-4) and the representations a stream carries.
 //
 // A record holds the DC (RGB c00) as RGB9E5 in 4 bytes and every other coefficient as one byte:
 // its ratio to the *decoded* DC of its channel, divided by the tight bound for non-negative
@@ -60,7 +60,7 @@ const char* representationName(Representation repr);
 std::optional<Representation> parseRepresentation(std::string_view name);
 bool isValidRepresentation(uint8_t value);
 
-// Ratio bounds for non-negative functions (CODEC.md §3).
+// Ratio bounds for non-negative functions (docs/CODEC.md §3).
 constexpr float kBoundL1 = 1.7320508f;         // √3
 constexpr float kBoundL2Off = 1.9364917f;      // √15/2, m = ±1, ±2
 constexpr float kBoundL2ZeroLo = -1.1180340f;  // -√5/2, m = 0

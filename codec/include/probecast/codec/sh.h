@@ -1,6 +1,6 @@
 // Real spherical harmonics, bands 0..2, and the probe layout shared by every module.
 //
-// Convention (CODEC.md §1): real SH without the Condon-Shortley phase (Ramamoorthi-Hanrahan
+// Convention (docs/CODEC.md §1): real SH without the Condon-Shortley phase (Ramamoorthi-Hanrahan
 // 2001), index i = l(l+1)+m, order [00, 1-1, 10, 11, 2-2, 2-1, 20, 21, 22], direction (x, y, z)
 // with z the pole. Probes hold SH of incident *radiance*.
 //
@@ -19,7 +19,7 @@ static_assert(kProbeFloats == 27, "L2 RGB probe is 27 floats");
 
 constexpr float kPi = 3.14159265358979323846f;
 
-// Basis constants (CODEC.md §1 table; sqrt((2l+1)/(4π) · (l-|m|)!/(l+|m|)!) times the polynomial's factor).
+// Basis constants (docs/CODEC.md §1 table; sqrt((2l+1)/(4π) · (l-|m|)!/(l+|m|)!) times the polynomial's factor).
 constexpr float kY00 = 0.282094792f;   // 1/(2√π)
 constexpr float kY1 = 0.488602512f;    // √3/(2√π)
 constexpr float kY2 = 1.092548431f;    // √15/(2√π)

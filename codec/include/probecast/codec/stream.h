@@ -1,4 +1,4 @@
-// Brick-based temporal coding of a probe grid and its container (CODEC.md §5, §7).
+// Brick-based temporal coding of a probe grid and its container (docs/CODEC.md §5, §7).
 //
 // The grid (nx, ny, nz probes, probe (x, y, z) at index x + nx (y + ny z)) is split into bricks of
 // brickDim³ probes (smaller at the far edges), brick (bx, by, bz) at index bx + nbx (by + nby bz).

@@ -1,4 +1,4 @@
-// ZH3: L1 plus one zonal L2 coefficient per channel around a luminance axis (CODEC.md §2).
+// ZH3: L1 plus one zonal L2 coefficient per channel around a luminance axis (docs/CODEC.md §2).
 // "ZH3: Zonal Harmonics for Real-Time Global Illumination" (Roughton, Activision 2024).
 //
 // All functions use the probe layout of sh.h (27 floats, coefficient-major, no CS phase).
@@ -27,7 +27,7 @@ void zh3ExpandToL2(float probe[kProbeFloats], const float axis[3], const float z
 // c20' = c00_k (0.08 r + 0.6 r²), z = c20' √(4π/5). Channels with c00 <= 0 get 0.
 void zh3Hallucinate(const float probe[kProbeFloats], const float axis[3], float zonal[3]);
 
-// The hallucination curve c20'/c00 as a function of r (CODEC.md §8.4).
+// The hallucination curve c20'/c00 as a function of r (docs/CODEC.md §8.4).
 float zh3HallucinationCurve(float r);
 
 // Convenience: replaces the L2 band of `probe` by its hallucinated ZH3 expansion.
