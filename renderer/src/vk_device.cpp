@@ -52,7 +52,7 @@ void vkFail(VkResult result, const char* call, const char* file, int line) {
                            " at " + file + ":" + std::to_string(line));
 }
 
-void createDevice(VulkanDevice& d, bool validation, bool preferGpu) {
+void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "probecast";
   app.apiVersion = VK_API_VERSION_1_3;
@@ -91,17 +91,31 @@ void createDevice(VulkanDevice& d, bool validation, bool preferGpu) {
   std::vector<VkPhysicalDevice> devices(count);
   VK_CHECK(vkEnumeratePhysicalDevices(d.instance, &count, devices.data()));
   int best = -1;
+  bool bestIsCpu = false;
+  std::string seen;  // every device, for the error when none fits
   for (uint32_t i = 0; i < count; ++i) {
-    if (!hasExtensions(devices[i])) continue;
     VkPhysicalDeviceProperties p;
     vkGetPhysicalDeviceProperties(devices[i], &p);
+    const bool rayTracing = hasExtensions(devices[i]);
     const bool isCpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-    if (best < 0 || (preferGpu ? !isCpu : isCpu)) best = static_cast<int>(i);
+    seen += std::string(seen.empty() ? "" : ", ") + p.deviceName + (isCpu ? " (CPU" : " (GPU") +
+            (rayTracing ? ")" : ", no ray tracing)");
+    if (!rayTracing || (choice == DeviceChoice::Gpu && isCpu) || (choice == DeviceChoice::Cpu && !isCpu)) continue;
+    if (best < 0 || (bestIsCpu && !isCpu)) {  // auto: the first GPU, else the first CPU
+      best = static_cast<int>(i);
+      bestIsCpu = isCpu;
+    }
   }
-  if (best < 0)
+  if (best < 0 && choice == DeviceChoice::Auto)
     throw std::runtime_error(
         "no Vulkan device with ray tracing (VK_KHR_ray_tracing_pipeline); lavapipe needs Mesa >= 24 from "
-        "bookworm-backports (scripts/setup.sh installs it)");
+        "bookworm-backports (scripts/setup.sh installs it); devices found: " +
+        (seen.empty() ? std::string("none") : seen));
+  if (best < 0)
+    throw std::runtime_error(std::string("--device ") + deviceChoiceName(choice) + ": no " +
+                             (choice == DeviceChoice::Gpu ? "GPU" : "CPU") +
+                             " Vulkan device with ray tracing; devices found: " +
+                             (seen.empty() ? std::string("none") : seen) + " (--device auto takes whichever there is)");
   d.physical = devices[best];
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   d.rtProperties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
@@ -194,7 +208,7 @@ void destroyDevice(VulkanDevice& d) {
 
 VulkanContext::VulkanContext(const ContextOptions& options) : device_(std::make_unique<VulkanDevice>()) {
   try {
-    createDevice(*device_, options.validation, options.preferGpu);
+    createDevice(*device_, options.validation, options.device);
   } catch (...) {
     destroyDevice(*device_);
     throw;
@@ -202,6 +216,26 @@ VulkanContext::VulkanContext(const ContextOptions& options) : device_(std::make_
 }
 
 VulkanContext::~VulkanContext() { destroyDevice(*device_); }
+
+bool parseDeviceChoice(const std::string& text, DeviceChoice& out) {
+  for (DeviceChoice c : {DeviceChoice::Auto, DeviceChoice::Gpu, DeviceChoice::Cpu})
+    if (text == deviceChoiceName(c)) {
+      out = c;
+      return true;
+    }
+  return false;
+}
+
+const char* deviceChoiceName(DeviceChoice choice) {
+  switch (choice) {
+    case DeviceChoice::Gpu:
+      return "gpu";
+    case DeviceChoice::Cpu:
+      return "cpu";
+    default:
+      return "auto";
+  }
+}
 const std::string& VulkanContext::deviceName() const { return device_->name; }
 uint32_t VulkanContext::validationMessages() const { return device_->validationMessages.load(); }
 VulkanDevice& VulkanContext::device() { return *device_; }

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <string>
 
+#include "probecast/renderer/vulkan_context.h"
 #include "vk_common.h"
 
 namespace probecast::renderer {
@@ -32,7 +33,7 @@ struct VulkanDevice {
   PFN_vkCmdTraceRaysKHR vkCmdTraceRaysKHR = nullptr;
 };
 
-void createDevice(VulkanDevice& d, bool validation, bool preferGpu);
+void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice);
 void destroyDevice(VulkanDevice& d);
 
 }  // namespace probecast::renderer
