@@ -5,6 +5,7 @@
 #   scripts/dev.sh core-test     the Vulkan-free build (codec, imaging, service, their tests) in build-core, and its tests
 #   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec and bus-format tests under it
 #   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec and the bus decoder
+#   scripts/dev.sh python        `pip install ./python` into build-python/venv, and the Python tests against it
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -85,8 +86,30 @@ case "$cmd" in
     done
     echo "fuzz: clean after ${secs}s"
     ;;
+  python)
+    # The module as a Python user installs it (python/README.md): a virtual environment over
+    # Debian's numpy, pytest, pybind11 and scikit-build-core, `pip install ./python` without build
+    # isolation or an index, its CMake build kept in build-python/build. The tests then run from
+    # build-python/ against the installed module, never a build tree's.
+    py=/usr/bin/python3
+    [ -x "$py" ] || py=python3
+    venv=$ROOT/build-python/venv
+    [ -x "$venv/bin/python" ] || "$py" -m venv --system-site-packages "$venv"
+    CMAKE_BUILD_PARALLEL_LEVEL=$JOBS "$venv/bin/python" -m pip install --no-build-isolation --no-index \
+      --config-settings=build-dir="$ROOT/build-python/build" \
+      --config-settings=cmake.define.PROBECAST_WERROR="$WERROR" ./python
+    # The C++ side of the byte-for-byte tests, from the same configuration.
+    cmake --build build-python/build -j "$JOBS" --target probecast_python_golden
+    site=$("$venv/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["platlib"])')
+    cd build-python
+    unset PYTHONPATH
+    module=$("$venv/bin/python" -c 'import probecast; print(probecast.__file__)')
+    echo "python: probecast $("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("probecast"))') from $module"
+    PROBECAST_EXPECT_MODULE_DIR=$site PROBECAST_GOLDEN=$ROOT/build-python/build/python/probecast_python_golden \
+      PROBECAST_TEST_DATA=$ROOT/tests/data "$venv/bin/python" -m pytest -q -p no:cacheprovider "$ROOT/python/tests" "$@"
+    ;;
   *)
-    echo "usage: scripts/dev.sh demo|test|core-test|memsafe|fuzz [args]" >&2
+    echo "usage: scripts/dev.sh demo|test|core-test|memsafe|fuzz|python [args]" >&2
     exit 2
     ;;
 esac

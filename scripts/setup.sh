@@ -10,9 +10,11 @@ PACKAGES=(
   libvulkan-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   nats-server libnats-dev
-  clang-14 libclang-rt-14-dev openssl
-  python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev
+  clang-14 libclang-rt-14-dev openssl libssl-dev
+  python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev python3-venv
 )
+# From bookworm-backports (bookworm has none): scikit-build-core, for `pip install ./python`.
+BACKPORTS_PACKAGES=(python3-scikit-build-core)
 # Mesa >= 24 from bookworm-backports: lavapipe with ray tracing (see docs/PLATFORM.md).
 MESA_MIN=24
 
@@ -20,9 +22,9 @@ sudo_if_needed() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
 }
 
-missing_packages() {
+missing_packages() {  # PACKAGE...
   local p
-  for p in "${PACKAGES[@]}"; do
+  for p in "$@"; do
     if ! dpkg-query -W -f='${Status}\n' "$p" 2>/dev/null | grep -q '^install ok installed'; then
       echo "$p"
     fi
@@ -65,20 +67,25 @@ SRC
 }
 
 main() {
-  local missing
-  missing=$(missing_packages)
-  if [ -z "$missing" ] && mesa_ok; then
+  local missing missing_bpo
+  missing=$(missing_packages "${PACKAGES[@]}")
+  missing_bpo=$(missing_packages "${BACKPORTS_PACKAGES[@]}")
+  if [ -z "$missing" ] && [ -z "$missing_bpo" ] && mesa_ok; then
     return 0
   fi
   export DEBIAN_FRONTEND=noninteractive
   add_backports_source
   local mesa=""
   mesa_ok || mesa="mesa-vulkan-drivers (bookworm-backports)"
-  echo "setup: installing:" $missing $mesa
+  echo "setup: installing:" $missing $mesa ${missing_bpo:+$missing_bpo (bookworm-backports)}
   sudo_if_needed apt-get update -q
   if [ -n "$missing" ]; then
     # shellcheck disable=SC2086
     sudo_if_needed apt-get install -y -q --no-install-recommends $missing
+  fi
+  if [ -n "$missing_bpo" ]; then
+    # shellcheck disable=SC2086
+    sudo_if_needed apt-get install -y -q --no-install-recommends -t bookworm-backports $missing_bpo
   fi
   if ! mesa_ok; then
     sudo_if_needed apt-get install -y -q -t bookworm-backports mesa-vulkan-drivers

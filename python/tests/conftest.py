@@ -1,4 +1,5 @@
-"""Fixtures of the probecast Python tests (run by ctest as python.pytest, PYTHONPATH=build/python)."""
+"""Fixtures of the probecast Python tests: run by ctest as python.pytest (PYTHONPATH=build/python),
+and by `scripts/dev.sh python` against the module installed by `pip install ./python`."""
 import os
 import subprocess
 
@@ -6,6 +7,12 @@ import numpy as np
 import pytest
 
 import probecast  # noqa: F401  (a missing module fails the run at collection, not skipped)
+
+# Where the module must come from (scripts/dev.sh python: the virtual environment's site-packages),
+# so that a module left in a build tree cannot pass for the installed one.
+_expected_dir = os.environ.get("PROBECAST_EXPECT_MODULE_DIR", "")
+if _expected_dir and os.path.dirname(os.path.realpath(probecast.__file__)) != os.path.realpath(_expected_dir):
+    raise ImportError(f"probecast imported from {probecast.__file__}, not from {_expected_dir}")
 
 
 def _golden_tool():
