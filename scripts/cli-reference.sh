@@ -20,14 +20,17 @@ subcommands() {
 
 help_of() {
   # CLI11 exits 0 on --help; keep the text whatever the status, and never let it end the script.
-  "$BIN" "$@" --help 2>&1 || true
+  # The binary's path becomes plain `probecast`; trailing spaces and blank lines go.
+  { "$BIN" "$@" --help 2>&1 || true; } |
+    sed -e "s|$BIN|probecast|g" -e 's/[[:space:]]*$//' |
+    awk 'NF { while (blank > 0) { print ""; blank-- } print; next } { blank++ }'
 }
 
 section() {
   local title=$1
   shift
   printf '\n## `probecast %s`\n\n```\n' "$title"
-  help_of "$@" | sed -e 's/[[:space:]]*$//'
+  help_of "$@"
   printf '```\n'
 }
 
@@ -38,7 +41,7 @@ trap 'rm -f "$tmp"' EXIT
   printf 'Generated from the command'"'"'s own `--help` by `bash scripts/cli-reference.sh`; do not edit by\n'
   printf 'hand. Regenerate it after changing an option. The [README](../README.md) shows the commands in use.\n'
   printf '\n## `probecast`\n\n```\n'
-  help_of | sed -e 's/[[:space:]]*$//'
+  help_of
   printf '```\n'
   for cmd in $(help_of | subcommands); do
     section "$cmd" "$cmd"
