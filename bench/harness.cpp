@@ -225,6 +225,75 @@ bool ReferenceCache::loadHalf(const nlohmann::json& key, const std::string& stem
   return true;
 }
 
+double ReferenceCache::renderHalf(const scene::Scene& scene, const ReferenceRequest& request, const nlohmann::json& key,
+                                  const std::string& stem, int k, uint32_t seed, uint32_t spp, renderer::Image& out,
+                                  std::string& pixels) {
+  const renderer::ReferenceOptions& ro = request.options;
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw std::runtime_error("--reference-cache " + dir_ + ": " + ec.message());
+  renderer::ReferenceOptions o = ro;
+  o.samplesPerPixel = spp;
+  o.seed = seed;
+  int lastPercent = -1;
+  const auto t0 = std::chrono::steady_clock::now();
+  o.progress = [&](uint32_t done, uint32_t total) {
+    const int percent = static_cast<int>(100.0 * done / total);
+    if (percent / 10 == lastPercent / 10 && done != total) return;
+    lastPercent = percent;
+    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    sayProgress(progress_, fmt::format("reference {}: half {} of 2, {}/{} spp ({}%), {}x{}, {:.0f} s", stem, k + 1, done,
+                                       total, percent, ro.width, ro.height, sec));
+  };
+  renderer::ReferenceStats stats;
+  const renderer::Image image = renderer::renderReference(context_, scene, request.camera, o, &stats);
+  ++renders_;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (stats.droppedSamples > 0)
+    sayProgress(progress_, fmt::format("reference {}: {} non-finite samples dropped", stem, stats.droppedSamples));
+  // Written, then read back: what is returned is exactly what a later run will load.
+  const std::string base = dir_ + "/" + stem;
+  const std::string path = base + "." + halfName(k) + ".exr";
+  std::string error;
+  int w = 0, h = 0;
+  if (!imaging::writeExr(path + ".tmp", image.rgb, static_cast<int>(image.width), static_cast<int>(image.height),
+                         error) ||
+      !imaging::readExr(path + ".tmp", out.rgb, w, h, error))
+    throw std::runtime_error("reference cache: " + error);
+  std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
+  out.width = image.width;
+  out.height = image.height;
+  pixels = pixelHash(out.rgb);
+  // The half's JSON goes last: an image without one (an interrupted write) is simply absent.
+  writeFileAtomically(base + "." + halfName(k) + ".json",
+                      nlohmann::json{{"key", key},
+                                     {"half", halfName(k)},
+                                     {"seed", seed},
+                                     {"spp", spp},
+                                     {"seconds", seconds},
+                                     {"device", context_.deviceName()},
+                                     {"pixels", pixels}}
+                              .dump(2) +
+                          "\n");
+  return seconds;
+}
+
+namespace {
+
+// The reference from its two halves: their mean, and their difference as its noise floor.
+void combineHalves(Reference& ref) {
+  ref.mean.width = ref.halfA.width;
+  ref.mean.height = ref.halfA.height;
+  ref.mean.rgb.resize(ref.halfA.rgb.size());
+  for (size_t i = 0; i < ref.mean.rgb.size(); ++i) ref.mean.rgb[i] = 0.5f * (ref.halfA.rgb[i] + ref.halfB.rgb[i]);
+  ref.floor = imaging::compareImages(ref.halfA.rgb, ref.halfB.rgb, static_cast<int>(ref.halfA.width),
+                                     static_cast<int>(ref.halfA.height));
+  ref.accuracyDb = ref.floor.psnrDb + 10.0 * std::log10(4.0);
+}
+
+}  // namespace
+
 Reference ReferenceCache::get(const scene::Scene& scene, const ReferenceRequest& request) {
   const renderer::ReferenceOptions& ro = request.options;
   if (ro.samplesPerPixel < 2)
@@ -233,13 +302,9 @@ Reference ReferenceCache::get(const scene::Scene& scene, const ReferenceRequest&
   const nlohmann::json key = referenceKey(scene, request);
   Reference ref;
   ref.key = referenceKeyStem(key);
-  const auto say = [&](const std::string& s) {
-    if (progress_) progress_(s);
-  };
   const uint32_t half = (ro.samplesPerPixel + 1) / 2;
   const uint32_t seeds[2] = {ro.seed, ro.seed + kSecondSeedOffset};
   renderer::Image* halves[2] = {&ref.halfA, &ref.halfB};
-  const std::string base = dir_ + "/" + ref.key;
   nlohmann::json pixels = nlohmann::json::array();
   int loaded = 0;
   // Each half is stored on its own as soon as it is traced, so an interrupted run keeps what it finished.
@@ -253,79 +318,50 @@ Reference ReferenceCache::get(const scene::Scene& scene, const ReferenceRequest&
       continue;
     }
     if (why != "absent")
-      say(fmt::format("reference {}: half {} unusable ({}); rendering it again", ref.key, halfName(k), why));
-    std::error_code ec;
-    std::filesystem::create_directories(dir_, ec);
-    if (ec) throw std::runtime_error("--reference-cache " + dir_ + ": " + ec.message());
-    renderer::ReferenceOptions o = ro;
-    o.samplesPerPixel = half;
-    o.seed = seeds[k];
-    int lastPercent = -1;
-    const auto t0 = std::chrono::steady_clock::now();
-    o.progress = [&](uint32_t done, uint32_t total) {
-      const int percent = static_cast<int>(100.0 * done / total);
-      if (percent / 10 == lastPercent / 10 && done != total) return;
-      lastPercent = percent;
-      const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      say(fmt::format("reference {}: half {} of 2, {}/{} spp ({}%), {}x{}, {:.0f} s", ref.key, k + 1, done, total,
-                      percent, ro.width, ro.height, sec));
-    };
-    renderer::ReferenceStats stats;
-    const renderer::Image image = renderer::renderReference(context_, scene, request.camera, o, &stats);
-    ++renders_;
-    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (stats.droppedSamples > 0)
-      say(fmt::format("reference {}: {} non-finite samples dropped", ref.key, stats.droppedSamples));
-    // Written, then read back: what is returned is exactly what a later run will load.
-    const std::string path = base + "." + halfName(k) + ".exr";
-    std::string error;
-    int w = 0, h = 0;
-    if (!imaging::writeExr(path + ".tmp", image.rgb, static_cast<int>(image.width), static_cast<int>(image.height),
-                           error) ||
-        !imaging::readExr(path + ".tmp", halves[k]->rgb, w, h, error))
-      throw std::runtime_error("reference cache: " + error);
-    std::filesystem::rename(path + ".tmp", path, ec);
-    if (ec) throw std::runtime_error("reference cache: " + path + ": " + ec.message());
-    halves[k]->width = image.width;
-    halves[k]->height = image.height;
-    pixels.push_back(pixelHash(halves[k]->rgb));
-    ref.seconds += seconds;
-    // The half's JSON goes last: an image without one (an interrupted write) is simply absent.
-    writeFileAtomically(base + "." + halfName(k) + ".json",
-                        nlohmann::json{{"key", key},
-                                       {"half", halfName(k)},
-                                       {"seed", seeds[k]},
-                                       {"spp", half},
-                                       {"seconds", seconds},
-                                       {"device", context_.deviceName()},
-                                       {"pixels", pixels.back()}}
-                                .dump(2) +
-                            "\n");
+      sayProgress(progress_, fmt::format("reference {}: half {} unusable ({}); rendering it again", ref.key, halfName(k), why));
+    std::string hash;
+    ref.seconds += renderHalf(scene, request, key, ref.key, k, seeds[k], half, *halves[k], hash);
+    pixels.push_back(hash);
   }
   ref.fromCache = loaded == 2;
   if (ref.fromCache) {
-    say(fmt::format("reference {}: from the cache ({} spp, {}x{})", ref.key, ro.samplesPerPixel, ro.width, ro.height));
+    sayProgress(progress_, fmt::format("reference {}: from the cache ({} spp, {}x{})", ref.key, ro.samplesPerPixel,
+                                       ro.width, ro.height));
   } else {
     // The summary of the whole entry, for people and scripts (loading checks each half's own JSON).
-    writeFileAtomically(base + ".json", nlohmann::json{{"key", key},
-                                                       {"spp", half * 2},
-                                                       {"spp_per_half", half},
-                                                       {"seeds", {seeds[0], seeds[1]}},
-                                                       {"seconds", ref.seconds},
-                                                       {"pixels", pixels}}
-                                                .dump(2) +
-                                            "\n");
-    say(fmt::format("reference {}: {} of 2 halves rendered, {:.1f} s in all, stored in {}", ref.key,
-                    2 - loaded, ref.seconds, dir_));
+    writeFileAtomically(dir_ + "/" + ref.key + ".json", nlohmann::json{{"key", key},
+                                                                       {"spp", half * 2},
+                                                                       {"spp_per_half", half},
+                                                                       {"seeds", {seeds[0], seeds[1]}},
+                                                                       {"seconds", ref.seconds},
+                                                                       {"pixels", pixels}}
+                                                                .dump(2) +
+                                                            "\n");
+    sayProgress(progress_, fmt::format("reference {}: {} of 2 halves rendered, {:.1f} s in all, stored in {}", ref.key,
+                                       2 - loaded, ref.seconds, dir_));
   }
-  ref.mean.width = ref.halfA.width;
-  ref.mean.height = ref.halfA.height;
-  ref.mean.rgb.resize(ref.halfA.rgb.size());
-  for (size_t i = 0; i < ref.mean.rgb.size(); ++i) ref.mean.rgb[i] = 0.5f * (ref.halfA.rgb[i] + ref.halfB.rgb[i]);
-  ref.floor = imaging::compareImages(ref.halfA.rgb, ref.halfB.rgb, static_cast<int>(ref.halfA.width),
-                                     static_cast<int>(ref.halfA.height));
-  ref.accuracyDb = ref.floor.psnrDb + 10.0 * std::log10(4.0);
+  combineHalves(ref);
   return ref;
+}
+
+ReferenceRequest referenceRequest(const renderer::CameraView& camera, uint32_t width, uint32_t height, uint32_t spp,
+                                  std::shared_ptr<const renderer::Environment> environment, float t) {
+  ReferenceRequest request;
+  request.t = t;
+  request.camera = camera;
+  request.options.width = width;
+  request.options.height = height;
+  request.options.samplesPerPixel = spp;
+  request.options.environment = std::move(environment);
+  return request;
+}
+
+void sayProgress(const std::function<void(const std::string&)>& progress, const std::string& line) {
+  if (progress) progress(line);
+}
+
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 imaging::ImageMetrics compareChecked(const renderer::Image& image, const renderer::Image& reference,

@@ -22,8 +22,10 @@
 // or damaged half is found and rendered again, never used.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -58,6 +60,11 @@ struct Reference {
   std::string key;                   // the entry's file stem
 };
 
+// The reference of `camera`'s view at t: `width`×`height`, `spp` samples per pixel over both
+// halves, lit by `environment` (none: misses are black); the tracer's other options as they default.
+ReferenceRequest referenceRequest(const renderer::CameraView& camera, uint32_t width, uint32_t height, uint32_t spp,
+                                  std::shared_ptr<const renderer::Environment> environment, float t = 0.0f);
+
 // The key in full (JSON) and its file stem (16 hex digits of its hash).
 nlohmann::json referenceKey(const scene::Scene& scene, const ReferenceRequest& request);
 std::string referenceKeyStem(const nlohmann::json& key);
@@ -83,11 +90,21 @@ class ReferenceCache {
  private:
   bool loadHalf(const nlohmann::json& key, const std::string& stem, int k, uint32_t seed, uint32_t spp,
                 renderer::Image& out, double& seconds, std::string& why) const;
+  // Traces half `k` (seed `seed`, `spp` samples per pixel) and stores it, its JSON last; `out` is
+  // what a later run will load. Returns the tracing seconds; `pixels` is the image's hash.
+  double renderHalf(const scene::Scene& scene, const ReferenceRequest& request, const nlohmann::json& key,
+                    const std::string& stem, int k, uint32_t seed, uint32_t spp, renderer::Image& out,
+                    std::string& pixels);
   renderer::VulkanContext& context_;
   std::string dir_;
   std::function<void(const std::string&)> progress_;
   uint32_t renders_ = 0;
 };
+
+// A bench's progress line, sent where `progress` says (nowhere when it is empty).
+void sayProgress(const std::function<void(const std::string&)>& progress, const std::string& line);
+// Milliseconds of the steady clock since `start`.
+double millisecondsSince(std::chrono::steady_clock::time_point start);
 
 // An image against the reference and against a second image of the same view (the float-probe
 // render, isolating the codec's loss). Throws std::invalid_argument naming `what` when an image
