@@ -49,11 +49,11 @@ std::string truthCachePath(const std::string& dir, const scene::Scene& scene, co
 // The cached volume when its file is there and sound (checksum, values, `count` probes); a file
 // that is not is said so, and converged again by the caller.
 bool readTruth(const std::string& path, uint32_t count, ProbeVolume& out,
-               const std::function<void(const std::string&)>& say) {
+               const std::function<void(const std::string&)>& progress) {
   if (!std::filesystem::exists(path)) return false;
   std::string why;
   if (readProbeFile(path, out, why) && out.probes.size() == static_cast<size_t>(count) * kProbeFloats) return true;
-  say(fmt::format("adaptive bench: {} unusable ({}); converging again", path, why.empty() ? "another grid" : why));
+  sayProgress(progress, fmt::format("adaptive bench: {} unusable ({}); converging again", path, why.empty() ? "another grid" : why));
   return false;
 }
 
@@ -69,6 +69,10 @@ struct Stream {
   std::vector<double> bytesPerProbe;  // per frame
   std::vector<float> held;            // what a subscriber holds after the frame before
   std::vector<double> heldChanges;    // per frame: its relative irradiance change (what a viewer sees flicker)
+  // Per scored moment, one value per scored update: the image's PSNR against the truth's; the held
+  // volume's relative irradiance RMSE against the converged one (pooled over the probes, and each
+  // probe relative to its own energy, so dim ones count as much).
+  std::vector<std::vector<double>> psnr, probeError, probeErrorEach;
 };
 
 // Pearson's correlation of a and b, each value raised to `power` first (1/3: of the cube roots,
@@ -223,170 +227,196 @@ void addSeedSummary(const std::vector<nlohmann::json>& bySeed, const AdaptiveBen
   }
 }
 
-AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
-  const auto say = [&](const std::string& s) {
-    if (o.progress) o.progress(s);
-  };
-  renderer::VulkanContext context(o.context);
-  if (o.reconvergenceOnly) {
-    AdaptiveBenchResult r;
-    r.json["command"] = o.command;
-    r.json["device"] = context.deviceName();
-    r.json["samples_per_probe"] = o.samplesPerProbe;
-    r.json["seed"] = o.seed;
-    addReconvergence(context, o, r);
-    return r;
-  }
-  const auto sceneAt = [&](float t) { return session::loadSceneOrThrow(o.sceneSpec, t); };
-  const scene::Scene first = sceneAt(0.0f);
-  const ProbeGrid grid = renderer::sceneGrid(first, o.dims);
-  const uint32_t count = grid.count();
-  const uint32_t frames = 2 * o.stillUpdates + o.movingUpdates;
-  const auto tAt = [&](uint32_t frame) {  // the light's t during update `frame` (0-based)
+namespace {
+
+std::string ruleName(const BlendRule& b) {
+  return b.rejectSigmas > 0 ? fmt::format("adaptive k={:g}", b.rejectSigmas) : fmt::format("w_min {:g}", b.wMin);
+}
+
+// What every phase shares: the scene at t = 0, its grid, the phases' updates, the scored moments
+// and the scored views (as the raster renders them and as a server knows them).
+class Setup {
+ public:
+  Setup(const AdaptiveBenchOptions& options, renderer::VulkanContext& context);
+
+  scene::Scene sceneAt(float t) const { return session::loadSceneOrThrow(o.sceneSpec, t); }
+  // The light's t during update `frame` (0-based).
+  float tAt(uint32_t frame) const {
     if (frame < o.stillUpdates) return 0.0f;
     return o.lightStep * static_cast<float>(std::min(frame - o.stillUpdates + 1, o.movingUpdates));
-  };
-  const StreamLayout layout = streamLayoutFor(grid, o.repr, 4);
-
-  // Converged float volumes where images are scored: end of each phase.
-  const auto phaseEnd = [&](uint32_t last, uint32_t length) {
-    return Moment{nullptr, last, last + 1 - std::min(o.scoredUpdates, length)};
-  };
-  std::vector<Moment> moments = {phaseEnd(o.stillUpdates - 1, o.stillUpdates),
-                                 phaseEnd(o.stillUpdates + o.movingUpdates - 1, o.movingUpdates),
-                                 phaseEnd(frames - 1, o.stillUpdates)};
-  moments[0].name = "still";
-  moments[1].name = "moving";
-  moments[2].name = "still_again";
-  const renderer::CameraView camera = renderer::CameraView::fromScene(first);
-  renderer::ViewSetSpec viewSpec;
-  std::string viewError;
-  if (!renderer::parseViewSet(o.scoredViews, viewSpec, viewError))
-    throw std::invalid_argument("bench adaptive: scored views: " + viewError);
-  renderer::ViewSetOptions viewOptions;
-  viewOptions.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
-  const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(camera, viewSpec, viewOptions);
+  }
   // Every scored view of a volume (the scene camera alone for mono, as a viewer sees it).
-  const auto renderWith = [&](renderer::RasterRenderer& raster, const ProbeVolume& v) {
+  std::vector<renderer::Image> renderWith(renderer::RasterRenderer& raster, const ProbeVolume& v) const {
     raster.setProbes(v);
     if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono)
       return std::vector<renderer::Image>{raster.render(raster.viewProjection(camera), camera.position)};
     return raster.renderViews(views);
-  };
-  const auto render = [&](const ProbeVolume& v, float t) {
+  }
+  std::vector<renderer::Image> render(const ProbeVolume& v, float t) const {
     renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
     return renderWith(raster, v);
-  };
+  }
   // The mean squared error of a set of views' pixels together (after gamma, as PSNR takes it).
-  const auto mseOf = [&](const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) {
+  double mseOf(const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) const {
     double mse = 0;
     for (size_t i = 0; i < images.size(); ++i)
       mse += imaging::compareImages(images[i].rgb, truth[i].rgb, static_cast<int>(o.width), static_cast<int>(o.height)).mse;
     return mse / static_cast<double>(images.size());
-  };
+  }
   // One PSNR for a set of views: of their pixels together.
-  const auto psnrOf = [&](const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) {
+  double psnrOf(const std::vector<renderer::Image>& images, const std::vector<renderer::Image>& truth) const {
     const double mse = mseOf(images, truth);
     return mse > 0 ? 10.0 * std::log10(1.0 / mse) : HUGE_VAL;
-  };
-  // The truth at every t a scored update has: the views of a converged float volume.
-  std::map<float, std::vector<renderer::Image>> truthImages;
-  std::map<float, std::vector<float>> truthProbes;  // and the converged volume itself
-  const auto converge = [&](float t, bool withImage) {
-    if (truthProbes.count(t) && (!withImage || truthImages.count(t))) return;
-    const scene::Scene sceneNow = sceneAt(t);
-    renderer::UpdaterOptions ro;
-    ro.samplesPerProbe = 512;
-    ro.rejectSigmas = 0.0f;
-    ro.seed = 4242;
-    ro.surfaceProbesOnly = false;  // every probe: the streams are scored on the probes they hold
-    constexpr int kUpdates = 16;
-    const std::string path = o.truthCache.empty() ? std::string() : truthCachePath(o.truthCache, sceneNow, o.dims, ro, kUpdates);
-    ProbeVolume stored;
-    if (!path.empty() && readTruth(path, count, stored, say)) {
-      if (withImage) truthImages.emplace(t, render(stored, t));
-      truthProbes.emplace(t, std::move(stored.probes));
-      return;
-    }
-    say(fmt::format("adaptive bench: converged volume at t = {:g}", t));
-    renderer::ProbeUpdater u(context, sceneNow, grid, ro);
-    for (int k = 0; k < kUpdates; ++k) u.update();
-    if (!path.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(o.truthCache, ec);
-      if (ec) throw std::runtime_error("--truth-cache " + o.truthCache + ": " + ec.message());
-      std::vector<uint8_t> bytes;
-      serializeProbeVolume(u.volume(), bytes);
-      writeFileAtomically(path, std::string(bytes.begin(), bytes.end()));
-    }
-    if (withImage) truthImages.emplace(t, render(u.volume(), t));
-    truthProbes.emplace(t, u.volume().probes);
-  };
-  for (const Moment& m : moments)
-    for (uint32_t f = m.first; f <= m.frame; ++f) converge(tAt(f), true);
+  }
+
+  const AdaptiveBenchOptions& o;
+  renderer::VulkanContext& context;
+  scene::Scene first;
+  ProbeGrid grid;
+  uint32_t count = 0;
+  uint32_t frames = 0;  // still, moving, still again
+  StreamLayout layout;
+  std::vector<Moment> moments;  // where images are scored: the end of each phase
+  renderer::CameraView camera;
+  renderer::ViewSetSpec viewSpec;
+  std::vector<renderer::ViewInfo> views;
   // The scored views as a server knows them (what a subscriber sends), for the view weights a
   // server works out itself (session/probe_interest.h): "surface" from the geometry the views show,
   // "lit" also from the light the volume holds. Without probe offsets: the scored renders here
   // draw every volume at the grid positions.
   std::vector<View> serverViews;
-  {
-    std::vector<renderer::ViewInfo> scored = views;
-    if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono) {
-      const renderer::RasterRenderer raster(context, first, o.width, o.height, renderer::RasterOptions{});
-      scored.assign(1, renderer::ViewInfo{});
-      scored[0].viewProj = raster.viewProjection(camera);
-      scored[0].eye = camera.position;
-    }
-    serverViews = session::priorityViews(scored);
-  }
-  const glm::uvec2 sampleSize = session::footprintSampleSize(serverViews.size());  // as the producer samples them
-  const session::SurfaceLighting firstLighting = session::surfaceLighting(first, scene::AreaLightOptions{});
-  // The noise-aware stream's view weights (AdaptiveBenchOptions::viewWeights = "footprint"): each
-  // probe's share of the scored views, measured on the converged volume at the start: the views'
-  // squared change (after gamma) when that probe alone is made 20 % brighter.
-  std::vector<float> footprint;
-  nlohmann::json footprintMatch;
-  if (o.viewWeights == "footprint") {
-    converge(tAt(0), false);
-    say("adaptive bench: each probe's footprint in the scored views");
-    const scene::Scene sceneNow = sceneAt(tAt(0));
-    renderer::RasterRenderer raster(context, sceneNow, o.width, o.height, renderer::RasterOptions{});
-    ProbeVolume v = makeProbeVolume(grid);
-    v.probes = truthProbes.at(tAt(0));
-    const std::vector<renderer::Image> base = renderWith(raster, v);
-    footprint.assign(count, 0.0f);
-    for (uint32_t p = 0; p < count; ++p) {
-      float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
-      if (std::all_of(c, c + kProbeFloats, [](float x) { return x == 0.0f; })) continue;  // inactive or black
-      for (int i = 0; i < kProbeFloats; ++i) c[i] *= 1.2f;
-      footprint[p] = static_cast<float>(mseOf(renderWith(raster, v), base));  // weights count relative to each other
-      for (int i = 0; i < kProbeFloats; ++i) c[i] = truthProbes.at(tAt(0))[static_cast<size_t>(p) * kProbeFloats + i];
-    }
-    // How well the server's own estimates follow the measured weights (on the same converged volume).
-    std::vector<uint8_t> lit(count, 0);
-    for (uint32_t p = 0; p < count; ++p) {
-      const float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
-      lit[p] = std::any_of(c, c + kProbeFloats, [](float x) { return x != 0.0f; });
-    }
-    const std::vector<session::ViewSample> seen =
-        session::sampleViewSurfaces(sceneNow, grid, lit, {}, serverViews, sampleSize.x, sampleSize.y);
-    const std::pair<const char*, std::vector<float>> estimates[] = {
-        {"surface", session::probeViewFootprints(seen, count)},
-        {"lit", session::probeViewSensitivity(seen, session::sampleDirectLight(sceneNow, seen, firstLighting),
-                                              firstLighting, v.probes, count)}};
-    for (const auto& [name, w] : estimates)
-      footprintMatch[name] = {{"pearson", pearson(w, footprint, 1.0)}, {"pearson_cube_roots", pearson(w, footprint, 1.0 / 3.0)}};
-  }
-  // The oracle stream needs the truth at every update.
-  if (!o.oracleErrorRatios.empty())
-    for (uint32_t f = 0; f < frames; ++f) converge(tAt(f), false);
+  glm::uvec2 sampleSize{0, 0};  // as the producer samples them
+  session::SurfaceLighting firstLighting;
+};
 
-  AdaptiveBenchResult r;
+Setup::Setup(const AdaptiveBenchOptions& options, renderer::VulkanContext& vulkan)
+    : o(options), context(vulkan), first(sceneAt(0.0f)) {
+  grid = renderer::sceneGrid(first, o.dims);
+  count = grid.count();
+  frames = 2 * o.stillUpdates + o.movingUpdates;
+  layout = streamLayoutFor(grid, o.repr, 4);
+  const auto phaseEnd = [&](const char* name, uint32_t last, uint32_t length) {
+    return Moment{name, last, last + 1 - std::min(o.scoredUpdates, length)};
+  };
+  moments = {phaseEnd("still", o.stillUpdates - 1, o.stillUpdates),
+             phaseEnd("moving", o.stillUpdates + o.movingUpdates - 1, o.movingUpdates),
+             phaseEnd("still_again", frames - 1, o.stillUpdates)};
+  camera = renderer::CameraView::fromScene(first);
+  std::string viewError;
+  if (!renderer::parseViewSet(o.scoredViews, viewSpec, viewError))
+    throw std::invalid_argument("bench adaptive: scored views: " + viewError);
+  renderer::ViewSetOptions viewOptions;
+  viewOptions.aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
+  views = renderer::makeViewSet(camera, viewSpec, viewOptions);
+  std::vector<renderer::ViewInfo> scored = views;
+  if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono) {
+    const renderer::RasterRenderer raster(context, first, o.width, o.height, renderer::RasterOptions{});
+    scored.assign(1, renderer::ViewInfo{});
+    scored[0].viewProj = raster.viewProjection(camera);
+    scored[0].eye = camera.position;
+  }
+  serverViews = session::priorityViews(scored);
+  sampleSize = session::footprintSampleSize(serverViews.size());
+  firstLighting = session::surfaceLighting(first, scene::AreaLightOptions{});
+}
+
+// The truth at every t a scored update has: the views of a converged float volume, and the volume.
+class Truth {
+ public:
+  explicit Truth(const Setup& setup) : s_(setup) {}
+  void converge(float t, bool withImage);
+  const std::vector<float>& probes(float t) const { return probes_.at(t); }
+  const std::vector<renderer::Image>& images(float t) const { return images_.at(t); }
+
+ private:
+  const Setup& s_;
+  std::map<float, std::vector<renderer::Image>> images_;
+  std::map<float, std::vector<float>> probes_;
+};
+
+void Truth::converge(float t, bool withImage) {
+  const AdaptiveBenchOptions& o = s_.o;
+  if (probes_.count(t) && (!withImage || images_.count(t))) return;
+  const scene::Scene sceneNow = s_.sceneAt(t);
+  renderer::UpdaterOptions ro;
+  ro.samplesPerProbe = 512;
+  ro.rejectSigmas = 0.0f;
+  ro.seed = 4242;
+  ro.surfaceProbesOnly = false;  // every probe: the streams are scored on the probes they hold
+  constexpr int kUpdates = 16;
+  const std::string path = o.truthCache.empty() ? std::string() : truthCachePath(o.truthCache, sceneNow, o.dims, ro, kUpdates);
+  ProbeVolume stored;
+  if (!path.empty() && readTruth(path, s_.count, stored, o.progress)) {
+    if (withImage) images_.emplace(t, s_.render(stored, t));
+    probes_.emplace(t, std::move(stored.probes));
+    return;
+  }
+  sayProgress(o.progress, fmt::format("adaptive bench: converged volume at t = {:g}", t));
+  renderer::ProbeUpdater u(s_.context, sceneNow, s_.grid, ro);
+  for (int k = 0; k < kUpdates; ++k) u.update();
+  if (!path.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.truthCache, ec);
+    if (ec) throw std::runtime_error("--truth-cache " + o.truthCache + ": " + ec.message());
+    std::vector<uint8_t> bytes;
+    serializeProbeVolume(u.volume(), bytes);
+    writeFileAtomically(path, std::string(bytes.begin(), bytes.end()));
+  }
+  if (withImage) images_.emplace(t, s_.render(u.volume(), t));
+  probes_.emplace(t, u.volume().probes);
+}
+
+// The noise-aware stream's view weights for AdaptiveBenchOptions::viewWeights = "footprint".
+struct Footprint {
+  std::vector<float> weights;  // per probe (empty: not measured)
+  nlohmann::json match;        // how well the server's own estimates follow them
+};
+
+// Each probe's share of the scored views, measured on the converged volume at the start: the
+// views' squared change (after gamma) when that probe alone is made 20 % brighter.
+Footprint measureFootprint(const Setup& s, Truth& truth) {
+  truth.converge(s.tAt(0), false);
+  sayProgress(s.o.progress, "adaptive bench: each probe's footprint in the scored views");
+  const scene::Scene sceneNow = s.sceneAt(s.tAt(0));
+  const std::vector<float>& converged = truth.probes(s.tAt(0));
+  renderer::RasterRenderer raster(s.context, sceneNow, s.o.width, s.o.height, renderer::RasterOptions{});
+  ProbeVolume v = makeProbeVolume(s.grid);
+  v.probes = converged;
+  const std::vector<renderer::Image> base = s.renderWith(raster, v);
+  Footprint fp;
+  fp.weights.assign(s.count, 0.0f);
+  for (uint32_t p = 0; p < s.count; ++p) {
+    float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
+    if (std::all_of(c, c + kProbeFloats, [](float x) { return x == 0.0f; })) continue;  // inactive or black
+    for (int i = 0; i < kProbeFloats; ++i) c[i] *= 1.2f;
+    fp.weights[p] = static_cast<float>(s.mseOf(s.renderWith(raster, v), base));  // weights count relative to each other
+    for (int i = 0; i < kProbeFloats; ++i) c[i] = converged[static_cast<size_t>(p) * kProbeFloats + i];
+  }
+  // How well the server's own estimates follow the measured weights (on the same converged volume).
+  std::vector<uint8_t> lit(s.count, 0);
+  for (uint32_t p = 0; p < s.count; ++p) {
+    const float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
+    lit[p] = std::any_of(c, c + kProbeFloats, [](float x) { return x != 0.0f; });
+  }
+  const std::vector<session::ViewSample> seen =
+      session::sampleViewSurfaces(sceneNow, s.grid, lit, {}, s.serverViews, s.sampleSize.x, s.sampleSize.y);
+  const std::pair<const char*, std::vector<float>> estimates[] = {
+      {"surface", session::probeViewFootprints(seen, s.count)},
+      {"lit", session::probeViewSensitivity(seen, session::sampleDirectLight(sceneNow, seen, s.firstLighting),
+                                            s.firstLighting, v.probes, s.count)}};
+  for (const auto& [name, w] : estimates)
+    fp.match[name] = {{"pearson", pearson(w, fp.weights, 1.0)}, {"pearson_cube_roots", pearson(w, fp.weights, 1.0 / 3.0)}};
+  return fp;
+}
+
+// The bench's settings in the JSON, and the table's head.
+void writeHeader(const Setup& s, const Footprint& footprint, AdaptiveBenchResult& r) {
+  const AdaptiveBenchOptions& o = s.o;
   nlohmann::json& j = r.json;
   j["command"] = o.command;
   j["codec_format_version"] = kFormatVersion;  // the stream bytes below are of this format
-  j["device"] = context.deviceName();
-  j["scene"] = first.name;
+  j["device"] = s.context.deviceName();
+  j["scene"] = s.first.name;
   j["grid"] = {o.dims[0], o.dims[1], o.dims[2]};
   j["samples_per_probe"] = o.samplesPerProbe;
   j["seed"] = o.seed;
@@ -395,9 +425,9 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
   j["representation"] = representationName(o.repr);
   j["surface_probes_only"] = o.surfaceProbesOnly;
   j["view_weights"] = o.viewWeights;
-  if (!footprint.empty())
-    j["probes_that_change_no_pixel"] = std::count(footprint.begin(), footprint.end(), 0.0f);  // of the grid
-  if (!footprintMatch.is_null()) j["view_weight_estimates_vs_footprint"] = footprintMatch;
+  if (!footprint.weights.empty())  // of the grid
+    j["probes_that_change_no_pixel"] = std::count(footprint.weights.begin(), footprint.weights.end(), 0.0f);
+  if (!footprint.match.is_null()) j["view_weight_estimates_vs_footprint"] = footprint.match;
   j["deadzone"] = o.deadzone;
   j["noise_scale"] = o.noiseScale;
   j["confirmations"] = o.confirmations;
@@ -409,245 +439,284 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                 "irradiance RMSE of the held volume against that converged volume (probe_error_rel: pooled over the "
                 "probes, so bright ones dominate; probe_error_rel_per_probe: each probe relative to its own energy, "
                 "RMS over the probes)";
-  std::string& table = r.table;
-  table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", first.name, o.dims[0],
-                      o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
-                      context.deviceName());
-  table += fmt::format("images: {} view{} ({}) at the last {} updates of each phase\n", views.size(),
-                       views.size() == 1 ? "" : "s", o.scoredViews, o.scoredUpdates);
-  table += fmt::format("{:<14} {:<7} {:>9} {:>9} {:>9} {:>9} {:>11} {:>11}\n", "rule", "stream", "still B", "moving B",
-                       "again B", "flicker", "held flick", "PSNR loss");
+  r.table = fmt::format("adaptive bench: {} {}x{}x{} probes, {} spp, {}, dead-zone {}, on {}\n", s.first.name, o.dims[0],
+                        o.dims[1], o.dims[2], o.samplesPerProbe, representationName(o.repr), o.deadzone,
+                        s.context.deviceName());
+  r.table += fmt::format("images: {} view{} ({}) at the last {} updates of each phase\n", s.views.size(),
+                         s.views.size() == 1 ? "" : "s", o.scoredViews, o.scoredUpdates);
+  r.table += fmt::format("{:<14} {:<7} {:>9} {:>9} {:>9} {:>9} {:>11} {:>11}\n", "rule", "stream", "still B",
+                         "moving B", "again B", "flicker", "held flick", "PSNR loss");
+}
 
-  std::vector<BlendRule> rules;
-  for (float w : o.fixedWMins) rules.push_back({w, 0.0f});
-  rules.push_back({0.0f, o.rejectSigmas});
-  const auto ruleName = [](const BlendRule& b) {
-    return b.rejectSigmas > 0 ? fmt::format("adaptive k={:g}", b.rejectSigmas) : fmt::format("w_min {:g}", b.wMin);
-  };
-  std::vector<imaging::ChartSeries> bytesSeries;
-  // The adaptive rule again with each further seed: its figures per seed (the tables and charts
-  // are the first seed's).
-  std::vector<nlohmann::json> adaptiveBySeed;
-  const uint32_t streamSeeds = std::max(o.streamSeeds, 1u);
-  std::vector<std::pair<uint32_t, BlendRule>> runs;  // (seed, rule)
-  for (uint32_t extra = 0; extra < streamSeeds; ++extra)
-    for (const BlendRule& rule : rules)
-      if (extra == 0 || rule.rejectSigmas > 0) runs.push_back({o.seed + extra, rule});
-  for (const auto& [seed, rule] : runs) {
-    const bool firstSeed = seed == o.seed;
-    say(fmt::format("adaptive bench: {}{}", ruleName(rule), firstSeed ? "" : fmt::format(", seed {}", seed)));
-    renderer::UpdaterOptions uo;
-    uo.samplesPerProbe = o.samplesPerProbe;
-    uo.seed = seed;
-    uo.minBlendWeight = rule.wMin;
-    uo.rejectSigmas = rule.rejectSigmas;
-    uo.neighbourHistory = rule.rejectSigmas > 0 ? o.neighbourHistory : 0.0f;
-    uo.changeHistory = rule.rejectSigmas > 0 ? o.changeHistory : 0.0f;
-    uo.surfaceProbesOnly = o.surfaceProbesOnly;
-    renderer::ProbeUpdater u(context, first, grid, uo);
-    if (!j.contains("active_probes")) j["active_probes"] = count - u.classifyStats().inactive;  // the same for every rule
-    std::vector<Stream> streams(3);
-    streams[0].name = "full";  // every quantised change
-    streams[1].name = "deadzone";
-    streams[1].options.deadzone = o.deadzone;
-    streams[2].name = "noise";
-    streams[2].options.deadzone = o.deadzone;
-    streams[2].options.noiseScale = o.noiseScale;
-    streams[2].options.confirmations = o.confirmations;
-    streams[2].options.refinementInterval = o.refinementInterval;
-    streams[2].withNoise = true;
-    streams[2].viewWeights = footprint;
-    std::vector<session::ViewSample> seenSurfaces;
-    if (o.viewWeights == "surface" || o.viewWeights == "lit") {
-      seenSurfaces = session::sampleViewSurfaces(first, grid, u.volume().active, {}, serverViews, sampleSize.x, sampleSize.y);
-      if (o.viewWeights == "surface") streams[2].viewWeights = session::probeViewFootprints(seenSurfaces, count);
+// The streams one rule's volumes go through: every quantised change, the dead-zone, the
+// noise-aware stream, and the oracles.
+std::vector<Stream> makeStreams(const Setup& s, const std::vector<float>& footprint) {
+  const AdaptiveBenchOptions& o = s.o;
+  std::vector<Stream> streams(3);
+  streams[0].name = "full";  // every quantised change
+  streams[1].name = "deadzone";
+  streams[1].options.deadzone = o.deadzone;
+  streams[2].name = "noise";
+  streams[2].options.deadzone = o.deadzone;
+  streams[2].options.noiseScale = o.noiseScale;
+  streams[2].options.confirmations = o.confirmations;
+  streams[2].options.refinementInterval = o.refinementInterval;
+  streams[2].withNoise = true;
+  streams[2].viewWeights = footprint;
+  for (float exponent : o.oracleExponents)
+    for (float ratio : o.oracleErrorRatios) {
+      Stream& st = streams.emplace_back();
+      st.name = fmt::format("oracle {:g}/{:g}", ratio, exponent);
+      st.oracleRatio = ratio;
+      st.oracleExponent = exponent;
+      st.options.deadzone = o.deadzone;
     }
-    session::SurfaceLighting lighting = firstLighting;  // its lights follow the scene
-    std::vector<glm::vec3> direct;                      // sampleDirectLight, again when the lights move
-    std::vector<float> litWeights;                      // blended over the updates, as the producer does
-    if (!seenSurfaces.empty()) direct = session::sampleDirectLight(first, seenSurfaces, lighting);
-    for (float exponent : o.oracleExponents)
-      for (float ratio : o.oracleErrorRatios) {
-        Stream& s = streams.emplace_back();
-        s.name = fmt::format("oracle {:g}/{:g}", ratio, exponent);
-        s.oracleRatio = ratio;
-        s.oracleExponent = exponent;
-        s.options.deadzone = o.deadzone;
-      }
-    for (Stream& s : streams) {
-      s.encoder = std::make_unique<StreamEncoder>(layout, s.options);
-      // The views' own weights: a probe's active flag in this updater may differ from the truth's.
-      if (!s.viewWeights.empty() && !s.encoder->setViewWeights(s.viewWeights))
-        throw std::runtime_error("bench adaptive: no probe shows in the scored views");
+  return streams;
+}
+
+// The scored views' surfaces and the light on them, for the "surface" and "lit" view weights; the
+// light follows the scene as it moves.
+struct SeenSurfaces {
+  std::vector<session::ViewSample> samples;  // empty: neither weight
+  session::SurfaceLighting lighting;
+  std::vector<glm::vec3> direct;  // sampleDirectLight, again when the lights move
+  std::vector<float> litWeights;  // blended over the updates, as the producer does
+};
+
+// One rule with one seed through the three phases: what it measured.
+struct RuleRun {
+  BlendRule rule;
+  uint32_t seed = 0;
+  uint32_t activeProbes = 0;
+  std::vector<double> changes;     // per update: the volume's relative irradiance change
+  std::vector<uint32_t> restarts;  // per update: probes whose history was rejected
+  std::vector<Stream> streams;     // each with its bytes, held changes and scores
+};
+
+// Every stream takes the update's volume (the oracles what they choose of it) and writes its frame.
+void encodeUpdate(const Setup& s, const Truth& truth, uint32_t f, const ProbeVolume& v, std::vector<Stream>& streams) {
+  std::vector<float> oracleInput;
+  std::vector<uint8_t> frame;
+  for (Stream& st : streams) {
+    const float* input = v.probes.data();
+    if (st.oracleRatio > 0.0f) {
+      // What knows the truth: re-send the fewest probes (largest error cut first) that bring the
+      // held volume's error to the stream's ratio × the full stream's; the rest input what is held.
+      oracleSelect(truth.probes(s.tAt(f)).data(), v.probes.data(), v.active.data(), streams[0].encoder->reconstruction(),
+                   st.encoder->reconstruction(), s.count, st.oracleRatio, st.oracleExponent, oracleInput);
+      input = oracleInput.data();
     }
-    std::vector<float> oracleInput;
-    std::vector<double> changes;
-    std::vector<uint32_t> restarts;
-    std::vector<float> previous;
-    nlohmann::json ruleJson = {{"rule", ruleName(rule)}, {"w_min", rule.wMin}, {"reject_sigmas", rule.rejectSigmas}};
-    // psnr[stream][moment]: one value per scored update.
-    std::vector<std::vector<std::vector<double>>> psnr(streams.size(), std::vector<std::vector<double>>(moments.size()));
-    // probeError[stream][moment]: the held volume's relative irradiance RMSE against the converged one.
-    std::vector<std::vector<std::vector<double>>> probeError = psnr;
-    // probeErrorEach[stream][moment]: the same, each probe relative to its own energy (dim ones count as much).
-    std::vector<std::vector<std::vector<double>>> probeErrorEach = psnr;
-    std::vector<uint8_t> frame;
-    for (uint32_t f = 0; f < frames; ++f) {
-      if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) {
-        const scene::Scene now = sceneAt(tAt(f));
-        u.setScene(now);
-        if (!seenSurfaces.empty() && now.lights != lighting.lights) {
-          lighting.lights = now.lights;
-          direct = session::sampleDirectLight(now, seenSurfaces, lighting);
-        }
-      }
-      restarts.push_back(u.update().restartedProbes);
-      const ProbeVolume& v = u.volume();
-      if (o.viewWeights == "lit") {
-        session::blendViewWeights(litWeights, session::probeViewSensitivity(seenSurfaces, direct, lighting, v.probes, count));
-        if (!streams[2].encoder->setViewWeights(litWeights))
-          streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
-      }
-      changes.push_back(previous.empty() ? 0.0 : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), count));
-      previous = v.probes;
-      for (Stream& s : streams) {
-        const float* input = v.probes.data();
-        if (s.oracleRatio > 0.0f) {
-          // What knows the truth: re-send the fewest probes (largest error cut first) that bring the
-          // held volume's error to the stream's ratio × the full stream's; the rest input what is held.
-          oracleSelect(truthProbes.at(tAt(f)).data(), v.probes.data(), v.active.data(), streams[0].encoder->reconstruction(),
-                       s.encoder->reconstruction(), count, s.oracleRatio, s.oracleExponent, oracleInput);
-          input = oracleInput.data();
-        }
-        const uint32_t changed = s.encoder->update(input, v.active.data(), s.withNoise ? v.noise.data() : nullptr,
-                                                   s.withNoise ? v.stillUpdates.data() : nullptr);
-        s.encoder->writeChangedFrame(frame);
-        // Frame 0 is the keyframe; a frame that changes no brick is never sent.
-        s.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / count);
-        ProbeVolume held;
-        s.encoder->copyVolume(grid.bounds, held);
-        s.heldChanges.push_back(s.held.empty() ? 0.0
-                                               : irradianceRmseRel(held.probes.data(), s.held.data(),
-                                                                   held.active.data(), count));
-        s.held = std::move(held.probes);
-      }
-      for (size_t m = 0; m < moments.size(); ++m) {
-        if (f < moments[m].first || f > moments[m].frame) continue;
-        for (size_t k = 0; k < streams.size(); ++k) {
-          ProbeVolume held;
-          streams[k].encoder->copyVolume(grid.bounds, held);
-          probeError[k][m].push_back(irradianceRmseRel(held.probes.data(), truthProbes.at(tAt(f)).data(),
-                                                       held.active.data(), count));
-          probeErrorEach[k][m].push_back(irradianceRmseRelPerProbe(held.probes.data(), truthProbes.at(tAt(f)).data(),
-                                                                   held.active.data(), count));
-          psnr[k][m].push_back(psnrOf(render(held, tAt(f)), truthImages.at(tAt(f))));
-        }
-      }
-    }
-    const auto flickerOver = [&](uint32_t end) {
-      const std::vector<double> tail(changes.begin() + (end - o.stillUpdates / 2), changes.begin() + end);
-      return session::median(tail);
-    };
-    ruleJson["flicker_rel"] = flickerOver(frames);
-    ruleJson["restarted_probes_per_update"] = restarts;
-    ruleJson["flicker_rel_first_still"] = flickerOver(o.stillUpdates);
-    for (size_t k = 0; k < streams.size(); ++k) {
-      const Stream& s = streams[k];
-      const size_t a = o.stillUpdates, b = o.stillUpdates + o.movingUpdates;
-      nlohmann::json sj = {{"stream", s.name},
-                           {"static_bytes_per_probe_frame", mean(s.bytesPerProbe, frames - o.stillUpdates / 2, frames)},
-                           {"first_still_bytes_per_probe_frame", mean(s.bytesPerProbe, a / 2, a)},
-                           {"moving_bytes_per_probe_frame", mean(s.bytesPerProbe, a, b)},
-                           {"bytes_per_probe_frame", s.bytesPerProbe}};
-      // Flicker of what a subscriber holds, over the last half of the second still phase: the
-      // median as for the volume, and the mean, which counts the updates that change nothing.
-      const std::vector<double> heldTail(s.heldChanges.end() - o.stillUpdates / 2, s.heldChanges.end());
-      sj["held_flicker_rel_median"] = session::median(heldTail);
-      sj["held_flicker_rel_mean"] = mean(heldTail, 0, heldTail.size());
-      double worstLoss = 0;
-      for (size_t m = 0; m < moments.size(); ++m) {
-        // The loss is paired update by update against the stream that sends every change (same
-        // noise in the volume, same truth), then averaged; its standard error says what it resolves.
-        const std::vector<double>& mine = psnr[k][m];
-        std::vector<double> loss(mine.size());
-        for (size_t i = 0; i < mine.size(); ++i) loss[i] = psnr[0][m][i] - mine[i];
-        const double meanLoss = mean(loss, 0, loss.size());
-        double var = 0;
-        for (double x : loss) var += (x - meanLoss) * (x - meanLoss);
-        const double se = loss.size() > 1 ? std::sqrt(var / static_cast<double>(loss.size() - 1) / static_cast<double>(loss.size())) : 0.0;
-        sj["psnr_db"][moments[m].name] = mean(mine, 0, mine.size());
-        sj["probe_error_rel"][moments[m].name] = mean(probeError[k][m], 0, probeError[k][m].size());
-        sj["probe_error_rel_per_probe"][moments[m].name] = mean(probeErrorEach[k][m], 0, probeErrorEach[k][m].size());
-        sj["psnr_loss_db"][moments[m].name] = meanLoss;
-        sj["psnr_loss_standard_error_db"][moments[m].name] = se;
-        sj["psnr_loss_db_per_update"][moments[m].name] = loss;
-        worstLoss = std::max(worstLoss, meanLoss);
-      }
-      sj["worst_psnr_loss_db"] = worstLoss;
-      if (!firstSeed) {
-        ruleJson["streams"].push_back(sj);
-        continue;
-      }
-      table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>10.2f}% {:>8.3f} dB\n", ruleName(rule),
-                           s.name, mean(s.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),
-                           sj["static_bytes_per_probe_frame"].get<double>(), 100 * ruleJson["flicker_rel"].get<double>(),
-                           100 * sj["held_flicker_rel_mean"].get<double>(), worstLoss);
-      ruleJson["streams"].push_back(sj);
-      if (s.name == "full") continue;
-      const bool adaptiveNoise = rule.rejectSigmas > 0 && s.withNoise;
-      if (!adaptiveNoise && s.withNoise) continue;  // the chart: fixed rules as streamed today, adaptive both ways
-      imaging::ChartSeries series{ruleName(rule) + ", " + s.name + " stream", {}, true};
-      for (uint32_t f = 1; f < frames; ++f) series.points.push_back({static_cast<double>(f), s.bytesPerProbe[f], ""});
-      bytesSeries.push_back(std::move(series));
-    }
-    ruleJson["seed"] = seed;
-    if (rule.rejectSigmas > 0) adaptiveBySeed.push_back(ruleJson);
-    if (firstSeed) j["rules"].push_back(std::move(ruleJson));
+    const uint32_t changed = st.encoder->update(input, v.active.data(), st.withNoise ? v.noise.data() : nullptr,
+                                                st.withNoise ? v.stillUpdates.data() : nullptr);
+    st.encoder->writeChangedFrame(frame);
+    // Frame 0 is the keyframe; a frame that changes no brick is never sent.
+    st.bytesPerProbe.push_back(f == 0 || changed == 0 ? 0.0 : static_cast<double>(frame.size()) / s.count);
+    ProbeVolume held;
+    st.encoder->copyVolume(s.grid.bounds, held);
+    st.heldChanges.push_back(st.held.empty() ? 0.0
+                                             : irradianceRmseRel(held.probes.data(), st.held.data(), held.active.data(),
+                                                                 s.count));
+    st.held = std::move(held.probes);
   }
-  if (streamSeeds > 1) addSeedSummary(adaptiveBySeed, o, r);
-  imaging::ChartSpec bytesSpec;
-  bytesSpec.title = fmt::format("Wire bytes per probe per frame: light still, moving (updates {}-{}), still", o.stillUpdates,
-                                o.stillUpdates + o.movingUpdates);
-  bytesSpec.xLabel = "update";
-  bytesSpec.yLabel = "bytes per probe per frame";
-  bytesSpec.footnote = o.command;
-  r.svgBytes = imaging::renderSvgChart(bytesSpec, bytesSeries);
+}
 
-  say("adaptive bench: light jump");
+// At a scored update: what each stream holds against the truth, as probes and as images.
+void scoreUpdate(const Setup& s, const Truth& truth, uint32_t f, std::vector<Stream>& streams) {
+  for (size_t m = 0; m < s.moments.size(); ++m) {
+    if (f < s.moments[m].first || f > s.moments[m].frame) continue;
+    const std::vector<float>& converged = truth.probes(s.tAt(f));
+    for (Stream& st : streams) {
+      ProbeVolume held;
+      st.encoder->copyVolume(s.grid.bounds, held);
+      st.probeError[m].push_back(irradianceRmseRel(held.probes.data(), converged.data(), held.active.data(), s.count));
+      st.probeErrorEach[m].push_back(
+          irradianceRmseRelPerProbe(held.probes.data(), converged.data(), held.active.data(), s.count));
+      st.psnr[m].push_back(s.psnrOf(s.render(held, s.tAt(f)), truth.images(s.tAt(f))));
+    }
+  }
+}
+
+renderer::UpdaterOptions updaterOptions(const AdaptiveBenchOptions& o, uint32_t seed, const BlendRule& rule) {
+  renderer::UpdaterOptions uo;
+  uo.samplesPerProbe = o.samplesPerProbe;
+  uo.seed = seed;
+  uo.minBlendWeight = rule.wMin;
+  uo.rejectSigmas = rule.rejectSigmas;
+  uo.neighbourHistory = rule.rejectSigmas > 0 ? o.neighbourHistory : 0.0f;
+  uo.changeHistory = rule.rejectSigmas > 0 ? o.changeHistory : 0.0f;
+  uo.surfaceProbesOnly = o.surfaceProbesOnly;
+  return uo;
+}
+
+RuleRun runRule(const Setup& s, const Truth& truth, const std::vector<float>& footprint, uint32_t seed,
+                const BlendRule& rule) {
+  const AdaptiveBenchOptions& o = s.o;
+  renderer::ProbeUpdater u(s.context, s.first, s.grid, updaterOptions(o, seed, rule));
+  RuleRun run{rule, seed, s.count - u.classifyStats().inactive, {}, {}, makeStreams(s, footprint)};
+  std::vector<Stream>& streams = run.streams;
+  SeenSurfaces seen;
+  seen.lighting = s.firstLighting;
+  if (o.viewWeights == "surface" || o.viewWeights == "lit") {
+    seen.samples = session::sampleViewSurfaces(s.first, s.grid, u.volume().active, {}, s.serverViews, s.sampleSize.x,
+                                               s.sampleSize.y);
+    if (o.viewWeights == "surface") streams[2].viewWeights = session::probeViewFootprints(seen.samples, s.count);
+  }
+  if (!seen.samples.empty()) seen.direct = session::sampleDirectLight(s.first, seen.samples, seen.lighting);
+  for (Stream& st : streams) {
+    st.encoder = std::make_unique<StreamEncoder>(s.layout, st.options);
+    // The views' own weights: a probe's active flag in this updater may differ from the truth's.
+    if (!st.viewWeights.empty() && !st.encoder->setViewWeights(st.viewWeights))
+      throw std::runtime_error("bench adaptive: no probe shows in the scored views");
+    st.psnr.assign(s.moments.size(), {});
+    st.probeError = st.probeErrorEach = st.psnr;
+  }
+  std::vector<float> previous;
+  for (uint32_t f = 0; f < s.frames; ++f) {
+    if (f >= o.stillUpdates && f < o.stillUpdates + o.movingUpdates) {
+      const scene::Scene now = s.sceneAt(s.tAt(f));
+      u.setScene(now);
+      if (!seen.samples.empty() && now.lights != seen.lighting.lights) {
+        seen.lighting.lights = now.lights;
+        seen.direct = session::sampleDirectLight(now, seen.samples, seen.lighting);
+      }
+    }
+    run.restarts.push_back(u.update().restartedProbes);
+    const ProbeVolume& v = u.volume();
+    if (o.viewWeights == "lit") {
+      session::blendViewWeights(seen.litWeights, session::probeViewSensitivity(seen.samples, seen.direct, seen.lighting,
+                                                                               v.probes, s.count));
+      if (!streams[2].encoder->setViewWeights(seen.litWeights))
+        streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
+    }
+    run.changes.push_back(previous.empty() ? 0.0
+                                           : irradianceRmseRel(v.probes.data(), previous.data(), v.active.data(), s.count));
+    previous = v.probes;
+    encodeUpdate(s, truth, f, v, streams);
+    scoreUpdate(s, truth, f, streams);
+  }
+  return run;
+}
+
+// A stream's figures: bytes per phase, the flicker of what it holds, and per scored moment its
+// PSNR, probe error and PSNR loss against the full stream.
+nlohmann::json streamJson(const Setup& s, const RuleRun& run, const Stream& st) {
+  const AdaptiveBenchOptions& o = s.o;
+  const size_t a = o.stillUpdates, b = o.stillUpdates + o.movingUpdates;
+  nlohmann::json sj = {{"stream", st.name},
+                       {"static_bytes_per_probe_frame", mean(st.bytesPerProbe, s.frames - o.stillUpdates / 2, s.frames)},
+                       {"first_still_bytes_per_probe_frame", mean(st.bytesPerProbe, a / 2, a)},
+                       {"moving_bytes_per_probe_frame", mean(st.bytesPerProbe, a, b)},
+                       {"bytes_per_probe_frame", st.bytesPerProbe}};
+  // Flicker of what a subscriber holds, over the last half of the second still phase: the
+  // median as for the volume, and the mean, which counts the updates that change nothing.
+  const std::vector<double> heldTail(st.heldChanges.end() - o.stillUpdates / 2, st.heldChanges.end());
+  sj["held_flicker_rel_median"] = session::median(heldTail);
+  sj["held_flicker_rel_mean"] = mean(heldTail, 0, heldTail.size());
+  double worstLoss = 0;
+  for (size_t m = 0; m < s.moments.size(); ++m) {
+    // The loss is paired update by update against the stream that sends every change (same
+    // noise in the volume, same truth), then averaged; its standard error says what it resolves.
+    const std::vector<double>& mine = st.psnr[m];
+    std::vector<double> loss(mine.size());
+    for (size_t i = 0; i < mine.size(); ++i) loss[i] = run.streams[0].psnr[m][i] - mine[i];
+    const double meanLoss = mean(loss, 0, loss.size());
+    double var = 0;
+    for (double x : loss) var += (x - meanLoss) * (x - meanLoss);
+    const double se = loss.size() > 1 ? std::sqrt(var / static_cast<double>(loss.size() - 1) / static_cast<double>(loss.size())) : 0.0;
+    const char* moment = s.moments[m].name;
+    sj["psnr_db"][moment] = mean(mine, 0, mine.size());
+    sj["probe_error_rel"][moment] = mean(st.probeError[m], 0, st.probeError[m].size());
+    sj["probe_error_rel_per_probe"][moment] = mean(st.probeErrorEach[m], 0, st.probeErrorEach[m].size());
+    sj["psnr_loss_db"][moment] = meanLoss;
+    sj["psnr_loss_standard_error_db"][moment] = se;
+    sj["psnr_loss_db_per_update"][moment] = loss;
+    worstLoss = std::max(worstLoss, meanLoss);
+  }
+  sj["worst_psnr_loss_db"] = worstLoss;
+  return sj;
+}
+
+// A rule's JSON; for the first seed also its table rows and its streams on the bytes chart (fixed
+// rules as streamed today, the adaptive rule both ways).
+nlohmann::json reportRule(const Setup& s, const RuleRun& run, bool firstSeed, std::string& table,
+                          std::vector<imaging::ChartSeries>& bytesSeries) {
+  const AdaptiveBenchOptions& o = s.o;
+  nlohmann::json ruleJson = {{"rule", ruleName(run.rule)}, {"w_min", run.rule.wMin}, {"reject_sigmas", run.rule.rejectSigmas}};
+  const auto flickerOver = [&](uint32_t end) {
+    const std::vector<double> tail(run.changes.begin() + (end - o.stillUpdates / 2), run.changes.begin() + end);
+    return session::median(tail);
+  };
+  ruleJson["flicker_rel"] = flickerOver(s.frames);
+  ruleJson["restarted_probes_per_update"] = run.restarts;
+  ruleJson["flicker_rel_first_still"] = flickerOver(o.stillUpdates);
+  for (const Stream& st : run.streams) {
+    const nlohmann::json sj = streamJson(s, run, st);
+    ruleJson["streams"].push_back(sj);
+    if (!firstSeed) continue;
+    const size_t a = o.stillUpdates;
+    table += fmt::format("{:<14} {:<7} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f}% {:>10.2f}% {:>8.3f} dB\n", ruleName(run.rule),
+                         st.name, mean(st.bytesPerProbe, a / 2, a), sj["moving_bytes_per_probe_frame"].get<double>(),
+                         sj["static_bytes_per_probe_frame"].get<double>(), 100 * ruleJson["flicker_rel"].get<double>(),
+                         100 * sj["held_flicker_rel_mean"].get<double>(), sj["worst_psnr_loss_db"].get<double>());
+    if (st.name == "full") continue;
+    const bool adaptiveNoise = run.rule.rejectSigmas > 0 && st.withNoise;
+    if (!adaptiveNoise && st.withNoise) continue;
+    imaging::ChartSeries series{ruleName(run.rule) + ", " + st.name + " stream", {}, true};
+    for (uint32_t f = 1; f < s.frames; ++f) series.points.push_back({static_cast<double>(f), st.bytesPerProbe[f], ""});
+    bytesSeries.push_back(std::move(series));
+  }
+  ruleJson["seed"] = run.seed;
+  return ruleJson;
+}
+
+std::string bytesChart(const AdaptiveBenchOptions& o, const std::vector<imaging::ChartSeries>& bytesSeries) {
+  imaging::ChartSpec spec;
+  spec.title = fmt::format("Wire bytes per probe per frame: light still, moving (updates {}-{}), still", o.stillUpdates,
+                           o.stillUpdates + o.movingUpdates);
+  spec.xLabel = "update";
+  spec.yLabel = "bytes per probe per frame";
+  spec.footnote = o.command;
+  return imaging::renderSvgChart(spec, bytesSeries);
+}
+
+// Every rule after a light jump on builtin:cornell 4³: the JSON, table lines and the error chart.
+void addJump(renderer::VulkanContext& context, const AdaptiveBenchOptions& o, const std::vector<BlendRule>& rules,
+             AdaptiveBenchResult& r) {
+  sayProgress(o.progress, "adaptive bench: light jump");
   const std::vector<FlickerLag> jump = measureFlickerLag(context, rules, o.samplesPerProbe, o.jumpUpdates);
+  const auto updates = [&](int n) { return n < 0 ? "> " + std::to_string(o.jumpUpdates) : std::to_string(n); };
+  const auto errorSeries = [](const std::string& name, const std::vector<double>& error) {
+    imaging::ChartSeries series{name, {}, true};
+    for (size_t k = 0; k < error.size(); ++k) series.points.push_back({static_cast<double>(k + 1), error[k], ""});
+    return series;
+  };
   std::vector<imaging::ChartSeries> jumpSeries;
-  table += "light jump (builtin:cornell 4x4x4, t 0 -> 0.5):\n";
+  r.table += "light jump (builtin:cornell 4x4x4, t 0 -> 0.5):\n";
   for (size_t i = 0; i < jump.size(); ++i) {
     const FlickerLag& f = jump[i];
-    j["jump"].push_back({{"rule", ruleName(rules[i])},
-                         {"flicker_rel", f.flickerRel},
-                         {"error_before_jump", f.errorBeforeJump},
-                         {"error_after_jump", f.errorAfterJump},
-                         {"fresh_error", f.freshError},
-                         {"follow_updates", f.updatesToFollow},
-                         {"reconvergence_updates", f.updatesToRecover}});
-    table += fmt::format("  {:<14} follows in {} updates, back to the pre-jump error in {} (flicker {:.2f}%)\n",
-                         ruleName(rules[i]), f.updatesToFollow < 0 ? "> " + std::to_string(o.jumpUpdates) : std::to_string(f.updatesToFollow),
-                         f.updatesToRecover < 0 ? "> " + std::to_string(o.jumpUpdates) : std::to_string(f.updatesToRecover),
-                         100 * f.flickerRel);
-    imaging::ChartSeries series{ruleName(rules[i]), {}, true};
-    for (size_t k = 0; k < f.errorAfterJump.size(); ++k)
-      series.points.push_back({static_cast<double>(k + 1), f.errorAfterJump[k], ""});
-    jumpSeries.push_back(std::move(series));
+    r.json["jump"].push_back({{"rule", ruleName(rules[i])},
+                              {"flicker_rel", f.flickerRel},
+                              {"error_before_jump", f.errorBeforeJump},
+                              {"error_after_jump", f.errorAfterJump},
+                              {"fresh_error", f.freshError},
+                              {"follow_updates", f.updatesToFollow},
+                              {"reconvergence_updates", f.updatesToRecover}});
+    r.table += fmt::format("  {:<14} follows in {} updates, back to the pre-jump error in {} (flicker {:.2f}%)\n",
+                           ruleName(rules[i]), updates(f.updatesToFollow), updates(f.updatesToRecover), 100 * f.flickerRel);
+    jumpSeries.push_back(errorSeries(ruleName(rules[i]), f.errorAfterJump));
   }
-  imaging::ChartSeries freshSeries{"fresh start on the new lighting", {}, true};
-  for (size_t k = 0; k < jump.back().freshError.size(); ++k)
-    freshSeries.points.push_back({static_cast<double>(k + 1), jump.back().freshError[k], ""});
-  jumpSeries.push_back(std::move(freshSeries));
-  imaging::ChartSpec jumpSpec;
-  jumpSpec.title = "Irradiance error after the light jumps (builtin:cornell, 4x4x4)";
-  jumpSpec.xLabel = "updates after the jump";
-  jumpSpec.yLabel = "relative irradiance RMSE against the converged new lighting";
-  jumpSpec.logY = true;
-  jumpSpec.footnote = o.command;
-  r.svgJump = imaging::renderSvgChart(jumpSpec, jumpSeries);
+  jumpSeries.push_back(errorSeries("fresh start on the new lighting", jump.back().freshError));
+  imaging::ChartSpec spec;
+  spec.title = "Irradiance error after the light jumps (builtin:cornell, 4x4x4)";
+  spec.xLabel = "updates after the jump";
+  spec.yLabel = "relative irradiance RMSE against the converged new lighting";
+  spec.logY = true;
+  spec.footnote = o.command;
+  r.svgJump = imaging::renderSvgChart(spec, jumpSeries);
+}
 
-  // The headline: the adaptive rule with the noise-aware stream.
+// The headline: the adaptive rule with the noise-aware stream.
+void addSummary(nlohmann::json& j) {
   const nlohmann::json& adaptive = j["rules"].back();
   const nlohmann::json& noise = adaptive["streams"][2];
   j["summary"] = {{"static_bytes_per_probe_frame", noise["static_bytes_per_probe_frame"]},
@@ -656,6 +725,61 @@ AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
                   {"follow_updates", j["jump"].back()["follow_updates"]},
                   {"reconvergence_updates", j["jump"].back()["reconvergence_updates"]},
                   {"worst_psnr_loss_db", noise["worst_psnr_loss_db"]}};
+}
+
+// The fixed rules, then the adaptive one; the adaptive rule again with each further seed (its
+// figures per seed; the tables and charts are the first seed's).
+std::vector<std::pair<uint32_t, BlendRule>> ruleRuns(const AdaptiveBenchOptions& o, const std::vector<BlendRule>& rules) {
+  std::vector<std::pair<uint32_t, BlendRule>> runs;  // (seed, rule)
+  for (uint32_t extra = 0; extra < std::max(o.streamSeeds, 1u); ++extra)
+    for (const BlendRule& rule : rules)
+      if (extra == 0 || rule.rejectSigmas > 0) runs.push_back({o.seed + extra, rule});
+  return runs;
+}
+
+}  // namespace
+
+AdaptiveBenchResult runAdaptiveBench(const AdaptiveBenchOptions& o) {
+  renderer::VulkanContext context(o.context);
+  AdaptiveBenchResult r;
+  if (o.reconvergenceOnly) {
+    r.json["command"] = o.command;
+    r.json["device"] = context.deviceName();
+    r.json["samples_per_probe"] = o.samplesPerProbe;
+    r.json["seed"] = o.seed;
+    addReconvergence(context, o, r);
+    return r;
+  }
+  const Setup s(o, context);
+  // Converged float volumes where images are scored: the end of each phase.
+  Truth truth(s);
+  for (const Moment& m : s.moments)
+    for (uint32_t f = m.first; f <= m.frame; ++f) truth.converge(s.tAt(f), true);
+  const Footprint footprint = o.viewWeights == "footprint" ? measureFootprint(s, truth) : Footprint{};
+  // The oracle stream needs the truth at every update.
+  if (!o.oracleErrorRatios.empty())
+    for (uint32_t f = 0; f < s.frames; ++f) truth.converge(s.tAt(f), false);
+  writeHeader(s, footprint, r);
+
+  std::vector<BlendRule> rules;
+  for (float w : o.fixedWMins) rules.push_back({w, 0.0f});
+  rules.push_back({0.0f, o.rejectSigmas});
+  std::vector<imaging::ChartSeries> bytesSeries;
+  std::vector<nlohmann::json> adaptiveBySeed;
+  for (const auto& [seed, rule] : ruleRuns(o, rules)) {
+    const bool firstSeed = seed == o.seed;
+    sayProgress(o.progress,
+                fmt::format("adaptive bench: {}{}", ruleName(rule), firstSeed ? "" : fmt::format(", seed {}", seed)));
+    const RuleRun run = runRule(s, truth, footprint.weights, seed, rule);
+    if (!r.json.contains("active_probes")) r.json["active_probes"] = run.activeProbes;  // the same for every rule
+    nlohmann::json ruleJson = reportRule(s, run, firstSeed, r.table, bytesSeries);
+    if (rule.rejectSigmas > 0) adaptiveBySeed.push_back(ruleJson);
+    if (firstSeed) r.json["rules"].push_back(std::move(ruleJson));
+  }
+  if (std::max(o.streamSeeds, 1u) > 1) addSeedSummary(adaptiveBySeed, o, r);
+  r.svgBytes = bytesChart(o, bytesSeries);
+  addJump(context, o, rules, r);
+  addSummary(r.json);
   addReconvergence(context, o, r);
   return r;
 }
