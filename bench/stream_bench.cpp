@@ -15,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "harness.h"
 #include "load_client.h"
 #include "probecast/codec/stream.h"
 #include "probecast/service/edge_server.h"
@@ -368,12 +369,7 @@ LoadReport takeAll(std::vector<std::unique_ptr<session::ChildProcess>>& loads) {
   return total;
 }
 
-}  // namespace
-
-StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
-  const auto say = [&](const std::string& s) {
-    if (o.progress) o.progress(s);
-  };
+void checkStreamBenchOptions(const StreamBenchOptions& o) {
   for (int n : o.subscribers)
     if (n < 1) throw std::invalid_argument("subscriber counts must be positive");
   if (o.subscribersPerLoadProcess < 1 || o.sampleEvery < 1 || o.ackIntervalMs < 0)
@@ -382,174 +378,230 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   if (!isValidLayout(streamLayoutFor(session::unitGrid({o.grid[0], o.grid[1], o.grid[2]}), Representation::Zh3, 4)))
     throw std::invalid_argument(fmt::format("a {}x{}x{} grid cannot be streamed (too many probes for the stream format)",
                                             o.grid[0], o.grid[1], o.grid[2]));
-  nlohmann::json runs = nlohmann::json::array();
+}
+
+// One subscriber count: what the server, the load and the check at the end measured.
+struct SubscriberRun {
+  int subscribers = 0;
+  uint32_t connected = 0;
+  int loadProcesses = 0;
+  double seconds = 0;             // the measured window
+  double baselineCores = 0;       // the server publishing to nobody
+  ProcessSample baseline;         // the server at the baseline's end
+  ProcessSample server0, server1;  // the server at the window's start and end
+  LoadReport load0, load1;        // the load clients at the window's start and end
+  service::LatencyHistogram writes;
+  double encodeMs = 0;            // per published frame
+  uint32_t published = 0;
+  SampleCheck samples;            // decoding subscribers holding the producer's volume
+
+  double serverCores() const { return (server1.cpuSeconds - server0.cpuSeconds) / seconds; }
+  double corePerSub() const { return (serverCores() - baselineCores) / subscribers; }
+  double rssKbPerSub() const { return (server1.rssKb - baseline.rssKb) / subscribers; }
+  double bytesPerSub() const { return static_cast<double>(load1.figures.bytes) / seconds / subscribers; }
+  double framesPerSub() const { return static_cast<double>(load1.figures.frames) / seconds / subscribers; }
+  double loadCores() const { return (load1.process.cpuSeconds - load0.process.cpuSeconds) / seconds; }
+  bool identical() const { return samples.sampled > 0 && samples.identical == samples.sampled; }
+  uint64_t errors() const {
+    const LoadFigures& f = load1.figures;
+    return f.sequenceErrors + f.crcErrors + f.decodeErrors + f.streamErrors;
+  }
+};
+
+ProcessSample sampleServers(Topology& topo) {
+  return sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
+}
+
+// Load: separate processes, a share of the `n` subscribers each. Returns once each has said how
+// many of its subscribers connected.
+std::vector<std::unique_ptr<session::ChildProcess>> startLoads(const StreamBenchOptions& o, const Topology& topo, int n,
+                                                               SubscriberRun& run) {
+  run.loadProcesses = (n + o.subscribersPerLoadProcess - 1) / o.subscribersPerLoadProcess;
+  const int processes = run.loadProcesses;
+  std::vector<std::unique_ptr<session::ChildProcess>> loads;
+  for (int k = 0; k < processes; ++k) {
+    LoadClientConfig lc;
+    lc.addresses = topo.addresses;
+    lc.token = kBenchToken;
+    lc.firstIndex = static_cast<uint32_t>(static_cast<int64_t>(n) * k / processes);
+    lc.subscribers = static_cast<uint32_t>(static_cast<int64_t>(n) * (k + 1) / processes) - lc.firstIndex;
+    lc.sampleEvery = static_cast<uint32_t>(o.sampleEvery);
+    lc.ackIntervalMs = static_cast<uint32_t>(o.ackIntervalMs);
+    lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
+    lc.view = [dims = o.grid](uint32_t i) { return randomView(i, dims); };
+    loads.push_back(std::make_unique<session::ChildProcess>(
+        [lc](const session::ChildProcess::Say& s, const session::ChildProcess::Hear& h) { return runLoad(lc, s, h); }));
+    loads.back()->go();
+  }
+  for (auto& l : loads) {
+    std::string line;
+    unsigned c = 0;
+    if (!l->readLine(line) || std::sscanf(line.c_str(), "connected %u", &c) != 1)
+      throw std::runtime_error("load process did not start: " + line);
+    run.connected += c;
+  }
+  return loads;
+}
+
+// The lighting stops; every decoding subscriber must come to hold the producer's volume. Then
+// every process is told to quit.
+void finishRun(Topology& topo, std::vector<std::unique_ptr<session::ChildProcess>>& loads, SubscriberRun& run) {
+  std::string hash;
+  {
+    const std::string fin = ask(*topo.servers[0], "stop", "final", "server");
+    char h[32] = {};
+    if (std::sscanf(fin.c_str(), "%31s %u %lf", h, &run.published, &run.encodeMs) != 3)
+      throw std::runtime_error("server sent a bad final line: " + fin);
+    hash = h;
+  }
+  for (auto& l : loads) {
+    unsigned sampled = 0, identical = 0;
+    const std::string r = ask(*l, "check " + hash, "samples", "load process");
+    if (std::sscanf(r.c_str(), "%u %u", &sampled, &identical) != 2) throw std::runtime_error("bad sample check: " + r);
+    run.samples.sampled += sampled;
+    run.samples.identical += identical;
+  }
+  for (auto& l : loads) {
+    l->tell("quit");
+    l->wait();
+  }
+  for (auto& sv : topo.servers) {
+    sv->tell("quit");
+    sv->wait();
+  }
+}
+
+SubscriberRun measureSubscribers(const StreamBenchOptions& o, int n) {
+  const auto say = [&](const std::string& line) { sayProgress(o.progress, line); };
+  SubscriberRun run;
+  run.subscribers = n;
+  Topology topo = makeTopology(o);
+  say(fmt::format("{} subscribers on {}{}, {:.0f} s at {} Hz", n, topo.addresses[0],
+                  o.edges > 0 ? fmt::format(" and {} more edges (through NATS)", o.edges - 1) : "", o.seconds, o.hz));
+  // Baseline: the producer publishing to nobody.
+  const ProcessSample b0 = sampleServers(topo);
+  auto tb = std::chrono::steady_clock::now();
+  std::this_thread::sleep_for(1500ms);
+  run.baseline = sampleServers(topo);
+  run.baselineCores = (run.baseline.cpuSeconds - b0.cpuSeconds) / secondsSince(tb);
+  std::vector<std::unique_ptr<session::ChildProcess>> loads = startLoads(o, topo, n, run);
+  if (run.connected == 0) throw std::runtime_error("subscribers never connected to " + topo.addresses[0]);
+  if (run.connected < static_cast<uint32_t>(n)) say(fmt::format("only {} of {} subscribers connected", run.connected, n));
+  std::this_thread::sleep_for(1s);  // the first keyframes go out
+  takeAll(loads);
+  takeWriteLatency(topo);
+  run.server0 = sampleServers(topo);
+  const auto t0 = std::chrono::steady_clock::now();
+  run.load0 = takeAll(loads);
+  std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds));
+  run.load1 = takeAll(loads);
+  run.seconds = secondsSince(t0);
+  run.server1 = sampleServers(topo);
+  run.writes = takeWriteLatency(topo);
+  finishRun(topo, loads, run);
+  return run;
+}
+
+nlohmann::json runJson(const StreamBenchOptions& o, const SubscriberRun& run) {
+  const LoadFigures& f = run.load1.figures;
+  return {{"subscribers", run.subscribers},
+          {"topology", o.edges > 0 ? "nats" : "direct"},
+          {"edges", o.edges},
+          {"connected", run.connected},
+          {"hz", o.hz},
+          {"seconds", run.seconds},
+          {"frames_received", f.frames},
+          {"frames_per_subscriber_per_s", run.framesPerSub()},
+          {"produce_to_receive_ms_p50", f.latency.percentileMs(0.5)},
+          {"produce_to_receive_ms_p99", f.latency.percentileMs(0.99)},
+          {"produce_to_receive_ms_max", static_cast<double>(f.latency.maxUs()) / 1000.0},
+          {"publish_to_write_ms_p50", run.writes.percentileMs(0.5)},
+          {"publish_to_write_ms_p99", run.writes.percentileMs(0.99)},
+          {"frames_written", run.writes.count()},
+          {"server_cpu_cores", run.serverCores()},
+          {"server_cpu_cores_baseline", run.baselineCores},
+          {"server_cpu_core_per_subscriber", run.corePerSub()},
+          {"server_rss_mb", run.server1.rssKb / 1024.0},
+          {"server_rss_mb_baseline", run.baseline.rssKb / 1024.0},
+          {"rss_kb_per_subscriber", run.rssKbPerSub()},
+          {"bytes_per_subscriber_per_s", run.bytesPerSub()},
+          {"load_client_cpu_cores", run.loadCores()},
+          {"load_processes", run.loadProcesses},
+          {"encode_ms_per_frame", run.encodeMs},
+          {"frames_published", run.published},
+          {"sequence_errors", f.sequenceErrors},
+          {"crc_errors", f.crcErrors},
+          {"decode_errors", f.decodeErrors},
+          {"stream_errors", f.streamErrors},
+          {"sampled_subscribers", run.samples.sampled},
+          {"sample_bit_identical", run.identical()}};
+}
+
+std::string tableRow(const SubscriberRun& run) {
+  const LoadFigures& f = run.load1.figures;
+  return fmt::format(
+      "{:>6} {:>9.1f} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>9.2f} {:>8.3f} {:>10.5f} {:>8.1f} {:>9.1f} {:>10.0f} "
+      "{:>8.3f} {:>7}\n",
+      run.subscribers, run.framesPerSub(), f.latency.percentileMs(0.5), f.latency.percentileMs(0.99),
+      static_cast<double>(f.latency.maxUs()) / 1000.0, run.writes.percentileMs(0.5), run.writes.percentileMs(0.99),
+      run.serverCores(), run.corePerSub(), run.server1.rssKb / 1024.0, run.rssKbPerSub(), run.bytesPerSub(),
+      run.loadCores(), run.errors());
+}
+
+// What went wrong in a run (empty: nothing).
+std::string runFailures(const SubscriberRun& run) {
+  const LoadFigures& f = run.load1.figures;
+  const int n = run.subscribers;
+  std::string failure;
+  if (!run.identical())
+    failure += fmt::format("{} subscribers: {} of {} decoding subscribers hold the producer's volume; ", n,
+                           run.samples.identical, run.samples.sampled);
+  if (run.errors() != 0)
+    failure += fmt::format("{} subscribers: {} sequence, {} CRC, {} decode, {} stream errors (last: {}); ", n,
+                           f.sequenceErrors, f.crcErrors, f.decodeErrors, f.streamErrors, f.lastError);
+  if (run.connected < static_cast<uint32_t>(n)) failure += fmt::format("{} subscribers: only {} connected; ", n, run.connected);
+  return failure;
+}
+
+nlohmann::json streamJson(const StreamBenchOptions& o, const std::vector<SubscriberRun>& runs) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const SubscriberRun& run : runs) rows.push_back(runJson(o, run));
+  return {{"command", o.command},
+          {"codec_format_version", kFormatVersion},
+          {"volume", fmt::format("{}x{}x{} probes, bricks of 4, {}, dead-zone 1, light circling", o.grid[0], o.grid[1],
+                                 o.grid[2], o.repr)},
+          {"hz", o.hz},
+          {"seconds", o.seconds},
+          {"budget_bytes_per_s", o.budgetBytesPerSecond},
+          {"ack_interval_ms", o.ackIntervalMs},
+          {"topology", o.edges > 0 ? fmt::format("nats: the producer publishes to a nats-server (JetStream); {} edge "
+                                                 "processes serve the subscribers, split evenly; server figures sum "
+                                                 "producer, edges and nats-server", o.edges)
+                                   : std::string("direct: one server process")},
+          {"runs", rows},
+          {"notes",
+           "loopback; the server (producer, hub, gRPC) and the load clients run in separate processes, CPU from "
+           "getrusage in each, as a fraction of one core. produce → receive: a frame's server time (the hub's publish "
+           "of its newest lighting) to its arrival at a load client, same system clock. publish → write: the same "
+           "start to gRPC's write-done on the server. server_cpu_core_per_subscriber and rss_kb_per_subscriber are "
+           "the increase over the server's baseline (publishing to nobody) divided by subscribers. Load clients check "
+           "sequence and CRCs of every frame and ack the newest at most every " +
+               std::to_string(o.ackIntervalMs) + " ms; 1 in " +
+               std::to_string(o.sampleEvery) + " subscribers decodes in full and is compared bit for bit with the "
+               "producer's reconstruction once the lighting stops."}};
+}
+
+// Latency against subscribers: produce → receive p50 and p99, server publish → write-done p99.
+std::string streamChart(const StreamBenchOptions& o, const std::vector<SubscriberRun>& runs) {
   imaging::ChartSeries p50Series{"produce → receive p50", {}, true};
   imaging::ChartSeries p99Series{"produce → receive p99", {}, true};
   imaging::ChartSeries writeSeries{"server publish → write-done p99", {}, true};
-  std::string table = fmt::format("{:>6} {:>9} {:>8} {:>8} {:>8} {:>9} {:>9} {:>8} {:>10} {:>8} {:>9} {:>10} {:>8} {:>7}\n",
-                                  "subs", "frm/s/sub", "p50 ms", "p99 ms", "max ms", "wr p50", "wr p99", "srv cpu",
-                                  "cpu/sub", "rss MB", "KB/sub", "B/s/sub", "load cpu", "errors");
-  std::string failure;
-  for (const int n : o.subscribers) {
-    Topology topo = makeTopology(o);
-    say(fmt::format("{} subscribers on {}{}, {:.0f} s at {} Hz", n, topo.addresses[0],
-                    o.edges > 0 ? fmt::format(" and {} more edges (through NATS)", o.edges - 1) : "", o.seconds, o.hz));
-    // Baseline: the producer publishing to nobody.
-    const ProcessSample b0 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
-    auto tb = std::chrono::steady_clock::now();
-    std::this_thread::sleep_for(1500ms);
-    const ProcessSample b1 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
-    const double baselineCores = (b1.cpuSeconds - b0.cpuSeconds) / secondsSince(tb);
-    // Load: separate processes, a share of the subscribers each.
-    const int processes = (n + o.subscribersPerLoadProcess - 1) / o.subscribersPerLoadProcess;
-    std::vector<std::unique_ptr<session::ChildProcess>> loads;
-    for (int k = 0; k < processes; ++k) {
-      LoadClientConfig lc;
-      lc.addresses = topo.addresses;
-      lc.token = kBenchToken;
-      lc.firstIndex = static_cast<uint32_t>(static_cast<int64_t>(n) * k / processes);
-      lc.subscribers = static_cast<uint32_t>(static_cast<int64_t>(n) * (k + 1) / processes) - lc.firstIndex;
-      lc.sampleEvery = static_cast<uint32_t>(o.sampleEvery);
-      lc.ackIntervalMs = static_cast<uint32_t>(o.ackIntervalMs);
-      lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
-      lc.view = [dims = o.grid](uint32_t i) { return randomView(i, dims); };
-      loads.push_back(std::make_unique<session::ChildProcess>(
-          [lc](const session::ChildProcess::Say& s, const session::ChildProcess::Hear& h) { return runLoad(lc, s, h); }));
-      loads.back()->go();
-    }
-    uint32_t connected = 0;
-    for (auto& l : loads) {
-      std::string line;
-      unsigned c = 0;
-      if (!l->readLine(line) || std::sscanf(line.c_str(), "connected %u", &c) != 1)
-        throw std::runtime_error("load process did not start: " + line);
-      connected += c;
-    }
-    if (connected == 0) throw std::runtime_error("subscribers never connected to " + topo.addresses[0]);
-    if (connected < static_cast<uint32_t>(n))
-      say(fmt::format("only {} of {} subscribers connected", connected, n));
-    std::this_thread::sleep_for(1s);  // the first keyframes go out
-    takeAll(loads);
-    takeWriteLatency(topo);
-    const ProcessSample s0 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
-    const auto t0 = std::chrono::steady_clock::now();
-    const LoadReport l0 = takeAll(loads);
-    std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds));
-    const LoadReport l1 = takeAll(loads);
-    const double dt = secondsSince(t0);
-    const ProcessSample s1 = sampleAll(topo.servers, "server", topo.nats ? topo.nats->pid() : -1);
-    const service::LatencyHistogram writes = takeWriteLatency(topo);
-    // The lighting stops; every decoding subscriber must come to hold the producer's volume.
-    std::string hash;
-    double encodeMs = 0;
-    uint32_t published = 0;
-    {
-      const std::string fin = ask(*topo.servers[0], "stop", "final", "server");
-      char h[32] = {};
-      if (std::sscanf(fin.c_str(), "%31s %u %lf", h, &published, &encodeMs) != 3)
-        throw std::runtime_error("server sent a bad final line: " + fin);
-      hash = h;
-    }
-    SampleCheck samples;
-    for (auto& l : loads) {
-      unsigned sampled = 0, identical = 0;
-      const std::string r = ask(*l, "check " + hash, "samples", "load process");
-      if (std::sscanf(r.c_str(), "%u %u", &sampled, &identical) != 2) throw std::runtime_error("bad sample check: " + r);
-      samples.sampled += sampled;
-      samples.identical += identical;
-    }
-    for (auto& l : loads) {
-      l->tell("quit");
-      l->wait();
-    }
-    for (auto& s : topo.servers) {
-      s->tell("quit");
-      s->wait();
-    }
-    const LoadFigures& f = l1.figures;
-    const double serverCores = (s1.cpuSeconds - s0.cpuSeconds) / dt;
-    const double corePerSub = (serverCores - baselineCores) / n;
-    const double rssKbPerSub = (s1.rssKb - b1.rssKb) / n;
-    const double bytesPerSub = static_cast<double>(f.bytes) / dt / n;
-    const double loadCores = (l1.process.cpuSeconds - l0.process.cpuSeconds) / dt;
-    const bool identical = samples.sampled > 0 && samples.identical == samples.sampled;
-    const uint64_t errors = f.sequenceErrors + f.crcErrors + f.decodeErrors + f.streamErrors;
-    const nlohmann::json run = {
-        {"subscribers", n},
-        {"topology", o.edges > 0 ? "nats" : "direct"},
-        {"edges", o.edges},
-        {"connected", connected},
-        {"hz", o.hz},
-        {"seconds", dt},
-        {"frames_received", f.frames},
-        {"frames_per_subscriber_per_s", static_cast<double>(f.frames) / dt / n},
-        {"produce_to_receive_ms_p50", f.latency.percentileMs(0.5)},
-        {"produce_to_receive_ms_p99", f.latency.percentileMs(0.99)},
-        {"produce_to_receive_ms_max", static_cast<double>(f.latency.maxUs()) / 1000.0},
-        {"publish_to_write_ms_p50", writes.percentileMs(0.5)},
-        {"publish_to_write_ms_p99", writes.percentileMs(0.99)},
-        {"frames_written", writes.count()},
-        {"server_cpu_cores", serverCores},
-        {"server_cpu_cores_baseline", baselineCores},
-        {"server_cpu_core_per_subscriber", corePerSub},
-        {"server_rss_mb", s1.rssKb / 1024.0},
-        {"server_rss_mb_baseline", b1.rssKb / 1024.0},
-        {"rss_kb_per_subscriber", rssKbPerSub},
-        {"bytes_per_subscriber_per_s", bytesPerSub},
-        {"load_client_cpu_cores", loadCores},
-        {"load_processes", processes},
-        {"encode_ms_per_frame", encodeMs},
-        {"frames_published", published},
-        {"sequence_errors", f.sequenceErrors},
-        {"crc_errors", f.crcErrors},
-        {"decode_errors", f.decodeErrors},
-        {"stream_errors", f.streamErrors},
-        {"sampled_subscribers", samples.sampled},
-        {"sample_bit_identical", identical}};
-    runs.push_back(run);
-    table += fmt::format(
-        "{:>6} {:>9.1f} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>9.2f} {:>8.3f} {:>10.5f} {:>8.1f} {:>9.1f} {:>10.0f} "
-        "{:>8.3f} {:>7}\n",
-        n, static_cast<double>(f.frames) / dt / n, f.latency.percentileMs(0.5), f.latency.percentileMs(0.99),
-        static_cast<double>(f.latency.maxUs()) / 1000.0, writes.percentileMs(0.5), writes.percentileMs(0.99),
-        serverCores, corePerSub, s1.rssKb / 1024.0, rssKbPerSub, bytesPerSub, loadCores, errors);
-    p50Series.points.push_back({static_cast<double>(n), std::max(1e-3, f.latency.percentileMs(0.5)), ""});
-    p99Series.points.push_back({static_cast<double>(n), std::max(1e-3, f.latency.percentileMs(0.99)), ""});
-    writeSeries.points.push_back({static_cast<double>(n), std::max(1e-3, writes.percentileMs(0.99)), ""});
-    if (!identical)
-      failure += fmt::format("{} subscribers: {} of {} decoding subscribers hold the producer's volume; ", n,
-                             samples.identical, samples.sampled);
-    if (errors != 0)
-      failure += fmt::format("{} subscribers: {} sequence, {} CRC, {} decode, {} stream errors (last: {}); ", n,
-                             f.sequenceErrors, f.crcErrors, f.decodeErrors, f.streamErrors, f.lastError);
-    if (connected < static_cast<uint32_t>(n)) failure += fmt::format("{} subscribers: only {} connected; ", n, connected);
+  for (const SubscriberRun& run : runs) {
+    const auto n = static_cast<double>(run.subscribers);
+    p50Series.points.push_back({n, std::max(1e-3, run.load1.figures.latency.percentileMs(0.5)), ""});
+    p99Series.points.push_back({n, std::max(1e-3, run.load1.figures.latency.percentileMs(0.99)), ""});
+    writeSeries.points.push_back({n, std::max(1e-3, run.writes.percentileMs(0.99)), ""});
   }
-  StreamBenchResult r;
-  r.json = {{"command", o.command},
-            {"codec_format_version", kFormatVersion},
-            {"volume", fmt::format("{}x{}x{} probes, bricks of 4, {}, dead-zone 1, light circling", o.grid[0], o.grid[1],
-                                   o.grid[2], o.repr)},
-            {"hz", o.hz},
-            {"seconds", o.seconds},
-            {"budget_bytes_per_s", o.budgetBytesPerSecond},
-            {"ack_interval_ms", o.ackIntervalMs},
-            {"topology", o.edges > 0 ? fmt::format("nats: the producer publishes to a nats-server (JetStream); {} edge "
-                                                   "processes serve the subscribers, split evenly; server figures sum "
-                                                   "producer, edges and nats-server", o.edges)
-                                     : std::string("direct: one server process")},
-            {"runs", runs},
-            {"notes",
-             "loopback; the server (producer, hub, gRPC) and the load clients run in separate processes, CPU from "
-             "getrusage in each, as a fraction of one core. produce → receive: a frame's server time (the hub's publish "
-             "of its newest lighting) to its arrival at a load client, same system clock. publish → write: the same "
-             "start to gRPC's write-done on the server. server_cpu_core_per_subscriber and rss_kb_per_subscriber are "
-             "the increase over the server's baseline (publishing to nobody) divided by subscribers. Load clients check "
-             "sequence and CRCs of every frame and ack the newest at most every " +
-                 std::to_string(o.ackIntervalMs) + " ms; 1 in " +
-                 std::to_string(o.sampleEvery) + " subscribers decodes in full and is compared bit for bit with the "
-                 "producer's reconstruction once the lighting stops."}};
-  r.table = table;
-  r.failure = failure;
   imaging::ChartSpec spec;
   spec.title = "probe stream: latency against subscribers";
   spec.xLabel = "subscribers";
@@ -557,7 +609,25 @@ StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
   spec.logX = true;
   spec.logY = true;
   spec.footnote = o.command;
-  r.svg = imaging::renderSvgChart(spec, {p50Series, p99Series, writeSeries});
+  return imaging::renderSvgChart(spec, {p50Series, p99Series, writeSeries});
+}
+
+}  // namespace
+
+StreamBenchResult runStreamBench(const StreamBenchOptions& o) {
+  checkStreamBenchOptions(o);
+  std::vector<SubscriberRun> runs;
+  for (const int n : o.subscribers) runs.push_back(measureSubscribers(o, n));
+  StreamBenchResult r;
+  r.json = streamJson(o, runs);
+  r.table = fmt::format("{:>6} {:>9} {:>8} {:>8} {:>8} {:>9} {:>9} {:>8} {:>10} {:>8} {:>9} {:>10} {:>8} {:>7}\n",
+                        "subs", "frm/s/sub", "p50 ms", "p99 ms", "max ms", "wr p50", "wr p99", "srv cpu", "cpu/sub",
+                        "rss MB", "KB/sub", "B/s/sub", "load cpu", "errors");
+  for (const SubscriberRun& run : runs) {
+    r.table += tableRow(run);
+    r.failure += runFailures(run);
+  }
+  r.svg = streamChart(o, runs);
   return r;
 }
 
