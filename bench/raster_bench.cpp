@@ -59,31 +59,134 @@ std::string timeVolumeUpdates(renderer::RasterRenderer& raster, const RasterBenc
 
 }  // namespace
 
-RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
-  using Clock = std::chrono::steady_clock;
-  const auto say = [&](const std::string& s) {
-    if (o.progress) o.progress(s);
-  };
-  renderer::VulkanContext context(o.context);
-  renderer::ProbeUpdater updater(context, o.scene, o.grid, o.updater);
-  for (uint32_t u = 0; u < o.updates; ++u) updater.update();
-  const ProbeVolume volume = updater.volume();
-  say(fmt::format("raster bench: {} probe updates of {} probes done", o.updates, o.grid.count()));
+namespace {
 
+using Clock = std::chrono::steady_clock;
+
+// One representation's mono view against the reference, and its speed.
+struct Quality {
+  Representation r;
+  imaging::ImageMetrics metrics;
+  double msPerView = 0;
+};
+
+// What the same views cost a producer with the noise rule on the CPU (probe_interest.h, as
+// ProbeProducer uses it): their surfaces when views change, their weights every update.
+struct ProducerWeights {
+  size_t viewsSampled = 0, samples = 0;
+  double surfacesMs = 0, directMs = 0, weightsMs = 0;  // medians
+};
+
+// One view set, drawn both ways: one pass per view, and multiview chunks.
+struct ViewSetSpeed {
+  std::string name;
+  size_t count = 0;
+  double setMs[2] = {0, 0}, perViewMs[2] = {0, 0};  // [way]
+  double shadowMs = 0, areaShadowMs = 0;
+  ProducerWeights producer;
+};
+
+// What the bench measures: filled by the phases below, written by the report functions.
+struct RasterMetrics {
+  double firstShadowMs = 0;  // drawn once, with the first representation
+  std::vector<Quality> quality;
+  bool visibilityOn = false;
+  double visibilityRenderMs = 0, visibilityMomentsMs = 0;
+  uint32_t multiviewChunk = 0;
+  std::vector<ViewSetSpeed> viewSets;
+  double shadowMs = 0, areaShadowMs = 0;  // after the view sets
+  size_t areaLights = 0;
+};
+
+const std::vector<Representation>& representations() {
+  static const std::vector<Representation> reprs = {{"float", false},
+                                                    {"l1", true, probecast::Representation::L1},
+                                                    {"zh3h", true, probecast::Representation::Zh3Hallucinated},
+                                                    {"zh3", true, probecast::Representation::Zh3},
+                                                    {"l2", true, probecast::Representation::L2},
+                                                    {"fp16", true, probecast::Representation::Fp16}};
+  return reprs;
+}
+
+// Quality and mono speed per representation (float = the updater's probes without the codec).
+void measureQuality(const RasterBenchOptions& o, renderer::RasterRenderer& raster, const ProbeVolume& volume,
+                    const Reference& ref, RasterMetrics& metrics) {
   const renderer::CameraView camera = renderer::CameraView::fromScene(o.scene);
-  ReferenceRequest request;
-  request.camera = camera;
-  request.options.width = o.width;
-  request.options.height = o.height;
-  request.options.samplesPerPixel = o.referenceSpp;
-  request.options.environment = o.updater.environment;  // the same light as the probes
-  ReferenceCache cache(context, o.referenceCache, o.progress);
-  const Reference ref = cache.get(o.scene, request);
+  for (const Representation& r : representations()) {
+    raster.setProbes(r.viaCodec ? decodeAs(volume, r.repr, /*zh3PerPixel=*/true) : volume);
+    const glm::mat4 vp = raster.viewProjection(camera);
+    renderer::Image image = raster.render(vp, camera.position);  // warm-up (and shadow maps)
+    if (metrics.quality.empty()) metrics.firstShadowMs = raster.timings().shadowMs;
+    std::vector<double> ms;
+    for (uint32_t k = 0; k < o.repeats; ++k) {
+      const auto t0 = Clock::now();
+      image = raster.render(vp, camera.position);
+      ms.push_back(millisecondsSince(t0));
+    }
+    metrics.quality.push_back({r, compareChecked(image, ref.mean, r.name), session::medianMidpoint(ms)});
+    sayProgress(o.progress, fmt::format("raster bench: {} {:.2f} dB", r.name, metrics.quality.back().metrics.psnrDb));
+  }
+  // Visibility made by the first setProbes above (the same positions do not make it again).
+  metrics.visibilityOn = raster.visibilityActive();
+  metrics.visibilityRenderMs = raster.timings().visibilityRenderMs;
+  metrics.visibilityMomentsMs = raster.timings().visibilityMomentsMs;
+}
 
+ProducerWeights measureProducerWeights(const RasterBenchOptions& o, const std::vector<renderer::ViewInfo>& views,
+                                       const ProbeVolume& volume, const session::SurfaceLighting& lighting) {
+  const std::vector<View> seen = session::spreadViews(session::priorityViews(views), session::kFootprintViews);
+  const glm::uvec2 size = session::footprintSampleSize(seen.size());
+  std::vector<double> surfacesMs, directMs, weightsMs;
+  std::vector<session::ViewSample> samples;
+  for (uint32_t k = 0; k < o.repeats; ++k) {
+    auto t0 = Clock::now();
+    samples = session::sampleViewSurfaces(o.scene, o.grid, volume.active, volume.offsets, seen, size.x, size.y);
+    surfacesMs.push_back(millisecondsSince(t0));
+    t0 = Clock::now();
+    const std::vector<glm::vec3> direct = session::sampleDirectLight(o.scene, samples, lighting);
+    directMs.push_back(millisecondsSince(t0));
+    t0 = Clock::now();
+    const std::vector<float> w = session::probeViewSensitivity(samples, direct, lighting, volume.probes, o.grid.count());
+    weightsMs.push_back(millisecondsSince(t0));
+  }
+  return {seen.size(), samples.size(), session::medianMidpoint(surfacesMs), session::medianMidpoint(directMs),
+          session::medianMidpoint(weightsMs)};
+}
+
+// Speed per view set, both ways of drawing several views (`renderers`: per view, multiview).
+ViewSetSpeed measureViewSet(const RasterBenchOptions& o, const std::string& name, renderer::RasterRenderer* renderers[2],
+                            const ProbeVolume& volume, const session::SurfaceLighting& lighting) {
+  renderer::ViewSetSpec spec;
+  std::string error;
+  if (!renderer::parseViewSet(name, spec, error)) throw std::invalid_argument(error);
+  const auto views = renderer::makeViewSet(renderer::CameraView::fromScene(o.scene), spec,
+                                           session::viewSetOptions(o.scene, o.width, o.height));
+  ViewSetSpeed speed;
+  speed.name = name;
+  speed.count = views.size();
+  for (int way = 0; way < 2; ++way) {
+    renderer::RasterRenderer& r = *renderers[way];
+    r.renderViews(views);  // warm-up
+    std::vector<double> ms;
+    for (uint32_t k = 0; k < o.repeats; ++k) {
+      r.renderViews(views);
+      ms.push_back(r.timings().viewsMs);
+    }
+    speed.setMs[way] = session::medianMidpoint(ms);
+    speed.perViewMs[way] = speed.setMs[way] / static_cast<double>(views.size());
+  }
+  speed.shadowMs = renderers[0]->timings().shadowMs;
+  speed.areaShadowMs = renderers[0]->timings().areaShadowMs;
+  speed.producer = measureProducerWeights(o, views, volume, lighting);
+  return speed;
+}
+
+nlohmann::json rasterJson(const RasterBenchOptions& o, const std::string& device, const Reference& ref,
+                          const RasterMetrics& m) {
   nlohmann::json json;
   json["command"] = o.command;
   json["scene"] = o.scene.name;
-  json["device"] = context.deviceName();
+  json["device"] = device;
   json["size"] = {o.width, o.height};
   json["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
   json["probe_updates"] = o.updates;
@@ -95,133 +198,69 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   json["shadow_cascades"] = o.raster.shadowCascades;
   json["area_lights"] = o.raster.areaLights.enabled;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
-  std::string table = fmt::format("raster bench: {} at {}x{} on {}; reference {} spp, {}\n", o.scene.name, o.width,
-                                  o.height, context.deviceName(), o.referenceSpp, describeFloor(ref));
-
-  // Quality and mono speed per representation (float = the updater's probes without the codec).
-  const std::vector<Representation> reprs = {{"float", false},
-                                             {"l1", true, probecast::Representation::L1},
-                                             {"zh3h", true, probecast::Representation::Zh3Hallucinated},
-                                             {"zh3", true, probecast::Representation::Zh3},
-                                             {"l2", true, probecast::Representation::L2},
-                                             {"fp16", true, probecast::Representation::Fp16}};
-  renderer::RasterOptions perView = o.raster;
-  perView.environment = o.updater.environment;
-  perView.passes = renderer::ViewPasses::PerView;
-  renderer::RasterRenderer raster(context, o.scene, o.width, o.height, perView);
-  imaging::ChartSeries qualitySeries{"representations (mono view)", {}, false};
-  table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
-  for (const Representation& r : reprs) {
-    raster.setProbes(r.viaCodec ? decodeAs(volume, r.repr, /*zh3PerPixel=*/true) : volume);
-    const glm::mat4 vp = raster.viewProjection(camera);
-    renderer::Image image = raster.render(vp, camera.position);  // warm-up (and shadow maps)
-    if (!json.contains("shadow_ms")) json["shadow_ms"] = raster.timings().shadowMs;  // drawn once, here
-    std::vector<double> ms;
-    for (uint32_t k = 0; k < o.repeats; ++k) {
-      const auto t0 = Clock::now();
-      image = raster.render(vp, camera.position);
-      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-    }
-    const imaging::ImageMetrics m = compareChecked(image, ref.mean, r.name);
-    const double msPerView = session::medianMidpoint(ms);
-    json["representations"].push_back({{"representation", r.name},
-                                       {"record_bytes", r.viaCodec ? recordSize(r.repr) : 108},
-                                       {"psnr_db", m.psnrDb},
-                                       {"ssim", m.ssim},
-                                       {"ms_per_view", msPerView}});
-    qualitySeries.points.push_back({msPerView, m.psnrDb, r.name});
-    table += fmt::format("{:<6} {:>9.2f} {:>7.4f} {:>11.2f}\n", r.name, m.psnrDb, m.ssim, msPerView);
-    say(fmt::format("raster bench: {} {:.2f} dB", r.name, m.psnrDb));
-  }
-
-  table += fmt::format("shadow maps ({} cascades per directional light): {:.2f} ms\n", o.raster.shadowCascades,
-                       json["shadow_ms"].get<double>());
-  // Visibility made by the first setProbes above (the same positions do not make it again).
-  json["visibility"] = {{"on", raster.visibilityActive()},
-                        {"build_render_ms", raster.timings().visibilityRenderMs},
-                        {"build_moments_ms", raster.timings().visibilityMomentsMs},
+  if (!m.quality.empty()) json["shadow_ms"] = m.firstShadowMs;
+  for (const Quality& q : m.quality)
+    json["representations"].push_back({{"representation", q.r.name},
+                                       {"record_bytes", q.r.viaCodec ? recordSize(q.r.repr) : 108},
+                                       {"psnr_db", q.metrics.psnrDb},
+                                       {"ssim", q.metrics.ssim},
+                                       {"ms_per_view", q.msPerView}});
+  json["visibility"] = {{"on", m.visibilityOn},
+                        {"build_render_ms", m.visibilityRenderMs},
+                        {"build_moments_ms", m.visibilityMomentsMs},
                         {"bytes_per_probe", renderer::RasterRenderer::visibilityBytesPerProbe()}};
-  table += fmt::format("visibility {}: made in {:.1f} ms (depth cubes) + {:.1f} ms (moments), {} bytes per probe\n",
-                       raster.visibilityActive() ? "on" : "off", raster.timings().visibilityRenderMs,
-                       raster.timings().visibilityMomentsMs, renderer::RasterRenderer::visibilityBytesPerProbe());
+  json["multiview_chunk"] = m.multiviewChunk;
+  for (const ViewSetSpeed& v : m.viewSets)
+    json["view_sets"].push_back(
+        {{"views", v.name},
+         {"count", v.count},
+         {"per_view_pass", {{"ms_per_view_set", v.setMs[0]}, {"ms_per_view", v.perViewMs[0]}}},
+         {"multiview", {{"ms_per_view_set", v.setMs[1]}, {"ms_per_view", v.perViewMs[1]}}},
+         {"shadow_ms", v.shadowMs},
+         {"area_shadow_ms", v.areaShadowMs},
+         {"producer_view_weights", {{"views_sampled", v.producer.viewsSampled},
+                                    {"samples", v.producer.samples},
+                                    {"surfaces_ms_median", v.producer.surfacesMs},
+                                    {"direct_light_ms_median", v.producer.directMs},
+                                    {"weights_ms_median", v.producer.weightsMs}}}});
+  return json;
+}
 
-  // Speed per view set, both ways of drawing several views.
-  const ProbeVolume l2 = decodeAs(volume, probecast::Representation::L2, /*zh3PerPixel=*/true);
-  raster.setProbes(l2);
-  renderer::RasterOptions multi = perView;
-  multi.passes = renderer::ViewPasses::Multiview;
-  renderer::RasterRenderer multiview(context, o.scene, o.width, o.height, multi);
-  multiview.setProbes(l2);
-  json["multiview_chunk"] = multiview.chunkSize();
-  std::vector<imaging::ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
+// The table, up to the volume updates (timeVolumeUpdates adds their rows).
+std::string rasterTable(const RasterBenchOptions& o, const std::string& device, const Reference& ref,
+                        const RasterMetrics& m) {
+  std::string table = fmt::format("raster bench: {} at {}x{} on {}; reference {} spp, {}\n", o.scene.name, o.width,
+                                  o.height, device, o.referenceSpp, describeFloor(ref));
+  table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
+  for (const Quality& q : m.quality)
+    table += fmt::format("{:<6} {:>9.2f} {:>7.4f} {:>11.2f}\n", q.r.name, q.metrics.psnrDb, q.metrics.ssim, q.msPerView);
+  table += fmt::format("shadow maps ({} cascades per directional light): {:.2f} ms\n", o.raster.shadowCascades,
+                       m.firstShadowMs);
+  table += fmt::format("visibility {}: made in {:.1f} ms (depth cubes) + {:.1f} ms (moments), {} bytes per probe\n",
+                       m.visibilityOn ? "on" : "off", m.visibilityRenderMs, m.visibilityMomentsMs,
+                       renderer::RasterRenderer::visibilityBytesPerProbe());
   table += fmt::format("\n{:<8} {:>6} {:>16} {:>16}\n", "views", "count", "per-view ms/view", "multiview ms/view");
-  const renderer::ViewSetOptions vo = session::viewSetOptions(o.scene, o.width, o.height);
-  const session::SurfaceLighting lighting = session::surfaceLighting(o.scene, o.raster.areaLights);
-  for (const std::string& name : o.viewSets) {
-    renderer::ViewSetSpec spec;
-    std::string error;
-    if (!renderer::parseViewSet(name, spec, error)) throw std::invalid_argument(error);
-    const auto views = renderer::makeViewSet(camera, spec, vo);
-    nlohmann::json row{{"views", name}, {"count", views.size()}};
-    double perViewMs[2] = {0, 0};
-    for (int way = 0; way < 2; ++way) {
-      renderer::RasterRenderer& r = way == 0 ? raster : multiview;
-      r.renderViews(views);  // warm-up
-      std::vector<double> ms;
-      for (uint32_t k = 0; k < o.repeats; ++k) {
-        r.renderViews(views);
-        ms.push_back(r.timings().viewsMs);
-      }
-      const double set = session::medianMidpoint(ms);
-      perViewMs[way] = set / static_cast<double>(views.size());
-      row[way == 0 ? "per_view_pass" : "multiview"] = {{"ms_per_view_set", set}, {"ms_per_view", perViewMs[way]}};
-      speedSeries[static_cast<size_t>(way)].points.push_back({static_cast<double>(views.size()), perViewMs[way], ""});
-    }
-    row["shadow_ms"] = raster.timings().shadowMs;
-    row["area_shadow_ms"] = raster.timings().areaShadowMs;
-    // What the same views cost a producer with the noise rule on the CPU (probe_interest.h, as
-    // ProbeProducer uses it): their surfaces when views change, their weights every update.
-    {
-      const std::vector<View> seen = session::spreadViews(session::priorityViews(views), session::kFootprintViews);
-      const glm::uvec2 size = session::footprintSampleSize(seen.size());
-      std::vector<double> surfacesMs, directMs, weightsMs;
-      std::vector<session::ViewSample> samples;
-      const auto since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
-      for (uint32_t k = 0; k < o.repeats; ++k) {
-        auto t0 = Clock::now();
-        samples = session::sampleViewSurfaces(o.scene, o.grid, volume.active, volume.offsets, seen, size.x, size.y);
-        surfacesMs.push_back(since(t0));
-        t0 = Clock::now();
-        const std::vector<glm::vec3> direct = session::sampleDirectLight(o.scene, samples, lighting);
-        directMs.push_back(since(t0));
-        t0 = Clock::now();
-        const std::vector<float> w = session::probeViewSensitivity(samples, direct, lighting, volume.probes, o.grid.count());
-        weightsMs.push_back(since(t0));
-      }
-      row["producer_view_weights"] = {{"views_sampled", seen.size()},
-                                      {"samples", samples.size()},
-                                      {"surfaces_ms_median", session::medianMidpoint(surfacesMs)},
-                                      {"direct_light_ms_median", session::medianMidpoint(directMs)},
-                                      {"weights_ms_median", session::medianMidpoint(weightsMs)}};
-    }
-    json["view_sets"].push_back(row);
-    table += fmt::format("{:<8} {:>6} {:>16.2f} {:>16.2f}\n", name, views.size(), perViewMs[0], perViewMs[1]);
-    say(fmt::format("raster bench: {} done", name));
-  }
-  table += fmt::format("multiview chunk: {} views per pass\n", multiview.chunkSize());
+  for (const ViewSetSpeed& v : m.viewSets)
+    table += fmt::format("{:<8} {:>6} {:>16.2f} {:>16.2f}\n", v.name, v.count, v.perViewMs[0], v.perViewMs[1]);
+  table += fmt::format("multiview chunk: {} views per pass\n", m.multiviewChunk);
   table += "producer view weights on the CPU (up to 16 views), ms: surfaces (when the views change), direct light "
            "(when the lights move), weights (every update)\n";
-  for (const nlohmann::json& row : json["view_sets"])
-    table += fmt::format("  {:<8} {:>8.2f} {:>8.2f} {:>8.2f}\n", row["views"].get<std::string>(),
-                         row["producer_view_weights"]["surfaces_ms_median"].get<double>(),
-                         row["producer_view_weights"]["direct_light_ms_median"].get<double>(),
-                         row["producer_view_weights"]["weights_ms_median"].get<double>());
+  for (const ViewSetSpeed& v : m.viewSets)
+    table += fmt::format("  {:<8} {:>8.2f} {:>8.2f} {:>8.2f}\n", v.name, v.producer.surfacesMs, v.producer.directMs,
+                         v.producer.weightsMs);
   table += fmt::format("shadow maps: punctual {:.2f} ms, {} client area lights {:.2f} ms (drawn once per plan)\n",
-                       raster.timings().shadowMs, raster.areaLights().lights.size(), raster.timings().areaShadowMs);
+                       m.shadowMs, m.areaLights, m.areaShadowMs);
+  return table;
+}
 
-  table += timeVolumeUpdates(raster, o, json);
-  json["validation_messages"] = context.validationMessages();
-
+// PSNR against ms per view per representation; ms per view against views per set, both ways.
+void rasterCharts(const RasterBenchOptions& o, const RasterMetrics& m, RasterBenchResult& result) {
+  imaging::ChartSeries qualitySeries{"representations (mono view)", {}, false};
+  for (const Quality& q : m.quality) qualitySeries.points.push_back({q.msPerView, q.metrics.psnrDb, q.r.name});
+  std::vector<imaging::ChartSeries> speedSeries = {{"one pass per view", {}, true}, {"multiview chunks", {}, true}};
+  for (const ViewSetSpeed& v : m.viewSets)
+    for (size_t way = 0; way < 2; ++way)
+      speedSeries[way].points.push_back({static_cast<double>(v.count), v.perViewMs[way], ""});
   imaging::ChartSpec spec;
   spec.title =
       fmt::format("Raster client, {} at {}x{}: image quality against time per view", o.scene.name, o.width, o.height);
@@ -229,7 +268,6 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   spec.yLabel = "PSNR against the reference, dB";
   spec.yFromZero = false;
   spec.footnote = o.command;
-  RasterBenchResult result;
   result.svg = imaging::renderSvgChart(spec, {qualitySeries});
   imaging::ChartSpec views;
   views.title =
@@ -239,8 +277,50 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   views.logX = true;
   views.footnote = o.command;
   result.svgViews = imaging::renderSvgChart(views, speedSeries);
-  result.json = std::move(json);
-  result.table = std::move(table);
+}
+
+}  // namespace
+
+RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
+  renderer::VulkanContext context(o.context);
+  renderer::ProbeUpdater updater(context, o.scene, o.grid, o.updater);
+  for (uint32_t u = 0; u < o.updates; ++u) updater.update();
+  const ProbeVolume volume = updater.volume();
+  sayProgress(o.progress, fmt::format("raster bench: {} probe updates of {} probes done", o.updates, o.grid.count()));
+  ReferenceCache cache(context, o.referenceCache, o.progress);
+  const Reference ref = cache.get(o.scene, referenceRequest(renderer::CameraView::fromScene(o.scene), o.width, o.height,
+                                                            o.referenceSpp, o.updater.environment));  // the probes' light
+
+  RasterMetrics metrics;
+  renderer::RasterOptions perView = o.raster;
+  perView.environment = o.updater.environment;
+  perView.passes = renderer::ViewPasses::PerView;
+  renderer::RasterRenderer raster(context, o.scene, o.width, o.height, perView);
+  measureQuality(o, raster, volume, ref, metrics);
+
+  const ProbeVolume l2 = decodeAs(volume, probecast::Representation::L2, /*zh3PerPixel=*/true);
+  raster.setProbes(l2);
+  renderer::RasterOptions multi = perView;
+  multi.passes = renderer::ViewPasses::Multiview;
+  renderer::RasterRenderer multiview(context, o.scene, o.width, o.height, multi);
+  multiview.setProbes(l2);
+  metrics.multiviewChunk = multiview.chunkSize();
+  const session::SurfaceLighting lighting = session::surfaceLighting(o.scene, o.raster.areaLights);
+  renderer::RasterRenderer* renderers[2] = {&raster, &multiview};
+  for (const std::string& name : o.viewSets) {
+    metrics.viewSets.push_back(measureViewSet(o, name, renderers, volume, lighting));
+    sayProgress(o.progress, fmt::format("raster bench: {} done", name));
+  }
+  metrics.shadowMs = raster.timings().shadowMs;
+  metrics.areaShadowMs = raster.timings().areaShadowMs;
+  metrics.areaLights = raster.areaLights().lights.size();
+
+  RasterBenchResult result;
+  result.json = rasterJson(o, context.deviceName(), ref, metrics);
+  result.table = rasterTable(o, context.deviceName(), ref, metrics);
+  result.table += timeVolumeUpdates(raster, o, result.json);
+  result.json["validation_messages"] = context.validationMessages();
+  rasterCharts(o, metrics, result);
   return result;
 }
 
