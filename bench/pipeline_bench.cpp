@@ -71,108 +71,109 @@ std::string paretoChart(const std::string& title, const std::string& xLabel, boo
 
 }  // namespace
 
-PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
-  const auto say = [&](const std::string& s) {
-    if (o.progress) o.progress(s);
-  };
-  const auto sceneAt = [&](float t) { return session::loadSceneOrThrow(o.sceneSpec, t); };
-  renderer::VulkanContext context(o.context);
-  const scene::Scene finalScene = sceneAt(o.t);
-  const renderer::CameraView camera = renderer::CameraView::fromScene(finalScene);
-  ReferenceRequest request;
-  request.t = o.t;
-  request.camera = camera;
-  request.options.width = o.width;
-  request.options.height = o.height;
-  request.options.samplesPerPixel = o.referenceSpp;
-  request.options.environment = o.environment;
-  say(fmt::format("pipeline bench: reference ({} spp)", o.referenceSpp));
-  ReferenceCache cache(context, o.referenceCache, o.progress);
-  const Reference reference = cache.get(finalScene, request);
-  renderer::RasterOptions rasterOptions;
-  rasterOptions.environment = o.environment;
-  renderer::RasterRenderer raster(context, finalScene, o.width, o.height, rasterOptions);
-  const auto score = [&](const ProbeVolume& v, Point& p) {
-    raster.setProbes(v);
-    const renderer::Image img = raster.render(raster.viewProjection(camera), camera.position);
-    const imaging::ImageMetrics m = compareChecked(img, reference.mean, "pipeline bench");
+namespace {
+
+// What the bench measures, one point per configuration: PSNR against each stage's cost.
+struct PipelineMetrics {
+  std::vector<Point> updateCost;      // ms per update, samples per probe × bounces
+  std::vector<Point> representation;  // bytes per probe record
+  std::vector<Point> wireBytes;       // bytes per second, representation × dead-zone
+};
+
+// Every phase scores a volume the same way: its raster view against the reference at t.
+class Scorer {
+ public:
+  Scorer(renderer::VulkanContext& context, const scene::Scene& scene, const PipelineBenchOptions& o,
+         const Reference& reference)
+      : camera_(renderer::CameraView::fromScene(scene)),
+        reference_(reference),
+        raster_(context, scene, o.width, o.height, rasterOptions(o)) {}
+
+  void score(const ProbeVolume& v, Point& p) {
+    raster_.setProbes(v);
+    const renderer::Image img = raster_.render(raster_.viewProjection(camera_), camera_.position);
+    const imaging::ImageMetrics m = compareChecked(img, reference_.mean, "pipeline bench");
     p.psnr = m.psnrDb;
     p.ssim = m.ssim;
-  };
+  }
 
-  PipelineBenchResult r;
-  nlohmann::json& j = r.json;
-  j["command"] = o.command;
-  j["codec_format_version"] = kFormatVersion;
-  j["scene"] = finalScene.name;
-  j["device"] = context.deviceName();
-  j["size"] = {o.width, o.height};
-  j["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
-  j["reference_spp"] = o.referenceSpp;
-  j["reference_key"] = reference.key;
-  j["floor_psnr_db"] = reference.floor.psnrDb;
-  j["reference_psnr_db_estimate"] = reference.accuracyDb;
-  j["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
-  std::string& table = r.table;
-  table = fmt::format("pipeline bench: {} at {}x{}, {}x{}x{} probes, on {}\n", finalScene.name, o.width, o.height,
-                      o.grid.dims[0], o.grid.dims[1], o.grid.dims[2], context.deviceName());
+ private:
+  static renderer::RasterOptions rasterOptions(const PipelineBenchOptions& o) {
+    renderer::RasterOptions ro;
+    ro.environment = o.environment;
+    return ro;
+  }
+  renderer::CameraView camera_;
+  const Reference& reference_;
+  renderer::RasterRenderer raster_;
+};
 
-  // (b) Update cost: samples per probe × bounces, the light still at t.
-  std::vector<Point> updatePoints;
+// (b) Update cost: samples per probe × bounces, the light still at t.
+std::vector<Point> measureUpdateCost(renderer::VulkanContext& context, const scene::Scene& scene,
+                                     const PipelineBenchOptions& o, Scorer& scorer) {
+  std::vector<Point> points;
   for (uint32_t b : o.bounces)
     for (uint32_t spp : o.spps) {
       renderer::UpdaterOptions uo;
       uo.samplesPerProbe = spp;
       uo.maxBounces = b;
       uo.environment = o.environment;
-      renderer::ProbeUpdater u(context, finalScene, o.grid, uo);
+      renderer::ProbeUpdater u(context, scene, o.grid, uo);
       std::vector<double> ms;
       for (uint32_t k = 0; k < o.updates; ++k) ms.push_back(u.update().milliseconds);
       Point p{fmt::format("{} spp, {} bounce{}", spp, b, b == 1 ? "" : "s"), session::median(ms)};
-      score(u.volume(), p);
-      updatePoints.push_back(p);
-      say(fmt::format("pipeline bench: {}: {:.1f} ms/update, {:.2f} dB", p.label, p.cost, p.psnr));
+      scorer.score(u.volume(), p);
+      points.push_back(p);
+      sayProgress(o.progress, fmt::format("pipeline bench: {}: {:.1f} ms/update, {:.2f} dB", p.label, p.cost, p.psnr));
     }
-  r.svgUpdate = paretoChart(fmt::format("PSNR against probe update time ({} updates each)", o.updates),
-                            "ms per update (median)", true, updatePoints, o.command, j["update_cost"]);
+  return points;
+}
 
-  // (c) Representation: one well-converged volume through each record type.
+// (c) Representation: one well-converged volume through each record type.
+std::vector<Point> measureRepresentations(renderer::VulkanContext& context, const scene::Scene& scene,
+                                          const PipelineBenchOptions& o, Scorer& scorer) {
   renderer::UpdaterOptions good;
   good.samplesPerProbe = 128;
   good.environment = o.environment;
-  renderer::ProbeUpdater converged(context, finalScene, o.grid, good);
+  renderer::ProbeUpdater converged(context, scene, o.grid, good);
   for (int k = 0; k < 8; ++k) converged.update();
   const ProbeVolume volume = converged.volume();
-  std::vector<Point> reprPoints;
+  std::vector<Point> points;
   for (Representation repr : kAllRepresentations) {
     Point p{representationName(repr), static_cast<double>(recordSize(repr))};
-    score(decodeAs(volume, repr, /*zh3PerPixel=*/true), p);
-    reprPoints.push_back(p);
+    scorer.score(decodeAs(volume, repr, /*zh3PerPixel=*/true), p);
+    points.push_back(p);
   }
   Point floatPoint{"float", 108.0};
-  score(volume, floatPoint);
-  reprPoints.push_back(floatPoint);
-  r.svgRepr = paretoChart("PSNR against bytes per probe (representation)", "bytes per probe record", true, reprPoints,
-                          o.command, j["representation"]);
+  scorer.score(volume, floatPoint);
+  points.push_back(floatPoint);
+  return points;
+}
 
-  // (a) Wire bytes: a moving-light sequence ending at t, encoded per representation × dead-zone;
-  // bytes per second at `hz`, quality of what a subscriber holds at the end.
+// A moving-light sequence ending at t.
+std::vector<ProbeVolume> traceMovingFrames(renderer::VulkanContext& context, const PipelineBenchOptions& o) {
+  const auto sceneAt = [&](float t) { return session::loadSceneOrThrow(o.sceneSpec, t); };
   std::vector<ProbeVolume> frames;
-  {
-    renderer::UpdaterOptions uo;
-    uo.samplesPerProbe = 64;
-    uo.minBlendWeight = 0.25f;
-    uo.environment = o.environment;
-    renderer::ProbeUpdater u(context, sceneAt(o.t), o.grid, uo);
-    for (uint32_t f = 0; f < o.streamFrames; ++f) {
-      const float t = o.t - 0.004f * static_cast<float>(o.streamFrames - 1 - f);
-      u.setScene(sceneAt(t - std::floor(t)));
-      u.update();
-      frames.push_back(u.volume());
-    }
-    say(fmt::format("pipeline bench: {} moving-light frames traced", o.streamFrames));
+  renderer::UpdaterOptions uo;
+  uo.samplesPerProbe = 64;
+  uo.minBlendWeight = 0.25f;
+  uo.environment = o.environment;
+  renderer::ProbeUpdater u(context, sceneAt(o.t), o.grid, uo);
+  for (uint32_t f = 0; f < o.streamFrames; ++f) {
+    const float t = o.t - 0.004f * static_cast<float>(o.streamFrames - 1 - f);
+    u.setScene(sceneAt(t - std::floor(t)));
+    u.update();
+    frames.push_back(u.volume());
   }
-  std::vector<Point> bytesPoints;
+  sayProgress(o.progress, fmt::format("pipeline bench: {} moving-light frames traced", o.streamFrames));
+  return frames;
+}
+
+// (a) Wire bytes: the sequence encoded per representation × dead-zone; bytes per second at `hz`,
+// quality of what a subscriber holds at the end.
+std::vector<Point> measureWireBytes(const std::vector<ProbeVolume>& frames, const PipelineBenchOptions& o,
+                                    Scorer& scorer) {
+  std::vector<Point> points;
   StreamLayout layout = streamLayoutFor(o.grid, Representation::L1, 4);
   for (Representation repr : kAllRepresentations)
     for (int dz : o.deadzones) {
@@ -196,22 +197,65 @@ PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
       decoder.copyVolume(frames.back().grid.bounds, held);
       Point p{fmt::format("{} dz{}", representationName(repr), dz),
               static_cast<double>(total) / static_cast<double>(frames.size() - 1) * o.hz};
-      score(held, p);
-      bytesPoints.push_back(p);
+      scorer.score(held, p);
+      points.push_back(p);
     }
-  r.svgBytes = paretoChart(fmt::format("PSNR against wire bytes/s while the light moves ({:g} updates/s)", o.hz),
-                           "bytes per second (one subscriber)", true, bytesPoints, o.command, j["wire_bytes"]);
+  return points;
+}
 
+// The charts (with each point in the JSON) and the table's sections.
+void reportPipeline(const PipelineBenchOptions& o, const PipelineMetrics& m, PipelineBenchResult& r) {
+  nlohmann::json& j = r.json;
+  r.svgUpdate = paretoChart(fmt::format("PSNR against probe update time ({} updates each)", o.updates),
+                            "ms per update (median)", true, m.updateCost, o.command, j["update_cost"]);
+  r.svgRepr = paretoChart("PSNR against bytes per probe (representation)", "bytes per probe record", true,
+                          m.representation, o.command, j["representation"]);
+  r.svgBytes = paretoChart(fmt::format("PSNR against wire bytes/s while the light moves ({:g} updates/s)", o.hz),
+                           "bytes per second (one subscriber)", true, m.wireBytes, o.command, j["wire_bytes"]);
   const auto section = [&](const std::string& name, const std::string& unit, const nlohmann::json& rows) {
-    table += fmt::format("\n{:<22} {:>14} {:>9} {:>7}  Pareto\n", name, unit, "PSNR dB", "SSIM");
+    r.table += fmt::format("\n{:<22} {:>14} {:>9} {:>7}  Pareto\n", name, unit, "PSNR dB", "SSIM");
     for (const auto& row : rows)
-      table += fmt::format("{:<22} {:>14.1f} {:>9.2f} {:>7.4f}  {}\n", row["label"].get<std::string>(),
-                           row["cost"].get<double>(), row["psnr_db"].get<double>(), row["ssim"].get<double>(),
-                           row["pareto"].get<bool>() ? "*" : "");
+      r.table += fmt::format("{:<22} {:>14.1f} {:>9.2f} {:>7.4f}  {}\n", row["label"].get<std::string>(),
+                             row["cost"].get<double>(), row["psnr_db"].get<double>(), row["ssim"].get<double>(),
+                             row["pareto"].get<bool>() ? "*" : "");
   };
   section("update", "ms/update", j["update_cost"]);
   section("representation", "bytes/probe", j["representation"]);
   section("stream", "bytes/s", j["wire_bytes"]);
+}
+
+}  // namespace
+
+PipelineBenchResult runPipelineBench(const PipelineBenchOptions& o) {
+  renderer::VulkanContext context(o.context);
+  const scene::Scene finalScene = session::loadSceneOrThrow(o.sceneSpec, o.t);
+  sayProgress(o.progress, fmt::format("pipeline bench: reference ({} spp)", o.referenceSpp));
+  ReferenceCache cache(context, o.referenceCache, o.progress);
+  const Reference reference = cache.get(finalScene, referenceRequest(renderer::CameraView::fromScene(finalScene), o.width,
+                                                                     o.height, o.referenceSpp, o.environment, o.t));
+  Scorer scorer(context, finalScene, o, reference);
+
+  PipelineBenchResult r;
+  nlohmann::json& j = r.json;
+  j["command"] = o.command;
+  j["codec_format_version"] = kFormatVersion;
+  j["scene"] = finalScene.name;
+  j["device"] = context.deviceName();
+  j["size"] = {o.width, o.height};
+  j["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};
+  j["reference_spp"] = o.referenceSpp;
+  j["reference_key"] = reference.key;
+  j["floor_psnr_db"] = reference.floor.psnrDb;
+  j["reference_psnr_db_estimate"] = reference.accuracyDb;
+  j["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
+  r.table = fmt::format("pipeline bench: {} at {}x{}, {}x{}x{} probes, on {}\n", finalScene.name, o.width, o.height,
+                        o.grid.dims[0], o.grid.dims[1], o.grid.dims[2], context.deviceName());
+
+  PipelineMetrics metrics;
+  metrics.updateCost = measureUpdateCost(context, finalScene, o, scorer);
+  metrics.representation = measureRepresentations(context, finalScene, o, scorer);
+  metrics.wireBytes = measureWireBytes(traceMovingFrames(context, o), o, scorer);
+  reportPipeline(o, metrics, r);
   return r;
 }
 
