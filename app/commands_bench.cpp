@@ -410,63 +410,71 @@ void addBenchEdge(CLI::App* bench) {
   });
 }
 
-// `probecast bench adaptive`: adaptive blending and the noise-aware stream against fixed w_min.
-void addBenchAdaptive(CLI::App* bench) {
-  CLI::App* adaptive = bench->add_subcommand(
-      "adaptive", "history rejection and the noise-aware stream: bytes still/moving, flicker, lag, PSNR loss");
-  struct AdaptiveOptions {
-    std::string json, chart, repr = "zh3";
-    GridOptions grid{{4, 4, 4}, {}};
-    GpuOptions gpu;
-    bench::AdaptiveBenchOptions bench;
-  };
-  auto ao = std::make_shared<AdaptiveOptions>();
-  ao->gpu.add(adaptive);
-  adaptive->add_option("--scene", ao->bench.sceneSpec, "an animated scene (t moves its light)");
-  ao->grid.add(adaptive, /*withBounds=*/false, 2, 64);
-  adaptive->add_option("--spp", ao->bench.samplesPerProbe, "paths per probe per update")->check(CLI::Range(1u, 1u << 16));
-  adaptive->add_option("--still", ao->bench.stillUpdates, "updates of each still phase")->check(CLI::Range(8u, 100000u));
-  adaptive->add_option("--moving", ao->bench.movingUpdates, "updates with the light moving")->check(CLI::Range(1u, 100000u));
-  adaptive->add_option("--light-step", ao->bench.lightStep, "t the light moves per update")->check(CLI::Range(0.0f, 1.0f));
-  adaptive->add_option("--seed", ao->bench.seed, "seed of the traced rules' updaters (the spread between seeds is the bench's own noise)");
-  adaptive->add_option("--reject-sigmas", ao->bench.rejectSigmas, "k of the adaptive rule")->check(CLI::Range(0.5f, 1000.0f));
-  adaptive->add_option("--neighbour-history", ao->bench.neighbourHistory,
+// `bench adaptive`'s options: the bench's own and the command's.
+struct AdaptiveOptions {
+  std::string json, chart, repr = "zh3";
+  GridOptions grid{{4, 4, 4}, {}};
+  GpuOptions gpu;
+  bench::AdaptiveBenchOptions bench;
+};
+
+// The phases of the light and the traced rules' updaters.
+void addAdaptivePhaseOptions(CLI::App* adaptive, bench::AdaptiveBenchOptions& b) {
+  adaptive->add_option("--spp", b.samplesPerProbe, "paths per probe per update")->check(CLI::Range(1u, 1u << 16));
+  adaptive->add_option("--still", b.stillUpdates, "updates of each still phase")->check(CLI::Range(8u, 100000u));
+  adaptive->add_option("--moving", b.movingUpdates, "updates with the light moving")->check(CLI::Range(1u, 100000u));
+  adaptive->add_option("--light-step", b.lightStep, "t the light moves per update")->check(CLI::Range(0.0f, 1.0f));
+  adaptive->add_option("--seed", b.seed, "seed of the traced rules' updaters (the spread between seeds is the bench's own noise)");
+}
+
+// The adaptive rule and the fixed ones it is compared with.
+void addAdaptiveRuleOptions(CLI::App* adaptive, bench::AdaptiveBenchOptions& b) {
+  adaptive->add_option("--reject-sigmas", b.rejectSigmas, "k of the adaptive rule")->check(CLI::Range(0.5f, 1000.0f));
+  adaptive->add_option("--neighbour-history", b.neighbourHistory,
                        "adaptive rule: neighbours of a restarted probe keep at most this many updates of history (0 = off)")
       ->check(CLI::Range(0.0f, 1e6f));
-  adaptive->add_option("--change-history", ao->bench.changeHistory,
+  adaptive->add_option("--change-history", b.changeHistory,
                        "adaptive rule: when the scene changes, every probe keeps at most this many updates of history "
                        "(0 = off)")
       ->check(CLI::Range(0.0f, 1e6f));
-  adaptive->add_option("--w-mins", ao->bench.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
-  adaptive->add_option("--noise-scale", ao->bench.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
-  adaptive->add_option("--confirmations", ao->bench.confirmations,
+  adaptive->add_option("--w-mins", b.fixedWMins, "fixed rules to compare")->delimiter(',')->check(CLI::Range(0.0f, 1.0f));
+}
+
+// The streams each rule's volumes go through: the noise-aware one, the oracles, and all of them.
+void addAdaptiveStreamOptions(CLI::App* adaptive, bench::AdaptiveBenchOptions& b) {
+  adaptive->add_option("--noise-scale", b.noiseScale, "c of the noise-aware stream")->check(CLI::Range(0.0f, 1000.0f));
+  adaptive->add_option("--confirmations", b.confirmations,
                        "the noise-aware stream re-sends a probe once it has been beyond c sigma this many updates more")
       ->check(CLI::Range(0u, 1000u));
-  adaptive->add_option("--oracle", ao->bench.oracleErrorRatios,
+  adaptive->add_option("--oracle", b.oracleErrorRatios,
                        "also streams that know the truth and keep the held error within each of these x the full "
                        "stream's (about the least bytes for that error)")
       ->delimiter(',')
       ->check(CLI::Range(0.5f, 100.0f));
-  adaptive->add_option("--oracle-exponents", ao->bench.oracleExponents,
+  adaptive->add_option("--oracle-exponents", b.oracleExponents,
                        "oracle streams weigh each probe's error by its energy to the minus these")
       ->delimiter(',')
       ->check(CLI::Range(0.0f, 2.0f));
-  adaptive->add_option("--deadzone", ao->bench.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
-  adaptive->add_flag("--surface-probes-only,!--all-probes", ao->bench.surfaceProbesOnly,
+  adaptive->add_option("--deadzone", b.deadzone, "dead-zone of every stream")->check(CLI::Range(0, 127));
+  adaptive->add_flag("--surface-probes-only,!--all-probes", b.surfaceProbesOnly,
                      "trace and stream only the probes that light some surface (default on)");
-  adaptive->add_option("--view-weights", ao->bench.viewWeights,
+  adaptive->add_option("--view-weights", b.viewWeights,
                        "the noise-aware stream holds probes the scored views show little of longer: none, footprint "
                        "(each probe's measured share of their pixels), surface (the views' surfaces and the probes "
                        "that light them, as a server can work them out) or lit (surface, weighed by the light the "
                        "volume holds, after gamma, at every update, blended over updates: what a producer does)")
       ->check(CLI::IsMember({"none", "footprint", "surface", "lit"}));
-  adaptive->add_option("--refinement-interval", ao->bench.refinementInterval,
+  adaptive->add_option("--refinement-interval", b.refinementInterval,
                        "noise-aware stream: refinements wait for the next update whose sequence is a multiple of this")
       ->check(CLI::Range(0u, 100000u));
-  adaptive->add_option("--scored-updates", ao->bench.scoredUpdates,
+}
+
+// How images are scored, against what, and over how many seeds.
+void addAdaptiveScoringOptions(CLI::App* adaptive, bench::AdaptiveBenchOptions& b) {
+  adaptive->add_option("--scored-updates", b.scoredUpdates,
                        "images scored at the last this many updates of each phase (the loss averaged over them)")
       ->check(CLI::Range(1u, 1000u));
-  adaptive->add_option("--scored-views", ao->bench.scoredViews,
+  adaptive->add_option("--scored-views", b.scoredViews,
                        "views each scored image is made of: mono (the scene camera), stereo, lf:NxM or lfh:NxM "
                        "around it; one PSNR over all their pixels")
       ->check([](const std::string& text) {
@@ -474,27 +482,45 @@ void addBenchAdaptive(CLI::App* bench) {
         std::string error;
         return renderer::parseViewSet(text, spec, error) ? std::string() : error;
       });
-  adaptive->add_option("--truth-cache", ao->bench.truthCache,
+  adaptive->add_option("--truth-cache", b.truthCache,
                        "directory keeping the converged volumes images are scored against, between runs");
-  adaptive->add_option("--stream-seeds", ao->bench.streamSeeds,
+  adaptive->add_option("--stream-seeds", b.streamSeeds,
                        "the adaptive rule's streams are measured with this many seeds (--seed, --seed + 1, ...): "
                        "each noise-aware figure's mean and standard error")
       ->check(CLI::Range(1u, 1000u));
+}
+
+// The ray budget's re-convergence against brute force.
+void addAdaptiveReconvergenceOptions(CLI::App* adaptive, bench::AdaptiveBenchOptions& b) {
+  adaptive->add_option("--rays-per-update", b.raysPerUpdate,
+                       "rays per update of the budget and of brute force (0 = active probes x --spp)");
+  adaptive->add_option("--view-yfov", b.viewYfov, "field of view (radians) of the viewer whose probes are scored")
+      ->check(CLI::Range(0.01f, 3.1f));
+  adaptive->add_flag("--reconvergence-only", b.reconvergenceOnly,
+                     "measure only the re-convergence of the ray budget against brute force");
+  adaptive->add_option("--reconvergence-updates", b.reconvergenceUpdates, "updates measured after the re-convergence jump")
+      ->check(CLI::Range(1u, 100000u));
+  adaptive->add_option("--reconvergence-seeds", b.reconvergenceSeeds,
+                       "seeds the re-convergence is measured with (--seed, --seed + 1, ...); the summary is their median")
+      ->check(CLI::Range(1u, 1000u));
+}
+
+// `probecast bench adaptive`: adaptive blending and the noise-aware stream against fixed w_min.
+void addBenchAdaptive(CLI::App* bench) {
+  CLI::App* adaptive = bench->add_subcommand(
+      "adaptive", "history rejection and the noise-aware stream: bytes still/moving, flicker, lag, PSNR loss");
+  auto ao = std::make_shared<AdaptiveOptions>();
+  ao->gpu.add(adaptive);
+  adaptive->add_option("--scene", ao->bench.sceneSpec, "an animated scene (t moves its light)");
+  ao->grid.add(adaptive, /*withBounds=*/false, 2, 64);
+  addAdaptivePhaseOptions(adaptive, ao->bench);
+  addAdaptiveRuleOptions(adaptive, ao->bench);
+  addAdaptiveStreamOptions(adaptive, ao->bench);
+  addAdaptiveScoringOptions(adaptive, ao->bench);
   addRepresentationOption(adaptive, ao->repr, "l1, zh3h, zh3, l2 or fp16");
   addJsonOption(adaptive, ao->json);
   adaptive->add_option("--chart", ao->chart, "SVG prefix: writes PREFIX_bytes.svg and PREFIX_jump.svg");
-  adaptive->add_option("--rays-per-update", ao->bench.raysPerUpdate,
-                       "rays per update of the budget and of brute force (0 = active probes x --spp)");
-  adaptive->add_option("--view-yfov", ao->bench.viewYfov, "field of view (radians) of the viewer whose probes are scored")
-      ->check(CLI::Range(0.01f, 3.1f));
-  adaptive->add_flag("--reconvergence-only", ao->bench.reconvergenceOnly,
-                     "measure only the re-convergence of the ray budget against brute force");
-  adaptive->add_option("--reconvergence-updates", ao->bench.reconvergenceUpdates,
-                       "updates measured after the re-convergence jump")
-      ->check(CLI::Range(1u, 100000u));
-  adaptive->add_option("--reconvergence-seeds", ao->bench.reconvergenceSeeds,
-                       "seeds the re-convergence is measured with (--seed, --seed + 1, ...); the summary is their median")
-      ->check(CLI::Range(1u, 1000u));
+  addAdaptiveReconvergenceOptions(adaptive, ao->bench);
   adaptive->callback([ao] {
     bench::AdaptiveBenchOptions o = ao->bench;
     o.dims = {ao->grid.dims[0], ao->grid.dims[1], ao->grid.dims[2]};
