@@ -25,21 +25,24 @@ void addDemoCommand(CLI::App& app) {
   demo->add_option("--light-field", o->lightField, "the light-field display's view set (lf:NxM or lfh:NxM)");
   demo->add_option("--settle-updates", o->settleUpdates, "updates with the light frozen before the comparison")
       ->check(CLI::Range(1, 10000));
-  demo->add_option("--noise-scale", o->noiseScale,
-                   "as serve: a probe is not re-sent while its change stays within this many standard errors of its "
-                   "Monte Carlo noise (0 = off)")
-      ->check(CLI::Range(0.0f, 1000.0f));
-  addRefinementIntervalOption(demo, o->refinementInterval);
-  addReferenceSppOption(demo, o->referenceSpp, 1u << 16, "samples per pixel of the reference images");
+  o->noise.add(demo);
+  addReferenceSppOption(demo, o->referenceSpp, 1u << 16,
+                        "samples per pixel of the reference images (two halves of different seeds)");
+  demo->add_option("--reference-cache", o->referenceCache,
+                   "where references are kept between runs (default $XDG_CACHE_HOME/probecast/references, else "
+                   "~/.cache/probecast/references)");
   addVisibilityOption(demo, o->visibility);
   demo->add_option("--supersample", o->supersample,
                    "the viewers' N × N raster samples per pixel, averaged (as the references average each pixel)")
       ->check(CLI::Range(1, 16));
   o->areaLights.add(demo);
+  o->device.add(demo);
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
   o->environment.add(demo);
   demo->callback([o] {
-    checkRefinementInterval(o->refinementInterval, o->noiseScale);
+    if (o->referenceSpp < 2)
+      throw std::runtime_error("--reference-spp must be at least 2: a reference is two halves of different seeds");
+    o->noise.apply(o->encoder, /*live=*/true);
     o->sky = o->environment.load();  // a bad map or sky fails here, before the server starts
     DemoRun run;
     run.wallStart = DemoClock::now();

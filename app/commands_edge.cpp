@@ -42,7 +42,7 @@ void addEdgeCommand(CLI::App& app) {
     ec.server.maxSubscribers = o->maxSubscribers;
     service::EdgeServer server(ec);
     fmt::print("edge: stream {} from {} on port {} ({})\n", service::busStreamName(ec.bus.stream), ec.bus.url,
-               server.port(), ec.server.tlsCertPem.empty() ? "plaintext" : "TLS");
+               server.port(), describeSecurity(ec.server, "edge", server.port()));
     std::fflush(stdout);
     std::signal(SIGINT, [](int) { gEdgeInterrupted = true; });
     std::signal(SIGTERM, [](int) { gEdgeInterrupted = true; });

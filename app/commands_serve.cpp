@@ -26,8 +26,9 @@ struct ServeOptions {
   std::string publish, stream = "probes";
   BusOptions bus;
   int brick = 4, deadzone = 1;
-  float noiseScale = 0.0f, errorBound = 0.0f;
-  uint32_t refinementInterval = 0, confirmations = 0;
+  NoiseRuleCli noise;  // on for live tracing unless --noise-scale 0
+  float errorBound = 0.0f;
+  uint32_t confirmations = 0;
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
 
@@ -38,13 +39,13 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
                                                      service::HubConfig& hub, std::string& what) {
   const Representation repr = session::parseRepresentationOrThrow(o.repr);
   const TracingOptions& tr = o.tracing;
+  EncoderOptions noiseRule;  // checked before anything is read or traced
+  o.noise.apply(noiseRule, o.probes.empty());
   scene::Scene s;
   ProbeGrid g;
   if (!o.probes.empty()) {
     if (tr.scene.environment.given())
       throw std::runtime_error("--environment and --sky light live tracing; a --probes file was traced already");
-    if (o.noiseScale > 0.0f)
-      throw std::runtime_error("--noise-scale needs live tracing: a --probes file carries no per-probe noise");
     std::string error;
     orThrow(readProbeFile(o.probes, file, error), error);
     o.areaLights.follow(file.areaLights, o.probes);  // a file's rule is what it was traced with
@@ -57,12 +58,11 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     hub = service::hubConfigFor(g, repr, o.brick, o.deadzone);
     what = s.name;
   }
-  hub.encoder.noiseScale = o.noiseScale;
-  hub.encoder.refinementInterval = o.refinementInterval;
-  checkRefinementInterval(o.refinementInterval, o.noiseScale);
+  hub.encoder.noiseScale = noiseRule.noiseScale;
+  hub.encoder.refinementInterval = noiseRule.refinementInterval;
   hub.encoder.confirmations = o.confirmations;
-  if (o.confirmations > 0 && o.noiseScale <= 0.0f)
-    throw std::runtime_error("--confirmations holds back what --noise-scale would re-send: give both");
+  if (o.confirmations > 0 && hub.encoder.noiseScale <= 0.0f)
+    throw std::runtime_error("--confirmations holds back what the noise rule would re-send, and the rule is off");
   hub.encoder.errorBound = o.errorBound;
   if (o.errorBound > 0.0f && brickRepresentations(repr).size() < 2)
     throw std::runtime_error(std::string("--error-bound chooses among cheaper representations per brick: --repr ") +
@@ -93,11 +93,7 @@ void addServeCommand(CLI::App& app) {
   serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
   serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
       ->check(CLI::Range(0, 127));
-  serve->add_option("--noise-scale", o->noiseScale,
-                    "live: a probe is not re-sent while its change stays within this many standard errors of its "
-                    "Monte Carlo noise (0 = off; bench adaptive measures 2)")
-      ->check(CLI::Range(0.0f, 1000.0f));
-  addRefinementIntervalOption(serve, o->refinementInterval);
+  o->noise.add(serve);
   serve->add_option("--confirmations", o->confirmations,
                     "with --noise-scale: a probe past the noise threshold is re-sent once it has stayed past it this "
                     "many updates more (past 4x the threshold at once; 0 = at once; bench adaptive measures 1)")
@@ -133,7 +129,7 @@ void addServeCommand(CLI::App& app) {
     }
     const AreaLightRule rule = producer->hub().volume().areaLights;
     fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}, client area lights {}\n", what, port,
-               sc.tlsCertPem.empty() ? "plaintext" : "TLS", representationName(hc.layout.repr), hc.layout.grid[0],
+               describeSecurity(sc, "serve", port), representationName(hc.layout.repr), hc.layout.grid[0],
                hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file",
                rule.on() ? fmt::format("on ({})", rule.minPowerFraction) : "off");
     std::fflush(stdout);

@@ -34,9 +34,10 @@ struct DemoOptions {
   std::string repr = "zh3";
   std::string lightField = "lf:5x5";
   uint32_t settleUpdates = 24;  // updates with the light frozen before the comparison
-  float noiseScale = 0.0f;      // the hub's noise rule (EncoderOptions::noiseScale); 0 = off
-  uint32_t refinementInterval = 0;  // with it: EncoderOptions::refinementInterval; 0 = off
-  uint32_t referenceSpp = 256;
+  NoiseRuleCli noise;           // the hub's noise rule, as given
+  EncoderOptions encoder;       // its scale and refinement interval once checked (NoiseRuleCli::apply)
+  uint32_t referenceSpp = 1024;  // two halves of different seeds: the reference's own noise floor
+  std::string referenceCache;    // empty: bench::defaultReferenceCacheDir()
   uint64_t lightFieldBudget = 6 * 1024;  // bytes/s: the display sits on a thin link
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
   EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
@@ -44,6 +45,7 @@ struct DemoOptions {
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
   uint32_t supersample = 4;              // the viewers' raster samples per pixel side (RasterOptions)
   AreaLightCli areaLights;               // the server's rule; the viewers follow what the stream says
+  GpuOptions device;                     // --device: the server's and the viewers' Vulkan device
 };
 
 struct DemoViewer {

@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <functional>
 
 #include "commands.h"
 #include "demo.h"
 #include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/imaging/image_metrics.h"
+#include "harness.h"
 #include "pipeline_bench.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/session/scene_loading.h"
@@ -33,9 +35,9 @@ std::string runSuites(const DemoOptions& o, const std::string& dir, const scene:
   po.grid = grid;
   po.width = 128;
   po.height = 80;
-  po.referenceSpp = 2 * o.referenceSpp;
+  po.referenceSpp = o.referenceSpp;
   po.environment = o.sky;
-  po.referenceCache = dir + "/references";  // beside the report: the demo leaves nothing elsewhere
+  po.referenceCache = o.referenceCache;
   po.spps = {32, 128};
   po.bounces = {1, 4};
   po.deadzones = {0, 4, 16};
@@ -84,11 +86,11 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
       "is compared with the reference path tracer ({} samples per pixel).\n\n",
       report["scene"].get<std::string>(), report["grid"][0].get<int>(), report["grid"][1].get<int>(),
       report["grid"][2].get<int>(), o.spp, report["update_ms_median"].get<double>(), o.repr,
-      o.noiseScale > 0.0f
-          ? fmt::format(" (a probe is re-sent only beyond {:g} standard errors of its noise{})", o.noiseScale,
-                        o.refinementInterval > 0
+      o.encoder.noiseScale > 0.0f
+          ? fmt::format(" (a probe is re-sent only beyond {:g} standard errors of its noise{})", o.encoder.noiseScale,
+                        o.encoder.refinementInterval > 0
                             ? fmt::format("; refinements of still probes wait for every {}th update",
-                                          o.refinementInterval)
+                                          o.encoder.refinementInterval)
                             : std::string())
           : std::string(),
       o.lightField,
@@ -109,12 +111,15 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
   md += fmt::format(
       "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without "
       "clamping; the PNGs use a filmic tone map. Each viewer pixel is the mean of {}² raster samples, "
-      "as each reference pixel averages its area. The reference has noise of its own: two "
-      "references of the headset's left eye with different seeds differ by {:.2f} dB PSNR, SSIM "
-      "{:.4f} — the ceiling these figures can reach. Light-field views compared: the corners and "
-      "the centre ({} in quilt order).\n\n",
-      o.supersample, report["reference_noise_floor"]["psnr_db"].get<double>(),
-      report["reference_noise_floor"]["ssim"].get<double>(), report["viewers"][1]["reference_views"].dump());
+      "as each reference pixel averages its area. The reference has noise of its own: its two "
+      "halves ({} samples per pixel each, different seeds) of the headset's left eye differ by "
+      "{:.2f} dB PSNR, SSIM {:.4f}, so the reference itself is about {:.1f} dB from converged — the "
+      "ceiling these figures can reach. Light-field views compared: the corners and the centre ({} "
+      "in quilt order).\n\n",
+      o.supersample, o.referenceSpp / 2, report["reference_noise_floor"]["psnr_db"].get<double>(),
+      report["reference_noise_floor"]["ssim"].get<double>(),
+      report["reference_noise_floor"]["reference_accuracy_db"].get<double>(),
+      report["viewers"][1]["reference_views"].dump());
   if (!viewsAboveScene.empty())
     md += fmt::format(
         "Views {} look from above the scene's top (the light field's top rows): they see the "
@@ -149,94 +154,122 @@ std::vector<size_t> referenceViews(const DemoViewer& v) {
   return views;
 }
 
+// One viewer's final images at the frozen light against references from the cache (traced on a
+// miss): the images, the metrics of each compared view, and view 0's reference with its noise floor.
+struct ViewerComparison {
+  std::vector<renderer::Image> references;  // black where no view was compared
+  std::vector<double> psnr, ssim;
+  imaging::ChartSeries series;
+  bench::Reference first;
+};
+
+ViewerComparison compareViewer(const DemoOptions& o, const DemoRun& run, DemoViewer& v, const scene::Scene& finalScene,
+                               const std::vector<size_t>& compared, bench::ReferenceCache& cache,
+                               const std::function<void()>& done) {
+  session::Viewer& viewer = *v.viewer;
+  const std::vector<renderer::ViewInfo>& views = viewer.views();
+  viewer.setShading(finalScene);
+  viewer.render();
+  const std::vector<renderer::Image>& images = viewer.images();
+  ViewerComparison c;
+  c.references.resize(views.size());
+  for (renderer::Image& img : c.references) {
+    img.width = v.width;
+    img.height = v.height;
+    img.rgb.assign(static_cast<size_t>(v.width) * v.height * 3, 0.0f);
+  }
+  c.series = {v.name + " (" + v.viewSet + ")", {}, true};
+  bench::ReferenceRequest request;
+  request.t = run.finalT;
+  request.options.width = v.width;
+  request.options.height = v.height;
+  request.options.samplesPerPixel = o.referenceSpp;
+  request.options.environment = o.sky;
+  for (size_t i : compared) {
+    request.camera = views[i].camera;
+    bench::Reference reference = cache.get(finalScene, request);
+    const imaging::ImageMetrics m = bench::compareChecked(images[i], reference.mean, fmt::format("{} view {}", v.name, i));
+    c.psnr.push_back(m.psnrDb);
+    c.ssim.push_back(m.ssim);
+    c.series.points.push_back({static_cast<double>(i), m.psnrDb, fmt::format("view {}", i)});
+    c.references[i] = reference.mean;
+    if (i == compared.front()) c.first = std::move(reference);
+    done();
+  }
+  return c;
+}
+
+double meanOf(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double x : values) sum += x;
+  return values.empty() ? 0.0 : sum / static_cast<double>(values.size());
+}
+
+// A viewer's part of report.json.
+nlohmann::json viewerReport(const DemoViewer& v, const DemoRun& run, const std::vector<size_t>& compared,
+                            const ViewerComparison& c, const std::string& tag) {
+  const session::Viewer& viewer = *v.viewer;
+  const service::ClientStats st = viewer.clientStats();
+  return {{"name", v.name},
+          {"views", v.viewSet},
+          {"view_count", viewer.views().size()},
+          {"size", {v.width, v.height}},
+          {"budget_bytes_per_s", v.budget},
+          {"frames_applied", st.framesApplied},
+          {"renders", viewer.stats().renders},
+          {"render_ms_per_view_median", session::median(viewer.stats().renderMsPerView)},
+          {"bytes_streaming", v.streamBytes},
+          {"bytes_per_s_streaming", static_cast<double>(v.streamBytes) / run.streamSeconds},
+          {"bytes_total", st.bytesReceived},
+          {"converged_to_server_volume", v.converged},
+          {"reference_views", compared},
+          {"psnr_db", c.psnr},
+          {"ssim", c.ssim},
+          {"psnr_db_mean", meanOf(c.psnr)},
+          {"ssim_mean", meanOf(c.ssim)},
+          {"images",
+           {{"final", "final_" + tag + ".png"},
+            {"reference", "reference_" + tag + ".png"},
+            {"difference_view0", "difference_" + tag + "_view0.png"}}}};
+}
+
 // Final images of every viewer at the frozen light, compared with references; the viewers' part
 // of the report and the PSNR-per-view series. Views without a reference stay black in the reference quilt.
 void compareWithReferences(const DemoOptions& o, DemoRun& run, const scene::Scene& finalScene, nlohmann::json& report,
                            std::vector<std::vector<size_t>>& compared, std::vector<imaging::ChartSeries>& psnrSeries) {
-  uint32_t referencesDone = 0, referencesTotal = 1;  // + the noise floor
+  uint32_t referencesDone = 0, referencesTotal = 0;
   for (const DemoViewer& v : run.viewers) {
     compared.push_back(referenceViews(v));
     referencesTotal += static_cast<uint32_t>(compared.back().size());
   }
   Progress progress("demo");
-  const auto progressReferences = [&] {
+  const auto status = [&progress](const std::string& s) { progress.message(s); };
+  bench::ReferenceCache cache(*run.viewerContext, o.referenceCache, status);
+  report["reference_cache"] = cache.dir();
+  const auto done = [&] {
     ++referencesDone;
     progress.update(static_cast<double>(referencesDone) / referencesTotal,
                     fmt::format("reference images {}/{}", referencesDone, referencesTotal));
   };
   for (size_t k = 0; k < run.viewers.size(); ++k) {
     DemoViewer& v = run.viewers[k];
-    session::Viewer& viewer = *v.viewer;
-    const std::vector<renderer::ViewInfo>& views = viewer.views();
-    viewer.setShading(finalScene);
-    viewer.render();
-    const std::vector<renderer::Image>& images = viewer.images();
-    std::vector<renderer::Image> references(views.size());
-    for (renderer::Image& img : references) {
-      img.width = v.width;
-      img.height = v.height;
-      img.rgb.assign(static_cast<size_t>(v.width) * v.height * 3, 0.0f);
-    }
-    std::vector<double> psnr, ssim;
-    imaging::ChartSeries series{v.name + " (" + v.viewSet + ")", {}, true};
-    renderer::ReferenceOptions ro;
-    ro.width = v.width;
-    ro.height = v.height;
-    ro.samplesPerPixel = o.referenceSpp;
-    ro.environment = o.sky;
-    for (size_t i : compared[k]) {
-      references[i] = renderer::renderReference(*run.viewerContext, finalScene, views[i].camera, ro);
-      const imaging::ImageMetrics m = imaging::compareImages(images[i].rgb, references[i].rgb, static_cast<int>(v.width),
-                                                         static_cast<int>(v.height));
-      psnr.push_back(m.psnrDb);
-      ssim.push_back(m.ssim);
-      series.points.push_back({static_cast<double>(i), m.psnrDb, fmt::format("view {}", i)});
-      progressReferences();
-    }
-    if (k == 0) {  // how far the reference itself is from converged: two seeds of view 0
-      ro.seed = 7;
-      const renderer::Image second = renderer::renderReference(*run.viewerContext, finalScene, views[0].camera, ro);
-      const imaging::ImageMetrics floor =
-          imaging::compareImages(second.rgb, references[0].rgb, static_cast<int>(v.width), static_cast<int>(v.height));
-      report["reference_noise_floor"] = {{"psnr_db", floor.psnrDb}, {"ssim", floor.ssim}};
-      progressReferences();
-    }
+    const ViewerComparison c = compareViewer(o, run, v, finalScene, compared[k], cache, done);
+    if (k == 0)  // how far the reference itself is from converged: its two halves, view 0
+      report["reference_noise_floor"] = {{"psnr_db", c.first.floor.psnrDb},
+                                         {"ssim", c.first.floor.ssim},
+                                         {"reference_accuracy_db", c.first.accuracyDb},
+                                         {"from_cache", c.first.fromCache}};
     const std::string tag = k == 0 ? "stereo" : "quilt";
+    const std::vector<renderer::Image>& images = v.viewer->images();
     writeViewerImages(o.out + "/final_" + tag, v, images);
-    writeViewerImages(o.out + "/reference_" + tag, v, references);
+    writeViewerImages(o.out + "/reference_" + tag, v, c.references);
     std::string error;
-    if (!imaging::writeDifferencePng(o.out + "/difference_" + tag + "_view0.png", images[0].rgb, references[0].rgb,
-                                   static_cast<int>(v.width), static_cast<int>(v.height), 0.25, error))
+    if (!imaging::writeDifferencePng(o.out + "/difference_" + tag + "_view0.png", images[0].rgb, c.references[0].rgb,
+                                     static_cast<int>(v.width), static_cast<int>(v.height), 0.25, error))
       throw std::runtime_error(error);
-    double meanPsnr = 0, meanSsim = 0;
-    for (size_t i = 0; i < psnr.size(); ++i) {
-      meanPsnr += psnr[i] / static_cast<double>(psnr.size());
-      meanSsim += ssim[i] / static_cast<double>(ssim.size());
-    }
-    const service::ClientStats st = viewer.clientStats();
-    report["viewers"].push_back({{"name", v.name},
-                                 {"views", v.viewSet},
-                                 {"view_count", views.size()},
-                                 {"size", {v.width, v.height}},
-                                 {"budget_bytes_per_s", v.budget},
-                                 {"frames_applied", st.framesApplied},
-                                 {"renders", viewer.stats().renders},
-                                 {"render_ms_per_view_median", session::median(viewer.stats().renderMsPerView)},
-                                 {"bytes_streaming", v.streamBytes},
-                                 {"bytes_per_s_streaming", static_cast<double>(v.streamBytes) / run.streamSeconds},
-                                 {"bytes_total", st.bytesReceived},
-                                 {"converged_to_server_volume", v.converged},
-                                 {"reference_views", compared[k]},
-                                 {"psnr_db", psnr},
-                                 {"ssim", ssim},
-                                 {"psnr_db_mean", meanPsnr},
-                                 {"ssim_mean", meanSsim},
-                                 {"images",
-                                  {{"final", "final_" + tag + ".png"},
-                                   {"reference", "reference_" + tag + ".png"},
-                                   {"difference_view0", "difference_" + tag + "_view0.png"}}}});
-    psnrSeries.push_back(std::move(series));
-    viewer.stop();
+    report["viewers"].push_back(viewerReport(v, run, compared[k], c, tag));
+    psnrSeries.push_back(c.series);
+    v.viewer->stop();
   }
   progress.finish();
 }
@@ -270,8 +303,8 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
   report["scene"] = run.scene0.name;
   report["grid"] = {run.grid.dims[0], run.grid.dims[1], run.grid.dims[2]};
   report["representation"] = o.repr;
-  report["noise_scale"] = o.noiseScale;
-  report["refinement_interval"] = o.refinementInterval;
+  report["noise_scale"] = o.encoder.noiseScale;
+  report["refinement_interval"] = o.encoder.refinementInterval;
   report["environment"] = !o.environment.file.empty() ? nlohmann::json(o.environment.file)
                           : !o.environment.sky.empty() ? nlohmann::json({{"sky", o.environment.sky}})
                                                        : nlohmann::json(nullptr);

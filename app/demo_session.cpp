@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <thread>
 
@@ -36,10 +37,10 @@ namespace {
 service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   run.scene0 = session::loadSceneOrThrow(o.scene, 0.0f);
   run.grid = o.grid.resolve(run.scene0);
-  run.serverContext = std::make_unique<renderer::VulkanContext>(renderer::ContextOptions{});
+  run.serverContext = std::make_unique<renderer::VulkanContext>(o.device.context());
   service::HubConfig hub = service::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1);
-  hub.encoder.noiseScale = o.noiseScale;
-  hub.encoder.refinementInterval = o.refinementInterval;
+  hub.encoder.noiseScale = o.encoder.noiseScale;
+  hub.encoder.refinementInterval = o.encoder.refinementInterval;
   run.producer = std::make_unique<session::ProbeProducer>(hub);
   renderer::UpdaterOptions uo;
   uo.samplesPerProbe = o.spp;
@@ -66,7 +67,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
 
 // The viewers on a Vulkan device of their own (a headset and a display are other machines).
 void startViewers(const DemoOptions& o, const service::ServerConfig& server, DemoRun& run) {
-  run.viewerContext = std::make_unique<renderer::VulkanContext>(renderer::ContextOptions{});
+  run.viewerContext = std::make_unique<renderer::VulkanContext>(o.device.context());
   run.viewers.resize(2);
   run.viewers[0].name = "headset";
   run.viewers[0].viewSet = "stereo";
@@ -154,7 +155,9 @@ void stream(const DemoOptions& o, DemoRun& run) {
 void settle(const DemoOptions& o, DemoRun& run) {
   Progress progress("demo");
   session::ProbeProducer& producer = *run.producer;
-  producer.freeze();
+  // Where the light stands after exactly o.seconds, whatever the loop's timing: the same final
+  // scene every run, so its references come from the cache.
+  producer.freeze(static_cast<float>(std::fmod(o.seconds * o.turnsPerMinute / 60.0, 1.0)));
   run.finalT = producer.t();
   while (producer.running() && producer.stats().settledUpdates < o.settleUpdates) {
     const uint32_t settled = producer.stats().settledUpdates;

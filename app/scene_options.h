@@ -10,10 +10,12 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include "commands.h"
 #include "probecast/renderer/environment.h"
 #include "probecast/renderer/probe_updater.h"
+#include "probecast/renderer/vulkan_context.h"
 #include "probecast/service/bus_nats.h"
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
@@ -68,16 +70,24 @@ struct SceneOptions {
   scene::Scene load() const { return session::loadSceneOrThrow(scene, t); }
 };
 
+// --device auto|gpu|cpu and --validation: the Vulkan device probes are traced and views drawn on.
 struct GpuOptions {
-  bool gpu = false;
+  renderer::DeviceChoice device = renderer::DeviceChoice::Auto;
   bool validation = false;
   void add(CLI::App* cmd) {
-    cmd->add_flag("--gpu", gpu, "prefer a GPU over lavapipe when one is present");
+    cmd->add_option_function<std::string>(
+           "--device",
+           [this](const std::string& text) {
+             if (!renderer::parseDeviceChoice(text, device))
+               throw CLI::ValidationError("--device", "'" + text + "' is not auto, gpu or cpu");
+           },
+           "auto: a GPU with ray tracing when one is present, lavapipe otherwise; gpu or cpu: that kind or an error")
+        ->default_str("auto");
     cmd->add_flag("--validation", validation, "enable the Vulkan validation layer");
   }
   renderer::ContextOptions context() const {
     renderer::ContextOptions o;
-    o.preferGpu = gpu;
+    o.device = device;
     o.validation = validation;
     return o;
   }
@@ -152,20 +162,49 @@ inline CLI::Option* addRepresentationOption(CLI::App* cmd, std::string& repr, co
       allowFloat ? "{float,l1,zh3h,zh3,l2,fp16}" : "{l1,zh3h,zh3,l2,fp16}"));
 }
 
-// --refinement-interval K of serve and demo (EncoderOptions::refinementInterval), and its check once
-// parsed: it holds back what the noise rule calls refinements, so it needs --noise-scale.
-inline CLI::Option* addRefinementIntervalOption(CLI::App* cmd, uint32_t& interval) {
-  return cmd
-      ->add_option("--refinement-interval", interval,
-                   "with --noise-scale: refinements (changes within twice the noise threshold of probes whose "
-                   "light held still this many updates) wait for the next update whose sequence is a multiple of "
-                   "this, every brick's going in that one frame (0 = at once)")
-      ->check(CLI::Range(0u, 100000u));
-}
-inline void checkRefinementInterval(uint32_t interval, float noiseScale) {
-  if (interval > 0 && noiseScale <= 0.0f)
-    throw std::runtime_error("--refinement-interval holds back what --noise-scale calls refinements: give both");
-}
+// The noise-aware stream of serve and demo (EncoderOptions::noiseScale and refinementInterval):
+// a probe is re-sent only when its change exceeds what its Monte Carlo noise explains, and
+// refinements of probes whose light held still wait for every Kth update. On by default wherever
+// probes are traced live (docs/MEASUREMENTS.md, "Defaults", has the figures behind these values);
+// --noise-scale 0 turns it off, and the refinement interval with it unless one is given.
+inline constexpr float kNoiseScaleDefault = 1.6f;
+inline constexpr uint32_t kRefinementIntervalDefault = 8;
+
+struct NoiseRuleCli {
+  float scale = kNoiseScaleDefault;
+  uint32_t refinementInterval = kRefinementIntervalDefault;
+  CLI::Option* scaleOption = nullptr;
+  CLI::Option* intervalOption = nullptr;
+  void add(CLI::App* cmd) {
+    scaleOption = cmd->add_option("--noise-scale", scale,
+                                  "live tracing: a probe is not re-sent while its change stays within this many "
+                                  "standard errors of its Monte Carlo noise (0 = off)")
+                      ->check(CLI::Range(0.0f, 1000.0f))
+                      ->capture_default_str();
+    intervalOption = cmd->add_option("--refinement-interval", refinementInterval,
+                                     "with the noise rule: refinements (changes within twice the noise threshold of "
+                                     "probes whose light held still this many updates) wait for the next update "
+                                     "whose sequence is a multiple of this, every brick's going in that one frame "
+                                     "(0 = at once)")
+                         ->check(CLI::Range(0u, 100000u))
+                         ->capture_default_str();
+  }
+  bool scaleGiven() const { return scaleOption && scaleOption->count() > 0; }
+  bool intervalGiven() const { return intervalOption && intervalOption->count() > 0; }
+  // The rule into `encoder`: as given (or the defaults) for live tracing; off for probes from a
+  // file, which carry no per-probe noise. Throws std::runtime_error when what was given cannot
+  // hold: a scale for a file, or a refinement interval with the rule off.
+  void apply(EncoderOptions& encoder, bool live) const {
+    if (!live && scaleGiven() && scale > 0.0f)
+      throw std::runtime_error("--noise-scale needs live tracing: a --probes file carries no per-probe noise");
+    const bool on = live && scale > 0.0f;
+    if (!on && intervalGiven() && refinementInterval > 0)
+      throw std::runtime_error("--refinement-interval holds back what the noise rule calls refinements, and the rule is " +
+                               std::string(live ? "off (--noise-scale 0)" : "off for a --probes file"));
+    encoder.noiseScale = on ? scale : 0.0f;
+    encoder.refinementInterval = on ? refinementInterval : 0;
+  }
+};
 
 struct TracerOptions {
   uint32_t spp = 128;
@@ -229,8 +268,10 @@ struct TracerOptions {
 // A viewer of probes from a file or a server also takes "auto" (its default): light by the rule
 // the probes state. on or off there must agree with the probes (a clear error otherwise: light
 // would be counted twice or lost), and so must an --area-light-min given.
-// Where probes are traced (view --probes live, serve, bake, demo) and --area-lights is not given.
-inline constexpr char kAreaLightsDefault[] = "off";
+// Where probes are traced (view --probes live, serve, bake, demo) and --area-lights is not given:
+// on, so emitters above --area-light-min are shaded by the viewers with soft shadows (a scene
+// without such emitters has none either way). docs/MEASUREMENTS.md, "Defaults", has the figures.
+inline constexpr char kAreaLightsDefault[] = "on";
 
 struct AreaLightCli {
   std::string mode;
@@ -377,6 +418,19 @@ struct ServerOptions {
     return sc;
   }
 };
+
+// How a started server is secured, for its banner: "TLS, token", "plaintext, token", or, loudly,
+// that anyone may subscribe. A server without authentication also says so on stderr, once.
+inline std::string describeSecurity(const service::ServerConfig& sc, const std::string& who, int port) {
+  const std::string transport = sc.tlsCertPem.empty() ? "plaintext" : "TLS";
+  if (!sc.noAuth) return transport + ", token";
+  fmt::print(stderr,
+             "{}: WARNING: no authentication (--no-auth): anyone who can reach port {} may subscribe; give --token "
+             "or --token-file on any network you do not trust\n",
+             who, port);
+  std::fflush(stderr);
+  return transport + ", NO AUTHENTICATION: anyone may subscribe";
+}
 
 // A client's connection to a server: --connect, --token (and --token-file), --tls-ca, --tls-name.
 struct ConnectOptions {

@@ -14,6 +14,10 @@
 #include <grpc/slice.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <openssl/bio.h>
+#include <openssl/err.h>
+#include <openssl/pem.h>
+#include <openssl/x509.h>
 
 #include "probecast.grpc.pb.h"
 #include "wire_convert.h"
@@ -373,6 +377,37 @@ struct ProbeServer::Impl {
   bool stopping = false;
 };
 
+namespace {
+
+// Checks the certificate and key before gRPC sees them: gRPC reports a bad pair only as a port it
+// could not bind. Throws std::runtime_error saying what is wrong with which of the two.
+void checkTlsPair(const std::string& certPem, const std::string& keyPem) {
+  const auto lastError = [] {
+    char text[256] = "no detail";
+    if (const unsigned long e = ERR_get_error()) ERR_error_string_n(e, text, sizeof text);
+    ERR_clear_error();
+    return std::string(text);
+  };
+  std::unique_ptr<BIO, decltype(&BIO_free)> certBio(BIO_new_mem_buf(certPem.data(), static_cast<int>(certPem.size())),
+                                                    &BIO_free);
+  std::unique_ptr<X509, decltype(&X509_free)> cert(PEM_read_bio_X509(certBio.get(), nullptr, nullptr, nullptr),
+                                                   &X509_free);
+  if (!cert) throw std::runtime_error("the TLS certificate is not a PEM certificate (" + lastError() + ")");
+  std::unique_ptr<BIO, decltype(&BIO_free)> keyBio(BIO_new_mem_buf(keyPem.data(), static_cast<int>(keyPem.size())),
+                                                   &BIO_free);
+  std::unique_ptr<EVP_PKEY, decltype(&EVP_PKEY_free)> key(
+      PEM_read_bio_PrivateKey(keyBio.get(), nullptr, nullptr, nullptr), &EVP_PKEY_free);
+  if (!key)
+    throw std::runtime_error("the TLS key is not an unencrypted PEM private key (" + lastError() + ")");
+  if (X509_check_private_key(cert.get(), key.get()) != 1) {
+    ERR_clear_error();
+    throw std::runtime_error("the TLS key does not match the certificate (it is the private key of another "
+                             "certificate)");
+  }
+}
+
+}  // namespace
+
 ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.config = config;
@@ -384,6 +419,7 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
   if (tls) {
     if (config.tlsCertPem.empty() || config.tlsKeyPem.empty())
       throw std::runtime_error("TLS needs both a certificate and a key");
+    checkTlsPair(config.tlsCertPem, config.tlsKeyPem);
     grpc::SslServerCredentialsOptions options;
     options.pem_key_cert_pairs.push_back({config.tlsKeyPem, config.tlsCertPem});
     creds = grpc::SslServerCredentials(options);

@@ -72,8 +72,10 @@ float ProbeProducer::t() const {
   return static_cast<float>(std::fmod(animation_.start + animation_.ratePerSecond * seconds, 1.0));
 }
 
-void ProbeProducer::freeze() {
-  frozenT_ = t();
+void ProbeProducer::freeze() { freeze(t()); }
+
+void ProbeProducer::freeze(float at) {
+  frozenT_ = at;
   frozen_ = true;
 }
 

@@ -104,8 +104,10 @@ class ProbeProducer {
   bool running() const { return running_; }
   std::string error() const;
 
-  // The animation holds its current t from now on; updates that begin afterwards count as settled.
+  // The animation holds its current t (or `at`) from now on; updates that begin afterwards count
+  // as settled.
   void freeze();
+  void freeze(float at);
   // Generated frames: false holds the lighting (steps only tick), true moves on.
   void setMoving(bool moving) { moving_ = moving; }
   // The animation parameter now (wall-clock animation: at this moment; otherwise of the last update).
