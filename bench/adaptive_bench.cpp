@@ -15,10 +15,10 @@
 #include "probecast/codec/stream.h"
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/imaging/svg_chart.h"
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/view_sets.h"
-#include "probecast/session/probe_interest.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/viewer.h"
@@ -281,12 +281,12 @@ class Setup {
   renderer::ViewSetSpec viewSpec;
   std::vector<renderer::ViewInfo> views;
   // The scored views as a server knows them (what a subscriber sends), for the view weights a
-  // server works out itself (session/probe_interest.h): "surface" from the geometry the views show,
+  // server works out itself (renderer/probe_interest.h): "surface" from the geometry the views show,
   // "lit" also from the light the volume holds. Without probe offsets: the scored renders here
   // draw every volume at the grid positions.
   std::vector<View> serverViews;
   glm::uvec2 sampleSize{0, 0};  // as the producer samples them
-  session::SurfaceLighting firstLighting;
+  renderer::SurfaceLighting firstLighting;
 };
 
 Setup::Setup(const AdaptiveBenchOptions& options, renderer::VulkanContext& vulkan)
@@ -316,8 +316,8 @@ Setup::Setup(const AdaptiveBenchOptions& options, renderer::VulkanContext& vulka
     scored[0].eye = camera.position;
   }
   serverViews = session::priorityViews(scored);
-  sampleSize = session::footprintSampleSize(serverViews.size());
-  firstLighting = session::surfaceLighting(first, scene::AreaLightOptions{});
+  sampleSize = renderer::footprintSampleSize(serverViews.size());
+  firstLighting = renderer::surfaceLighting(first, scene::AreaLightOptions{});
 }
 
 // The truth at every t a scored update has: the views of a converged float volume, and the volume.
@@ -398,12 +398,12 @@ Footprint measureFootprint(const Setup& s, Truth& truth) {
     const float* c = v.probes.data() + static_cast<size_t>(p) * kProbeFloats;
     lit[p] = std::any_of(c, c + kProbeFloats, [](float x) { return x != 0.0f; });
   }
-  const std::vector<session::ViewSample> seen =
-      session::sampleViewSurfaces(sceneNow, s.grid, lit, {}, s.serverViews, s.sampleSize.x, s.sampleSize.y);
+  const std::vector<renderer::ViewSample> seen =
+      renderer::sampleViewSurfaces(sceneNow, s.grid, lit, {}, s.serverViews, s.sampleSize.x, s.sampleSize.y);
   const std::pair<const char*, std::vector<float>> estimates[] = {
-      {"surface", session::probeViewFootprints(seen, s.count)},
-      {"lit", session::probeViewSensitivity(seen, session::sampleDirectLight(sceneNow, seen, s.firstLighting),
-                                            s.firstLighting, v.probes, s.count)}};
+      {"surface", renderer::probeViewFootprints(seen, s.count)},
+      {"lit", renderer::probeViewSensitivity(seen, renderer::sampleDirectLight(sceneNow, seen, s.firstLighting),
+                                             s.firstLighting, v.probes, s.count)}};
   for (const auto& [name, w] : estimates)
     fp.match[name] = {{"pearson", pearson(w, fp.weights, 1.0)}, {"pearson_cube_roots", pearson(w, fp.weights, 1.0 / 3.0)}};
   return fp;
@@ -477,8 +477,8 @@ std::vector<Stream> makeStreams(const Setup& s, const std::vector<float>& footpr
 // The scored views' surfaces and the light on them, for the "surface" and "lit" view weights; the
 // light follows the scene as it moves.
 struct SeenSurfaces {
-  std::vector<session::ViewSample> samples;  // empty: neither weight
-  session::SurfaceLighting lighting;
+  std::vector<renderer::ViewSample> samples;  // empty: neither weight
+  renderer::SurfaceLighting lighting;
   std::vector<glm::vec3> direct;  // sampleDirectLight, again when the lights move
   std::vector<float> litWeights;  // blended over the updates, as the producer does
 };
@@ -557,11 +557,11 @@ RuleRun runRule(const Setup& s, const Truth& truth, const std::vector<float>& fo
   SeenSurfaces seen;
   seen.lighting = s.firstLighting;
   if (o.viewWeights == "surface" || o.viewWeights == "lit") {
-    seen.samples = session::sampleViewSurfaces(s.first, s.grid, u.volume().active, {}, s.serverViews, s.sampleSize.x,
-                                               s.sampleSize.y);
-    if (o.viewWeights == "surface") streams[2].viewWeights = session::probeViewFootprints(seen.samples, s.count);
+    seen.samples = renderer::sampleViewSurfaces(s.first, s.grid, u.volume().active, {}, s.serverViews, s.sampleSize.x,
+                                                s.sampleSize.y);
+    if (o.viewWeights == "surface") streams[2].viewWeights = renderer::probeViewFootprints(seen.samples, s.count);
   }
-  if (!seen.samples.empty()) seen.direct = session::sampleDirectLight(s.first, seen.samples, seen.lighting);
+  if (!seen.samples.empty()) seen.direct = renderer::sampleDirectLight(s.first, seen.samples, seen.lighting);
   for (Stream& st : streams) {
     st.encoder = std::make_unique<StreamEncoder>(s.layout, st.options);
     // The views' own weights: a probe's active flag in this updater may differ from the truth's.
@@ -577,14 +577,14 @@ RuleRun runRule(const Setup& s, const Truth& truth, const std::vector<float>& fo
       u.setScene(now);
       if (!seen.samples.empty() && now.lights != seen.lighting.lights) {
         seen.lighting.lights = now.lights;
-        seen.direct = session::sampleDirectLight(now, seen.samples, seen.lighting);
+        seen.direct = renderer::sampleDirectLight(now, seen.samples, seen.lighting);
       }
     }
     run.restarts.push_back(u.update().restartedProbes);
     const ProbeVolume& v = u.volume();
     if (o.viewWeights == "lit") {
-      session::blendViewWeights(seen.litWeights, session::probeViewSensitivity(seen.samples, seen.direct, seen.lighting,
-                                                                               v.probes, s.count));
+      renderer::blendViewWeights(seen.litWeights, renderer::probeViewSensitivity(seen.samples, seen.direct,
+                                                                                 seen.lighting, v.probes, s.count));
       if (!streams[2].encoder->setViewWeights(seen.litWeights))
         streams[2].encoder->setViewWeights({});  // nothing the views show is lit yet: as the hub does
     }

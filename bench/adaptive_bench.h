@@ -45,9 +45,9 @@ struct AdaptiveBenchOptions {
   // The noise-aware stream's view weights (StreamEncoder::setViewWeights): "none"; "footprint":
   // each probe's measured share of the scored views (at the start, on the converged volume; the
   // raster renders the views once per probe); "surface": what a server can work out from the
-  // views' geometry alone (session::probeViewFootprints); "lit": that weighed by the light the
-  // updater's volume holds, recomputed every update (session::probeViewSensitivity) and blended
-  // over the updates (session::blendViewWeights), as the producer does.
+  // views' geometry alone (renderer::probeViewFootprints); "lit": that weighed by the light the
+  // updater's volume holds, recomputed every update (renderer::probeViewSensitivity) and blended
+  // over the updates (renderer::blendViewWeights), as the producer does.
   std::string viewWeights = "none";
   int deadzone = 1;                  // both streams
   Representation repr = Representation::Zh3;

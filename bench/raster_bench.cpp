@@ -9,8 +9,8 @@
 
 #include "probecast/imaging/image_metrics.h"
 #include "probecast/codec/record.h"
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/renderer/view_sets.h"
-#include "probecast/session/probe_interest.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/viewer.h"
 #include "probecast/imaging/svg_chart.h"
@@ -133,20 +133,21 @@ void measureQuality(const RasterBenchOptions& o, renderer::RasterRenderer& raste
 }
 
 ProducerWeights measureProducerWeights(const RasterBenchOptions& o, const std::vector<renderer::ViewInfo>& views,
-                                       const ProbeVolume& volume, const session::SurfaceLighting& lighting) {
-  const std::vector<View> seen = session::spreadViews(session::priorityViews(views), session::kFootprintViews);
-  const glm::uvec2 size = session::footprintSampleSize(seen.size());
+                                       const ProbeVolume& volume, const renderer::SurfaceLighting& lighting) {
+  const std::vector<View> seen = renderer::spreadViews(session::priorityViews(views), renderer::kFootprintViews);
+  const glm::uvec2 size = renderer::footprintSampleSize(seen.size());
   std::vector<double> surfacesMs, directMs, weightsMs;
-  std::vector<session::ViewSample> samples;
+  std::vector<renderer::ViewSample> samples;
   for (uint32_t k = 0; k < o.repeats; ++k) {
     auto t0 = Clock::now();
-    samples = session::sampleViewSurfaces(o.scene, o.grid, volume.active, volume.offsets, seen, size.x, size.y);
+    samples = renderer::sampleViewSurfaces(o.scene, o.grid, volume.active, volume.offsets, seen, size.x, size.y);
     surfacesMs.push_back(millisecondsSince(t0));
     t0 = Clock::now();
-    const std::vector<glm::vec3> direct = session::sampleDirectLight(o.scene, samples, lighting);
+    const std::vector<glm::vec3> direct = renderer::sampleDirectLight(o.scene, samples, lighting);
     directMs.push_back(millisecondsSince(t0));
     t0 = Clock::now();
-    const std::vector<float> w = session::probeViewSensitivity(samples, direct, lighting, volume.probes, o.grid.count());
+    const std::vector<float> w =
+        renderer::probeViewSensitivity(samples, direct, lighting, volume.probes, o.grid.count());
     weightsMs.push_back(millisecondsSince(t0));
   }
   return {seen.size(), samples.size(), session::medianMidpoint(surfacesMs), session::medianMidpoint(directMs),
@@ -155,7 +156,7 @@ ProducerWeights measureProducerWeights(const RasterBenchOptions& o, const std::v
 
 // Speed per view set, both ways of drawing several views (`renderers`: per view, multiview).
 ViewSetSpeed measureViewSet(const RasterBenchOptions& o, const std::string& name, renderer::RasterRenderer* renderers[2],
-                            const ProbeVolume& volume, const session::SurfaceLighting& lighting) {
+                            const ProbeVolume& volume, const renderer::SurfaceLighting& lighting) {
   renderer::ViewSetSpec spec;
   std::string error;
   if (!renderer::parseViewSet(name, spec, error)) throw std::invalid_argument(error);
@@ -305,7 +306,7 @@ RasterBenchResult runRasterBench(const RasterBenchOptions& o) {
   renderer::RasterRenderer multiview(context, o.scene, o.width, o.height, multi);
   multiview.setProbes(l2);
   metrics.multiviewChunk = multiview.chunkSize();
-  const session::SurfaceLighting lighting = session::surfaceLighting(o.scene, o.raster.areaLights);
+  const renderer::SurfaceLighting lighting = renderer::surfaceLighting(o.scene, o.raster.areaLights);
   renderer::RasterRenderer* renderers[2] = {&raster, &multiview};
   for (const std::string& name : o.viewSets) {
     metrics.viewSets.push_back(measureViewSet(o, name, renderers, volume, lighting));

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <span>
 
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/renderer/raster_client.h"
-#include "probecast/session/probe_interest.h"
 #include "probecast/session/scene_loading.h"
 #include "update_bench.h"
 
@@ -73,7 +73,7 @@ ReconvergenceResult measureReconvergence(renderer::VulkanContext& context, const
     std::memcpy(view.viewProj, &vp[0][0], sizeof view.viewProj);
     view.eye[0] = camera.position.x, view.eye[1] = camera.position.y, view.eye[2] = camera.position.z;
   }
-  const std::vector<float> weights = session::probeViewWeights(grid, bv.offsets, std::span<const View>(&view, 1));
+  const std::vector<float> weights = renderer::probeViewWeights(grid, bv.offsets, std::span<const View>(&view, 1));
   std::vector<uint8_t> inView(grid.count());
   for (uint32_t p = 0; p < grid.count(); ++p) {
     inView[p] = bv.active[p] && weights[p] > 0.0f ? 1 : 0;

@@ -1,4 +1,4 @@
-// What the views show of each probe (session/probe_interest.h): probeViewFootprints on a wall seen
+// What the views show of each probe (renderer/probe_interest.h): probeViewFootprints on a wall seen
 // straight on, behind an occluder, from inside the scene, and with views that see nothing; and
 // probeViewSensitivity against its formula worked by hand (gamma, direct light, colour, textures,
 // bad coefficients).
@@ -11,10 +11,10 @@
 
 #include "probecast/codec/sh.h"
 #include "probecast/renderer/glossy_sh.h"
-#include "probecast/session/probe_interest.h"
+#include "probecast/renderer/probe_interest.h"
 #include "view_test_support.h"
 
-namespace probecast::session {
+namespace probecast::renderer {
 namespace {
 
 using test::toView;
@@ -364,4 +364,4 @@ TEST(ProbeInterest, AClientAreaLightIsAddedAsTheViewersAddIt) {
 }
 
 }  // namespace
-}  // namespace probecast::session
+}  // namespace probecast::renderer

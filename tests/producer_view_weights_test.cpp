@@ -7,7 +7,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "probecast/session/probe_interest.h"
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/session/probe_producer.h"
 #include "view_test_support.h"
 #include "vulkan_test_support.h"
@@ -33,7 +33,7 @@ TEST(ProducerViewWeights, ProbesNoViewShowsAreResentLessAndTheSeenOnesAreNot) {
   hc.encoder.noiseScale = 1.5f;
   const View view = rightWallView();
   // Which probes the view shows (what the producer works out, without the light).
-  const std::vector<float> shown = session::probeViewFootprints(s, grid, {}, std::span<const View>(&view, 1));
+  const std::vector<float> shown = renderer::probeViewFootprints(s, grid, {}, std::span<const View>(&view, 1));
   ASSERT_EQ(shown.size(), grid.count());
 
   constexpr int kUpdates = 48;

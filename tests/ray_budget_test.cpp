@@ -10,8 +10,8 @@
 
 #include "probe_history.h"
 #include "probecast/codec/probe_offsets.h"
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/renderer/probe_updater.h"
-#include "probecast/session/probe_interest.h"
 #include "vulkan_test_support.h"
 #include "probecast/scene/scene.h"
 
@@ -102,7 +102,7 @@ TEST_F(RayBudget, InViewProbesGetMoreAndEveryProbeSomeWithinTenUpdates) {
   o.raysPerUpdate = 64 * 32;  // what brute force spends
   ProbeUpdater u(context_, s, g, o);
   const View view = halfView(g);
-  const std::vector<float> weights = session::probeViewWeights(g, u.volume().offsets, std::span<const View>(&view, 1));
+  const std::vector<float> weights = probeViewWeights(g, u.volume().offsets, std::span<const View>(&view, 1));
   uint32_t seen = 0;
   for (float w : weights) seen += w > 0.0f ? 1u : 0u;
   ASSERT_EQ(seen, 32u) << "the view covers half the volume";
@@ -140,7 +140,7 @@ TEST_F(RayBudget, AProbeGivenNoRaysKeepsItsValueAndItsNoise) {
   o.raysPerUpdate = 16 * 32;  // a quarter of the probes' worth: most get nothing each update
   ProbeUpdater u(context_, s, g, o);
   const View view = halfView(g);
-  u.setViewWeights(session::probeViewWeights(g, u.volume().offsets, std::span<const View>(&view, 1)));
+  u.setViewWeights(probeViewWeights(g, u.volume().offsets, std::span<const View>(&view, 1)));
   uint32_t kept = 0, changed = 0;
   for (int k = 0; k < 12; ++k) {
     const std::vector<float> probes = u.volume().probes, noise = u.volume().noise;
@@ -175,7 +175,7 @@ TEST_F(RayBudget, AnAbsurdBudgetIsCappedAndBadViewWeightsAreRefused) {
   EXPECT_THROW(u.setViewWeights(std::vector<float>(g.count() + 1, 1.0f)), std::invalid_argument);
   View bad = halfView(g);
   bad.viewProj[0] = std::numeric_limits<float>::infinity();
-  const std::vector<float> none = session::probeViewWeights(g, {}, std::span<const View>(&bad, 1));
+  const std::vector<float> none = probeViewWeights(g, {}, std::span<const View>(&bad, 1));
   ASSERT_EQ(none.size(), g.count());
   for (float w : none) EXPECT_EQ(w, 0.0f);  // a view of nonsense sees nothing
   u.setViewWeights(none);

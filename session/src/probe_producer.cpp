@@ -5,7 +5,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "probecast/session/probe_interest.h"
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/volumes.h"
 
@@ -50,7 +50,8 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   geometry_.triangleMaterial = first.triangleMaterial;
   areaLights_ = options.areaLights;
   viewWeights_.clear();
-  lighting_ = noiseRule_ ? surfaceLighting(first, areaLights_) : SurfaceLighting{};  // for the view weights only
+  // for the view weights only
+  lighting_ = noiseRule_ ? renderer::surfaceLighting(first, areaLights_) : renderer::SurfaceLighting{};
   lightingMaterials_ = first.materials;
   footprintsStale_ = true;
   rayBudget_ = options.raysPerUpdate > 0;
@@ -95,7 +96,7 @@ void ProbeProducer::step() {
         footprintsStale_ = true;
       }
       if (noiseRule_ && next.materials != lightingMaterials_) {
-        lighting_ = surfaceLighting(next, areaLights_);
+        lighting_ = renderer::surfaceLighting(next, areaLights_);
         lightingMaterials_ = next.materials;
         directStale_ = true;
       } else if (noiseRule_) {
@@ -107,7 +108,8 @@ void ProbeProducer::step() {
     if (rayBudget_ || noiseRule_) {
       const std::vector<View> views = hub_.subscriberViews();
       if (noiseRule_) hub_.setViewWeights(viewFootprints(views));
-      if (rayBudget_) updater_->setViewWeights(probeViewWeights(updater_->grid(), updater_->volume().offsets, views));
+      if (rayBudget_)
+        updater_->setViewWeights(renderer::probeViewWeights(updater_->grid(), updater_->volume().offsets, views));
     }
     const renderer::UpdateStats st = updater_->update();
     const auto t0 = Clock::now();
@@ -142,23 +144,24 @@ std::vector<float> ProbeProducer::viewFootprints(const std::vector<View>& views)
     return {};
   }
   if (footprintsStale_ || !same(views, footprintViews_)) {
-    const std::vector<View> sampled = spreadViews(views, kFootprintViews);
-    const glm::uvec2 size = footprintSampleSize(sampled.size());
-    viewSurfaces_ = sampleViewSurfaces(geometry_, updater_->grid(), updater_->volume().active,
+    const std::vector<View> sampled = renderer::spreadViews(views, renderer::kFootprintViews);
+    const glm::uvec2 size = renderer::footprintSampleSize(sampled.size());
+    viewSurfaces_ = renderer::sampleViewSurfaces(geometry_, updater_->grid(), updater_->volume().active,
                                        updater_->volume().offsets, sampled, size.x, size.y);
     footprintViews_ = views;
     footprintsStale_ = false;
     directStale_ = true;
   }
   if (directStale_ || direct_.size() != viewSurfaces_.size() || lighting_.lights != directLights_) {
-    direct_ = sampleDirectLight(geometry_, viewSurfaces_, lighting_);
+    direct_ = renderer::sampleDirectLight(geometry_, viewSurfaces_, lighting_);
     directLights_ = lighting_.lights;
     directStale_ = false;
   }
   // The probes' light changes every update: weigh the surfaces by what the volume holds now, and
   // blend that into the weights slowly (blendViewWeights: one noisy update must not move them).
-  blendViewWeights(viewWeights_, probeViewSensitivity(viewSurfaces_, direct_, lighting_, updater_->volume().probes,
-                                                      updater_->grid().count()));
+  renderer::blendViewWeights(viewWeights_, renderer::probeViewSensitivity(viewSurfaces_, direct_, lighting_,
+                                                                          updater_->volume().probes,
+                                                                          updater_->grid().count()));
   return viewWeights_;
 }
 

@@ -124,7 +124,7 @@ class ProbeUpdater {
   void setScene(const scene::Scene& scene);
   UpdateStats update();
   // How much each probe (grid order) matters to viewers, in [0, 1]: 1 inside some subscriber's
-  // view, 0 outside every one (session/probe_interest.h). Empty: every probe counts as seen.
+  // view, 0 outside every one (renderer/probe_interest.h). Empty: every probe counts as seen.
   // Used by the ray budget only. std::invalid_argument for a wrong size or a weight outside [0, 1].
   void setViewWeights(std::vector<float> weights);
   // Samples each probe (grid order) traced in the last update.

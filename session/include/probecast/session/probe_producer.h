@@ -14,10 +14,10 @@
 #include <thread>
 #include <vector>
 
+#include "probecast/renderer/probe_interest.h"
 #include "probecast/renderer/probe_updater.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
-#include "probecast/session/probe_interest.h"
 #include "probecast/service/bus_nats.h"
 #include "probecast/service/probe_hub.h"
 #include "probecast/service/server.h"
@@ -136,10 +136,10 @@ class ProbeProducer {
   std::vector<float> viewFootprints(const std::vector<View>& views);
   scene::Scene geometry_;  // the triangles traced (positions, indices, materials of the last scene set)
   scene::AreaLightOptions areaLights_;      // the updater's: what viewers light themselves
-  SurfaceLighting lighting_;                // of the last scene set
+  renderer::SurfaceLighting lighting_;      // of the last scene set
   std::vector<scene::Material> lightingMaterials_;  // the materials lighting_ is of
   std::vector<View> footprintViews_;        // the views viewSurfaces_ are of
-  std::vector<ViewSample> viewSurfaces_;
+  std::vector<renderer::ViewSample> viewSurfaces_;
   bool footprintsStale_ = true;
   std::vector<glm::vec3> direct_;           // sampleDirectLight of viewSurfaces_ under directLights_
   std::vector<scene::Light> directLights_;

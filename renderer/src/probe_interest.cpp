@@ -1,5 +1,5 @@
 // Probes inside the subscribers' views (probe_interest.h).
-#include "probecast/session/probe_interest.h"
+#include "probecast/renderer/probe_interest.h"
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 #include "probecast/codec/sh.h"
 #include "probecast/renderer/glossy_sh.h"
 
-namespace probecast::session {
+namespace probecast::renderer {
 namespace {
 
 bool finiteView(const View& v) {
@@ -49,9 +49,9 @@ std::vector<float> probeViewWeights(const ProbeGrid& grid, const std::vector<flo
   return weights;
 }
 
-}  // namespace probecast::session
+}  // namespace probecast::renderer
 
-namespace probecast::session {
+namespace probecast::renderer {
 namespace {
 
 struct ClipVertex {
@@ -238,9 +238,9 @@ std::vector<float> probeViewFootprints(const scene::Scene& scene, const ProbeGri
   return probeViewFootprints(sampleViewSurfaces(scene, grid, active, {}, views, width, height), grid.count());
 }
 
-}  // namespace probecast::session
+}  // namespace probecast::renderer
 
-namespace probecast::session {
+namespace probecast::renderer {
 namespace {
 
 // The mean linear colour of an sRGB texture, over a grid of at most 64 × 64 texels.
@@ -498,4 +498,4 @@ void blendViewWeights(std::vector<float>& held, std::span<const float> fresh, fl
     if (std::isfinite(fresh[p]) && fresh[p] >= 0.0f) held[p] = keep * held[p] + rate * fresh[p];
 }
 
-}  // namespace probecast::session
+}  // namespace probecast::renderer

@@ -14,7 +14,7 @@
 #include "probecast/scene/area_lights.h"
 #include "probecast/scene/scene.h"
 
-namespace probecast::session {
+namespace probecast::renderer {
 
 // Per probe (grid order): 1 when the box it shades (its position, plus `offsets` when not empty,
 // grown by one cell on every side: its trilinear support) meets the frustum of any of `views`,
@@ -114,4 +114,4 @@ std::vector<float> probeViewSensitivity(std::span<const ViewSample> samples, std
 constexpr float kViewWeightBlend = 1.0f / 32.0f;
 void blendViewWeights(std::vector<float>& held, std::span<const float> fresh, float rate = kViewWeightBlend);
 
-}  // namespace probecast::session
+}  // namespace probecast::renderer
