@@ -11,12 +11,12 @@
 
 #include "probecast/codec/stream.h"
 #include "probecast/service/client.h"
-#include "probecast/session/child_process.h"
-#include "probecast/session/edge_process.h"
-#include "probecast/session/nats_server.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/volumes.h"
+#include "probecast/testing/child_process.h"
+#include "probecast/testing/edge_process.h"
+#include "probecast/testing/nats_server.h"
 #include "harness.h"
 #include "stream_bench.h"
 
@@ -31,7 +31,7 @@ constexpr char kToken[] = "bench";
 // same lighting for `hold` seconds (so every client can catch up); served directly and
 // published to the bus. Says "port N", then "report MESSAGES BYTES KEYFRAME_BYTES DELTA_BYTES FRAMES".
 int produce(const EdgeBenchOptions& o, const service::BusConfig& bus, double moving, double hold,
-            const session::ChildProcess::Say& say) {
+            const testing::ChildProcess::Say& say) {
   session::ProbeProducer producer(service::hubConfigFor(
       session::unitGrid({kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]}),
       parseRepresentation(o.repr).value_or(Representation::Zh3), 4, 1));
@@ -93,14 +93,14 @@ struct EdgeRig {
   explicit EdgeRig(const EdgeBenchOptions& o)
       : bus(nats.bus("bench")),
         moving(2 * (o.seconds + 1.0) + o.kills * kKillSeconds + 2.0),
-        producer([this, &o](const session::ChildProcess::Say& tell) { return produce(o, bus, moving, hold, tell); }) {
+        producer([this, &o](const testing::ChildProcess::Say& tell) { return produce(o, bus, moving, hold, tell); }) {
     for (int k = 0; k < 2 + o.kills; ++k) {
       service::EdgeConfig ec;
       ec.bus = bus;
       ec.server.listen = at(ports[k % 2]);
       ec.server.token = kToken;
       ec.server.plaintext = true;
-      edges.push_back(std::make_unique<session::EdgeProcess>(ec));
+      edges.push_back(std::make_unique<testing::EdgeProcess>(ec));
     }
   }
   EdgeRig(const EdgeRig&) = delete;
@@ -118,12 +118,12 @@ struct EdgeRig {
     return direct;
   }
 
-  session::NatsServer nats;
+  testing::NatsServer nats;
   const service::BusConfig bus;
-  const int ports[2] = {session::freeLoopbackPort(), session::freeLoopbackPort()};
+  const int ports[2] = {testing::freeLoopbackPort(), testing::freeLoopbackPort()};
   const double moving, hold = 4.0;  // seconds of moving lighting, then of the same lighting
-  session::ChildProcess producer;
-  std::vector<std::unique_ptr<session::EdgeProcess>> edges;
+  testing::ChildProcess producer;
+  std::vector<std::unique_ptr<testing::EdgeProcess>> edges;
 };
 
 // What the bench measures: filled by the phases below, written by edgeJson and edgeTable.

@@ -20,11 +20,11 @@
 #include "probecast/codec/stream.h"
 #include "probecast/service/edge_server.h"
 #include "probecast/service/server.h"
-#include "probecast/session/child_process.h"
-#include "probecast/session/nats_server.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/volumes.h"
+#include "probecast/testing/child_process.h"
+#include "probecast/testing/nats_server.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::bench {
@@ -91,7 +91,7 @@ uint64_t rssKb() {
 std::string sampleLine() { return fmt::format("sample {:.6f} {}", cpuSeconds(), rssKb()); }
 
 // A child's answer to `command`: its next line, which must start with `expect`; the rest of it.
-std::string ask(session::ChildProcess& child, const std::string& command, const std::string& expect,
+std::string ask(testing::ChildProcess& child, const std::string& command, const std::string& expect,
                 const std::string& who) {
   std::string line;
   if (!child.tell(command) || !child.readLine(line))
@@ -112,7 +112,7 @@ ProcessSample parseSample(const std::string& text, const std::string& who) {
 // parent's commands (sample, latency, stop, quit) so that baseline and load are measured apart.
 // With `bus`, it also publishes every brick version there (the relayed topology's origin).
 int serveLightingFrames(double hz, const std::string& repr, std::array<uint16_t, 3> dims, const service::BusConfig* bus,
-                        const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
+                        const testing::ChildProcess::Say& say, const testing::ChildProcess::Hear& hear) {
   session::ProbeProducer producer(service::hubConfigFor(
       session::unitGrid({dims[0], dims[1], dims[2]}), parseRepresentation(repr).value_or(Representation::Zh3), 4, 1));
   service::ServerConfig sc;
@@ -156,8 +156,8 @@ struct LoadReport {
 };
 
 // A load process: `config`'s subscribers, driven by the parent's commands (take, check, quit).
-int runLoad(const LoadClientConfig& config, const session::ChildProcess::Say& say,
-            const session::ChildProcess::Hear& hear) {
+int runLoad(const LoadClientConfig& config, const testing::ChildProcess::Say& say,
+            const testing::ChildProcess::Hear& hear) {
   LoadClient load(config);
   load.start();
   say(fmt::format("connected {}", load.waitConnected(std::chrono::seconds(20))));
@@ -229,8 +229,8 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 // An edge process: an edge server fed from `bus`, driven like the server process (sample,
 // latency, quit). It says its port once the bus has delivered the volume, so subscribers that
 // connect then are served rather than told to go elsewhere.
-int serveEdge(const service::BusConfig& bus, const session::ChildProcess::Say& say,
-              const session::ChildProcess::Hear& hear) {
+int serveEdge(const service::BusConfig& bus, const testing::ChildProcess::Say& say,
+              const testing::ChildProcess::Hear& hear) {
   service::EdgeConfig ec;
   ec.bus = bus;
   ec.server.plaintext = true;
@@ -287,13 +287,13 @@ ProcessSample sampleProcess(pid_t pid) {
 // The server side of a run: its processes (the producer first) and the addresses subscribers
 // connect to; a relayed run also has a nats-server, whose CPU and memory count as the server's.
 struct Topology {
-  std::unique_ptr<session::NatsServer> nats;
-  std::vector<std::unique_ptr<session::ChildProcess>> servers;
+  std::unique_ptr<testing::NatsServer> nats;
+  std::vector<std::unique_ptr<testing::ChildProcess>> servers;
   std::vector<std::string> addresses;
 };
 
 // Starts a server-side child and reads the port it says.
-int startServerChild(session::ChildProcess& child, const std::string& who) {
+int startServerChild(testing::ChildProcess& child, const std::string& who) {
   child.go();
   std::string line;
   int port = 0;
@@ -308,19 +308,19 @@ Topology makeTopology(const StreamBenchOptions& o) {
   Topology t;
   service::BusConfig bus;
   if (o.edges > 0) {
-    t.nats = std::make_unique<session::NatsServer>();
+    t.nats = std::make_unique<testing::NatsServer>();
     bus = t.nats->bus("bench");
   }
   const service::BusConfig* busOrNull = o.edges > 0 ? &bus : nullptr;
-  t.servers.push_back(std::make_unique<session::ChildProcess>(
-      [&o, busOrNull](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
+  t.servers.push_back(std::make_unique<testing::ChildProcess>(
+      [&o, busOrNull](const testing::ChildProcess::Say& say, const testing::ChildProcess::Hear& hear) {
         return serveLightingFrames(o.hz, o.repr, o.grid, busOrNull, say, hear);
       }));
   const int port = startServerChild(*t.servers.back(), "server process");
   if (o.edges == 0) t.addresses.push_back("127.0.0.1:" + std::to_string(port));
   for (int e = 0; e < o.edges; ++e) {
-    t.servers.push_back(std::make_unique<session::ChildProcess>(
-        [bus](const session::ChildProcess::Say& say, const session::ChildProcess::Hear& hear) {
+    t.servers.push_back(std::make_unique<testing::ChildProcess>(
+        [bus](const testing::ChildProcess::Say& say, const testing::ChildProcess::Hear& hear) {
           return serveEdge(bus, say, hear);
         }));
     t.addresses.push_back("127.0.0.1:" + std::to_string(startServerChild(*t.servers.back(), "edge process")));
@@ -328,7 +328,7 @@ Topology makeTopology(const StreamBenchOptions& o) {
   return t;
 }
 
-ProcessSample sampleAll(std::vector<std::unique_ptr<session::ChildProcess>>& processes, const std::string& who,
+ProcessSample sampleAll(std::vector<std::unique_ptr<testing::ChildProcess>>& processes, const std::string& who,
                         pid_t other = -1) {
   ProcessSample total = sampleProcess(other);
   for (auto& p : processes) {
@@ -350,7 +350,7 @@ service::LatencyHistogram takeWriteLatency(Topology& t) {
   return all;
 }
 
-LoadReport takeAll(std::vector<std::unique_ptr<session::ChildProcess>>& loads) {
+LoadReport takeAll(std::vector<std::unique_ptr<testing::ChildProcess>>& loads) {
   LoadReport total;
   for (auto& l : loads) {
     const LoadReport r = parseFigures(ask(*l, "take", "figures", "load process"), "load process");
@@ -414,11 +414,11 @@ ProcessSample sampleServers(Topology& topo) {
 
 // Load: separate processes, a share of the `n` subscribers each. Returns once each has said how
 // many of its subscribers connected.
-std::vector<std::unique_ptr<session::ChildProcess>> startLoads(const StreamBenchOptions& o, const Topology& topo, int n,
+std::vector<std::unique_ptr<testing::ChildProcess>> startLoads(const StreamBenchOptions& o, const Topology& topo, int n,
                                                                SubscriberRun& run) {
   run.loadProcesses = (n + o.subscribersPerLoadProcess - 1) / o.subscribersPerLoadProcess;
   const int processes = run.loadProcesses;
-  std::vector<std::unique_ptr<session::ChildProcess>> loads;
+  std::vector<std::unique_ptr<testing::ChildProcess>> loads;
   for (int k = 0; k < processes; ++k) {
     LoadClientConfig lc;
     lc.addresses = topo.addresses;
@@ -429,8 +429,8 @@ std::vector<std::unique_ptr<session::ChildProcess>> startLoads(const StreamBench
     lc.ackIntervalMs = static_cast<uint32_t>(o.ackIntervalMs);
     lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
     lc.view = [dims = o.grid](uint32_t i) { return randomView(i, dims); };
-    loads.push_back(std::make_unique<session::ChildProcess>(
-        [lc](const session::ChildProcess::Say& s, const session::ChildProcess::Hear& h) { return runLoad(lc, s, h); }));
+    loads.push_back(std::make_unique<testing::ChildProcess>(
+        [lc](const testing::ChildProcess::Say& s, const testing::ChildProcess::Hear& h) { return runLoad(lc, s, h); }));
     loads.back()->go();
   }
   for (auto& l : loads) {
@@ -445,7 +445,7 @@ std::vector<std::unique_ptr<session::ChildProcess>> startLoads(const StreamBench
 
 // The lighting stops; every decoding subscriber must come to hold the producer's volume. Then
 // every process is told to quit.
-void finishRun(Topology& topo, std::vector<std::unique_ptr<session::ChildProcess>>& loads, SubscriberRun& run) {
+void finishRun(Topology& topo, std::vector<std::unique_ptr<testing::ChildProcess>>& loads, SubscriberRun& run) {
   std::string hash;
   {
     const std::string fin = ask(*topo.servers[0], "stop", "final", "server");
@@ -484,7 +484,7 @@ SubscriberRun measureSubscribers(const StreamBenchOptions& o, int n) {
   std::this_thread::sleep_for(1500ms);
   run.baseline = sampleServers(topo);
   run.baselineCores = (run.baseline.cpuSeconds - b0.cpuSeconds) / secondsSince(tb);
-  std::vector<std::unique_ptr<session::ChildProcess>> loads = startLoads(o, topo, n, run);
+  std::vector<std::unique_ptr<testing::ChildProcess>> loads = startLoads(o, topo, n, run);
   if (run.connected == 0) throw std::runtime_error("subscribers never connected to " + topo.addresses[0]);
   if (run.connected < static_cast<uint32_t>(n)) say(fmt::format("only {} of {} subscribers connected", run.connected, n));
   std::this_thread::sleep_for(1s);  // the first keyframes go out

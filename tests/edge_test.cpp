@@ -15,8 +15,8 @@
 #include "probecast/service/bus_nats.h"
 #include "probecast/service/client.h"
 #include "probecast/service/edge_server.h"
-#include "probecast/session/edge_process.h"
-#include "probecast/session/nats_server.h"
+#include "probecast/testing/edge_process.h"
+#include "probecast/testing/nats_server.h"
 #include "service_test_support.h"
 #include "test_probes.h"
 
@@ -42,10 +42,10 @@ struct BusProducer {
 class Edge : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_FALSE(session::NatsServer::findProgram().empty())
+    ASSERT_FALSE(testing::NatsServer::findProgram().empty())
         << "nats-server is a dependency of these tests (scripts/setup.sh installs it): not on PATH, in /usr/sbin "
            "or /usr/bin";
-    nats = std::make_unique<session::NatsServer>();
+    nats = std::make_unique<testing::NatsServer>();
     static int tests = 0;
     bus = nats->bus("edge-test-" + std::to_string(++tests));
   }
@@ -75,7 +75,7 @@ class Edge : public ::testing::Test {
     return c;
   }
 
-  std::unique_ptr<session::NatsServer> nats;
+  std::unique_ptr<testing::NatsServer> nats;
   BusConfig bus;
 };
 
@@ -153,7 +153,7 @@ TEST_F(Edge, AFrozenEdgeIsNoticedByKeepaliveAndItsSubscribersFailOver) {
   fast.server.minClientPingMs = 100;
   // The edge process is forked from this one: before any NATS client thread runs here (one
   // holding a library lock at the fork would leave it held in the child for good).
-  session::EdgeProcess a(fast);
+  testing::EdgeProcess a(fast);
   const int portA = a.start();
   BusProducer producer(bus);
   EdgeServer b(fast);
@@ -399,10 +399,10 @@ TEST_F(Edge, ALinkTheBusRefusesFailsAtOnceSayingWhyAndAnAbsentBusIsReported) {
 TEST(EdgeTls, ABusOverTlsCarriesTheStreamAndUntrustedOrPlaintextLinksAreRefused) {
   std::string key, cert;
   ASSERT_TRUE(makeTestCertificate(PROBECAST_TEST_TMP, "nats-tls", key, cert)) << "openssl could not make a test certificate";
-  session::NatsServerOptions no;
+  testing::NatsServerOptions no;
   no.tlsCert = cert;
   no.tlsKey = key;
-  session::NatsServer nats(no);
+  testing::NatsServer nats(no);
   const BusConfig bus = nats.bus("edge-tls");
   ASSERT_TRUE(bus.tls);
   BusConfig plain = bus;

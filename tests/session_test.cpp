@@ -8,11 +8,11 @@
 #include <stdexcept>
 #include <thread>
 
-#include "probecast/session/child_process.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/stats.h"
 #include "probecast/session/volumes.h"
+#include "probecast/testing/child_process.h"
 
 namespace probecast::session {
 namespace {
@@ -150,7 +150,7 @@ TEST(SessionProducer, ThreadLoopStopsOnRequest) {
 }
 
 TEST(SessionChildProcess, RunsOnlyAfterGoAndPassesLinesAndStatus) {
-  ChildProcess child([](const ChildProcess::Say& say) {
+  testing::ChildProcess child([](const testing::ChildProcess::Say& say) {
     say("port 1234");
     say("report done");
     return 3;
@@ -167,7 +167,8 @@ TEST(SessionChildProcess, RunsOnlyAfterGoAndPassesLinesAndStatus) {
 
 TEST(SessionChildProcess, TakesLinesOfAnyLengthBothWays) {
   const std::string longLine(100000, 'x');  // a histogram or a list of samples is long
-  ChildProcess child([&longLine](const ChildProcess::Say& say, const ChildProcess::Hear& hear) {
+  testing::ChildProcess child([&longLine](const testing::ChildProcess::Say& say,
+                                          const testing::ChildProcess::Hear& hear) {
     std::string line;
     while (hear(line)) {
       if (line == "quit") return 5;
@@ -190,7 +191,7 @@ TEST(SessionChildProcess, TakesLinesOfAnyLengthBothWays) {
 }
 
 TEST(SessionChildProcess, ALongLineFromTheChildArrivesWhole) {
-  ChildProcess child([](const ChildProcess::Say& say) {
+  testing::ChildProcess child([](const testing::ChildProcess::Say& say) {
     say(std::string(5000, 'y'));
     return 0;
   });
@@ -203,8 +204,8 @@ TEST(SessionChildProcess, ALongLineFromTheChildArrivesWhole) {
 }
 
 TEST(SessionChildProcess, AChildDroppedBeforeGoEndsWithoutRunning) {
-  auto first = std::make_unique<ChildProcess>([](const ChildProcess::Say&) { return 7; });
-  ChildProcess second([](const ChildProcess::Say&) { return 0; });  // holds no copy of first's pipes
+  auto first = std::make_unique<testing::ChildProcess>([](const testing::ChildProcess::Say&) { return 7; });
+  testing::ChildProcess second([](const testing::ChildProcess::Say&) { return 0; });  // holds no copy of first's pipes
   first.reset();  // would hang if the second child kept first's "go" pipe open
   second.go();
   EXPECT_EQ(second.wait(), 0);

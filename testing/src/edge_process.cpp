@@ -1,4 +1,4 @@
-#include "probecast/session/edge_process.h"
+#include "probecast/testing/edge_process.h"
 
 #include <pthread.h>
 #include <signal.h>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace probecast::session {
+namespace probecast::testing {
 namespace {
 
 // The child: an edge until SIGTERM. The signal is blocked before any thread starts, so every
@@ -61,4 +61,4 @@ int EdgeProcess::stop() {
   return child_.wait();
 }
 
-}  // namespace probecast::session
+}  // namespace probecast::testing

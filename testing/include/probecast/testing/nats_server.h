@@ -10,7 +10,7 @@
 
 #include "probecast/service/bus_nats.h"
 
-namespace probecast::session {
+namespace probecast::testing {
 
 // A loopback port free now (the kernel's pick); a server told to listen there next gets it.
 int freeLoopbackPort();
@@ -55,4 +55,4 @@ class NatsServer {
   pid_t pid_ = -1;
 };
 
-}  // namespace probecast::session
+}  // namespace probecast::testing

@@ -9,7 +9,7 @@
 #include <functional>
 #include <string>
 
-namespace probecast::session {
+namespace probecast::testing {
 
 class ChildProcess {
  public:
@@ -45,4 +45,4 @@ class ChildProcess {
   FILE* from_ = nullptr;
 };
 
-}  // namespace probecast::session
+}  // namespace probecast::testing

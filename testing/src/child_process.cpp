@@ -1,4 +1,4 @@
-#include "probecast/session/child_process.h"
+#include "probecast/testing/child_process.h"
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-namespace probecast::session {
+namespace probecast::testing {
 
 ChildProcess::ChildProcess(std::function<int(const Say& say)> body) {
   start([body = std::move(body)](const Say& say, const Hear&) { return body(say); });
@@ -127,4 +127,4 @@ int ChildProcess::wait() {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-}  // namespace probecast::session
+}  // namespace probecast::testing

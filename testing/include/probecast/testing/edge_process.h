@@ -6,9 +6,9 @@
 #include <memory>
 
 #include "probecast/service/edge_server.h"
-#include "probecast/session/child_process.h"
+#include "probecast/testing/child_process.h"
 
-namespace probecast::session {
+namespace probecast::testing {
 
 class EdgeProcess {
  public:
@@ -33,4 +33,4 @@ class EdgeProcess {
   bool started_ = false, ended_ = false;
 };
 
-}  // namespace probecast::session
+}  // namespace probecast::testing

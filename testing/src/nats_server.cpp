@@ -1,4 +1,4 @@
-#include "probecast/session/nats_server.h"
+#include "probecast/testing/nats_server.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -21,7 +21,7 @@
 
 extern char** environ;
 
-namespace probecast::session {
+namespace probecast::testing {
 int freeLoopbackPort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   if (fd < 0) throw std::runtime_error("socket failed");
@@ -168,4 +168,4 @@ void NatsServer::stop() {
   pid_ = -1;
 }
 
-}  // namespace probecast::session
+}  // namespace probecast::testing
