@@ -21,7 +21,7 @@ void addBakeCommand(CLI::App& app) {
   bake->callback([=] {
     const scene::Scene s = tr->scene.load();
     const auto env = tr->scene.environment.load();
-    renderer::VulkanContext context(tr->gpu.context());
+    renderer::VulkanContext context(tr->device.context());
     const ProbeGrid g = tr->grid.resolve(s);
     renderer::UpdaterOptions uo = tr->updater(env);
     uo.areaLights = areaLights->options();

@@ -128,7 +128,7 @@ void addBenchUpdate(CLI::App* bench) {
     o.scene = ut->scene.load();
     o.grid = ut->grid.resolve(o.scene);
     o.updater = ut->updater(ut->scene.environment.load());
-    o.context = ut->gpu.context();
+    o.context = ut->device.context();
     o.updates = uo->updates;
     o.referenceSamples = uo->referenceSamples;
     o.minBlendWeights = uo->wMins;
@@ -186,7 +186,7 @@ void addBenchRaster(CLI::App* bench) {
     ro->bench.grid = rt->grid.resolve(ro->bench.scene);
     ro->bench.updater = rt->updater(rt->scene.environment.load());  // the reference and background too
     ro->bench.updater.areaLights = ro->bench.raster.areaLights = ro->areaLights.options();
-    ro->bench.context = rt->gpu.context();
+    ro->bench.context = rt->device.context();
     ro->bench.width = ro->size[0];
     ro->bench.height = ro->size[1];
     ro->bench.command = commandLine();
@@ -242,7 +242,7 @@ void addBenchScene(CLI::App* bench) {
     o.grid = st->grid.resolve(o.scene);
     o.updater = st->updater(st->scene.environment.load());
     o.updater.areaLights = o.raster.areaLights = so->areaLights.options();
-    o.context = st->gpu.context();
+    o.context = st->device.context();
     o.command = commandLine();
     o.progress = progressLine;
     const bench::SceneBenchResult r = bench::runSceneBench(o);
@@ -276,7 +276,7 @@ void addBenchPipeline(CLI::App* bench) {
     po->bench.scene = pt->scene.load();
     po->bench.t = pt->scene.t;
     po->bench.grid = pt->grid.resolve(po->bench.scene);
-    po->bench.context = pt->gpu.context();
+    po->bench.context = pt->device.context();
     po->bench.environment = pt->scene.environment.load();
     po->bench.width = po->size[0];
     po->bench.height = po->size[1];
@@ -299,14 +299,14 @@ void addBenchEnvironment(CLI::App* bench) {
       "environment", "reference tracer convergence under a small sun: environment importance sampling vs BSDF only");
   struct EnvironmentCli {
     SceneOptions scene;
-    GpuOptions gpu;
+    DeviceOptions device;
     std::string json, chart;
     std::vector<uint32_t> size{48, 32};
     bench::EnvironmentBenchOptions bench;
   };
   auto eo = std::make_shared<EnvironmentCli>();
   eo->scene.add(cmd);
-  eo->gpu.add(cmd);
+  eo->device.add(cmd);
   addSizeOption(cmd, eo->size, "image size WxH", 4, 1024);
   addReferenceSppOption(cmd, eo->bench.referenceSpp, 1u << 20);
   cmd->add_option("--spps", eo->bench.spps, "samples per pixel to measure")->delimiter(',')->check(CLI::Range(1, 1 << 16));
@@ -322,7 +322,7 @@ void addBenchEnvironment(CLI::App* bench) {
       eo->bench.scene = bench::sunlitYard(eo->bench.camera);
     }
     eo->bench.environment = eo->scene.environment.given() ? eo->scene.environment.load() : bench::builtinSunSky();
-    eo->bench.context = eo->gpu.context();
+    eo->bench.context = eo->device.context();
     eo->bench.width = eo->size[0];
     eo->bench.height = eo->size[1];
     eo->bench.command = commandLine();
@@ -414,7 +414,7 @@ void addBenchEdge(CLI::App* bench) {
 struct AdaptiveOptions {
   std::string json, chart, repr = "zh3";
   GridOptions grid{{4, 4, 4}, {}};
-  GpuOptions gpu;
+  DeviceOptions device;
   bench::AdaptiveBenchOptions bench;
 };
 
@@ -510,7 +510,7 @@ void addBenchAdaptive(CLI::App* bench) {
   CLI::App* adaptive = bench->add_subcommand(
       "adaptive", "history rejection and the noise-aware stream: bytes still/moving, flicker, lag, PSNR loss");
   auto ao = std::make_shared<AdaptiveOptions>();
-  ao->gpu.add(adaptive);
+  ao->device.add(adaptive);
   adaptive->add_option("--scene", ao->bench.sceneSpec, "an animated scene (t moves its light)");
   ao->grid.add(adaptive, /*withBounds=*/false, 2, 64);
   addAdaptivePhaseOptions(adaptive, ao->bench);
@@ -525,7 +525,7 @@ void addBenchAdaptive(CLI::App* bench) {
     bench::AdaptiveBenchOptions o = ao->bench;
     o.dims = {ao->grid.dims[0], ao->grid.dims[1], ao->grid.dims[2]};
     o.repr = *parseRepresentation(ao->repr);
-    o.context = ao->gpu.context();
+    o.context = ao->device.context();
     o.command = commandLine();
     o.progress = progressLine;
     const bench::AdaptiveBenchResult r = bench::runAdaptiveBench(o);

@@ -14,7 +14,7 @@ namespace probecast::app {
 void addReferenceCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render-reference", "ground-truth camera path tracer (EXR out)");
   auto scene = std::make_shared<SceneOptions>();
-  auto gpu = std::make_shared<GpuOptions>();
+  auto device = std::make_shared<DeviceOptions>();
   struct Options {
     std::vector<uint32_t> size{320, 240};
     uint32_t spp = 256, bounces = 8, seed = 1;
@@ -25,7 +25,7 @@ void addReferenceCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   scene->add(cmd);
-  gpu->add(cmd);
+  device->add(cmd);
   addSizeOption(cmd, o->size, "image size WxH", 1, 8192);
   addSppOption(cmd, o->spp, "samples per pixel", 1u << 20);
   cmd->add_option("--bounces", o->bounces, "surface interactions per path")->check(CLI::Range(1, 16));
@@ -48,7 +48,7 @@ void addReferenceCommand(CLI::App& app) {
       if (std::fabs(glm::dot(camera.forward, camera.up)) > 0.999f) camera.up = glm::vec3(0, 0, -1);
     }
     if (o->yfovDeg > 0) camera.yfov = glm::radians(o->yfovDeg);
-    renderer::VulkanContext context(gpu->context());
+    renderer::VulkanContext context(device->context());
     renderer::ReferenceOptions ro;
     ro.width = o->size[0];
     ro.height = o->size[1];

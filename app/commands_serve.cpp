@@ -70,7 +70,7 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   if (!isValidLayout(hub.layout)) throw std::runtime_error("grid too large for the stream format");
   auto producer = std::make_unique<session::ProbeProducer>(hub);
   if (o.probes.empty()) {
-    context = std::make_unique<renderer::VulkanContext>(tr.gpu.context());
+    context = std::make_unique<renderer::VulkanContext>(tr.device.context());
     session::Animation animation;
     animation.mode = o.animate > 0 ? session::Animation::Mode::PerStep : session::Animation::Mode::Still;
     animation.start = tr.scene.t;

@@ -179,7 +179,7 @@ void addViewCommand(CLI::App& app) {
     const auto environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
         renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
-    renderer::VulkanContext context(o->tracing.gpu.context());
+    renderer::VulkanContext context(o->tracing.device.context());
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;

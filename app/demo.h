@@ -45,7 +45,7 @@ struct DemoOptions {
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
   uint32_t supersample = 4;              // the viewers' raster samples per pixel side (RasterOptions)
   AreaLightCli areaLights;               // the server's rule; the viewers follow what the stream says
-  GpuOptions device;                     // --device: the server's and the viewers' Vulkan device
+  DeviceOptions device;                     // --device: the server's and the viewers' Vulkan device
 };
 
 struct DemoViewer {

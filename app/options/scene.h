@@ -1,0 +1,60 @@
+// The scene a command loads and the distant light around it: --scene, --t, --environment, --sky.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "probecast/renderer/environment.h"
+#include "probecast/scene/scene.h"
+#include "probecast/session/scene_loading.h"
+
+namespace probecast::app {
+
+// Distant light around the scene: --environment FILE (.hdr or .exr, equirect) with
+// --environment-intensity K and --environment-rotation DEG, or a uniform --sky R,G,B. The map's
+// convention is renderer/environment.h's (top row +Y, centre −Z, u = 0.75 toward +X; positive
+// rotation turns it counter-clockwise seen from above, the centre toward −X).
+struct EnvironmentOptions {
+  std::string file;
+  float intensity = 1.0f, rotationDeg = 0.0f;
+  std::vector<float> sky;
+  void add(CLI::App* cmd) {
+    CLI::Option* e = cmd->add_option(
+        "--environment", file, "equirect environment map (.hdr or .exr): top row +Y, image centre facing -Z");
+    cmd->add_option("--environment-intensity", intensity, "scale of the environment map's radiance (>= 0)")->needs(e);
+    cmd->add_option("--environment-rotation", rotationDeg,
+                    "turn the map about +Y, degrees (counter-clockwise seen from above)")
+        ->needs(e);
+    cmd->add_option("--sky", sky, "uniform sky radiance R,G,B instead of a map")->delimiter(',')->expected(3)->excludes(e);
+  }
+  bool given() const { return !file.empty() || !sky.empty(); }
+  // The environment, or null when neither option is given; throws with a clear message for a
+  // missing or unreadable file, non-finite pixels, or a negative or NaN intensity or sky value.
+  std::shared_ptr<const renderer::Environment> load() const {
+    if (!given()) return nullptr;
+    auto env = std::make_shared<renderer::Environment>();
+    std::string error;
+    const bool ok = !file.empty() ? renderer::loadEnvironment(file, intensity, rotationDeg, *env, error)
+                                  : renderer::makeUniformSky({sky[0], sky[1], sky[2]}, *env, error);
+    if (!ok) throw std::runtime_error((!file.empty() ? "--environment: " : "--sky: ") + error);
+    return env;
+  }
+};
+
+struct SceneOptions {
+  std::string scene = "builtin:cornell";
+  float t = 0.0f;
+  EnvironmentOptions environment;
+  void add(CLI::App* cmd) {
+    cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
+    cmd->add_option("--t", t, "animation parameter of built-in scenes")->check(CLI::Range(0.0f, 1.0f));
+    environment.add(cmd);
+  }
+  scene::Scene load() const { return session::loadSceneOrThrow(scene, t); }
+};
+
+}  // namespace probecast::app
