@@ -177,6 +177,11 @@ void addBenchRaster(CLI::App* bench) {
                  &ro->bench.raster.shadowMapSize}
       .add(raster, "probe updates before rendering", "timed renders per case (median)");
   addShadowCascadesOption(raster, ro->bench.raster.shadowCascades);
+  raster->add_option("--supersample", ro->bench.raster.samplesPerSide,
+                     "N × N raster samples per pixel, averaged (1 here, so the timings compare like with like; "
+                     "the viewers default to 4)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   addVisibilityOption(raster, ro->bench.raster.visibility);
   ro->areaLights.add(raster);
   addJsonOption(raster, ro->json);
@@ -222,7 +227,8 @@ void addBenchScene(CLI::App* bench) {
       .add(cmd, "probe updates (each timed)", "timed renders of the view set per representation (median)");
   cmd->add_option("--supersample", so->bench.raster.samplesPerSide,
                   "N × N raster samples per pixel, averaged (as the reference averages each pixel's area)")
-      ->check(CLI::Range(1, 16));
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   addVisibilityOption(cmd, so->bench.raster.visibility);
   so->areaLights.add(cmd);  // the reference sees every emitter either way, so the cached one still serves
   cmd->add_option("--reference-bounces", so->bench.referenceBounces, "surface interactions per reference path")

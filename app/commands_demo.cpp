@@ -34,7 +34,8 @@ void addDemoCommand(CLI::App& app) {
   addVisibilityOption(demo, o->visibility);
   demo->add_option("--supersample", o->supersample,
                    "the viewers' N × N raster samples per pixel, averaged (as the references average each pixel)")
-      ->check(CLI::Range(1, 16));
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   o->areaLights.add(demo);
   o->device.add(demo);
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");

@@ -27,7 +27,7 @@ struct ViewOptions {
   double waitSeconds = 3.0;
   std::vector<uint32_t> size{320, 200};
   uint32_t updates = 4;
-  uint32_t supersample = 4;  // raster samples per pixel side: an image on disk averages each pixel, as a reference does
+  uint32_t supersample = renderer::RasterOptions{}.samplesPerSide;  // raster samples per pixel side
   float exposure = 1.0f;
   bool exr = false;
   bool visibility = true;
@@ -151,7 +151,8 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--supersample", o->supersample,
                   "N × N raster samples per pixel, averaged (as a reference averages the pixel's footprint; 1: "
                   "one sample at the pixel's centre, about N² times faster)")
-      ->check(CLI::Range(1, 16));
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "probecast/renderer/probe_updater.h"
+#include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
@@ -43,7 +44,7 @@ struct DemoOptions {
   EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
   std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
-  uint32_t supersample = 4;              // the viewers' raster samples per pixel side (RasterOptions)
+  uint32_t supersample = renderer::RasterOptions{}.samplesPerSide;  // the viewers' raster samples per pixel side
   AreaLightCli areaLights;               // the server's rule; the viewers follow what the stream says
   DeviceOptions device;                     // --device: the server's and the viewers' Vulkan device
 };

@@ -253,7 +253,7 @@ class Setup {
     return raster.renderViews(views);
   }
   std::vector<renderer::Image> render(const ProbeVolume& v, float t) const {
-    renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, renderer::RasterOptions{});
+    renderer::RasterRenderer raster(context, sceneAt(t), o.width, o.height, singleSampleRaster());
     return renderWith(raster, v);
   }
   // The mean squared error of a set of views' pixels together (after gamma, as PSNR takes it).
@@ -310,7 +310,7 @@ Setup::Setup(const AdaptiveBenchOptions& options, renderer::VulkanContext& vulka
   views = renderer::makeViewSet(camera, viewSpec, viewOptions);
   std::vector<renderer::ViewInfo> scored = views;
   if (viewSpec.kind == renderer::ViewSetSpec::Kind::Mono) {
-    const renderer::RasterRenderer raster(context, first, o.width, o.height, renderer::RasterOptions{});
+    const renderer::RasterRenderer raster(context, first, o.width, o.height, singleSampleRaster());
     scored.assign(1, renderer::ViewInfo{});
     scored[0].viewProj = raster.viewProjection(camera);
     scored[0].eye = camera.position;
@@ -379,7 +379,7 @@ Footprint measureFootprint(const Setup& s, Truth& truth) {
   sayProgress(s.o.progress, "adaptive bench: each probe's footprint in the scored views");
   const scene::Scene sceneNow = s.sceneAt(s.tAt(0));
   const std::vector<float>& converged = truth.probes(s.tAt(0));
-  renderer::RasterRenderer raster(s.context, sceneNow, s.o.width, s.o.height, renderer::RasterOptions{});
+  renderer::RasterRenderer raster(s.context, sceneNow, s.o.width, s.o.height, singleSampleRaster());
   ProbeVolume v = makeProbeVolume(s.grid);
   v.probes = converged;
   const std::vector<renderer::Image> base = s.renderWith(raster, v);

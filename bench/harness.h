@@ -32,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "probecast/imaging/image_metrics.h"
+#include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
@@ -100,6 +101,15 @@ class ReferenceCache {
   std::function<void(const std::string&)> progress_;
   uint32_t renders_ = 0;
 };
+
+// Raster options for the benches that compare streams, representations or rules rather than
+// anti-aliasing: one raster sample per pixel, so their figures hold when the viewers' default
+// (RasterOptions::samplesPerSide) moves. bench scene and bench raster take --supersample.
+inline renderer::RasterOptions singleSampleRaster() {
+  renderer::RasterOptions o;
+  o.samplesPerSide = 1;
+  return o;
+}
 
 // A bench's progress line, sent where `progress` says (nowhere when it is empty).
 void sayProgress(const std::function<void(const std::string&)>& progress, const std::string& line);

@@ -99,7 +99,7 @@ class Scorer {
 
  private:
   static renderer::RasterOptions rasterOptions(const PipelineBenchOptions& o) {
-    renderer::RasterOptions ro;
+    renderer::RasterOptions ro = singleSampleRaster();
     ro.environment = o.environment;
     return ro;
   }

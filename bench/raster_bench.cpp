@@ -197,6 +197,7 @@ nlohmann::json rasterJson(const RasterBenchOptions& o, const std::string& device
   json["reference_psnr_db_estimate"] = ref.accuracyDb;
   json["shadow_map_size"] = o.raster.shadowMapSize;
   json["shadow_cascades"] = o.raster.shadowCascades;
+  json["supersample"] = o.raster.samplesPerSide;  // ms per view are for the supersampled size
   json["area_lights"] = o.raster.areaLights.enabled;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
   if (!m.quality.empty()) json["shadow_ms"] = m.firstShadowMs;

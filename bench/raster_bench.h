@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "probecast/renderer/probe_updater.h"
+#include "harness.h"
 #include "probecast/renderer/raster_client.h"
 
 namespace probecast::bench {
@@ -19,7 +20,7 @@ struct RasterBenchOptions {
   ProbeGrid grid;
   renderer::UpdaterOptions updater;
   renderer::ContextOptions context;
-  renderer::RasterOptions raster;  // shadow map size; `passes` is measured both ways
+  renderer::RasterOptions raster = singleSampleRaster();  // `passes` is measured both ways
   uint32_t updates = 8;            // probe updates before rendering
   uint32_t width = 320, height = 200;
   std::vector<std::string> viewSets = {"mono", "stereo", "lf:2x2", "lf:4x4", "lf:5x5", "lf:8x6"};

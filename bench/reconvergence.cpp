@@ -6,6 +6,7 @@
 
 #include "probecast/renderer/probe_interest.h"
 #include "probecast/renderer/raster_client.h"
+#include "harness.h"
 #include "probecast/session/scene_loading.h"
 #include "update_bench.h"
 
@@ -68,7 +69,7 @@ ReconvergenceResult measureReconvergence(renderer::VulkanContext& context, const
   camera.yfov = o.viewYfov;
   View view{};
   {
-    renderer::RasterRenderer raster(context, before, 64, 64, renderer::RasterOptions{});
+    renderer::RasterRenderer raster(context, before, 64, 64, singleSampleRaster());
     const glm::mat4 vp = raster.viewProjection(camera);
     std::memcpy(view.viewProj, &vp[0][0], sizeof view.viewProj);
     view.eye[0] = camera.position.x, view.eye[1] = camera.position.y, view.eye[2] = camera.position.z;

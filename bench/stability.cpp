@@ -256,7 +256,7 @@ WallLeak measureWallLeak(renderer::VulkanContext& context) {
   r.raySavings = static_cast<double>(r.inactiveProbes) / r.probes;
   const uint32_t w = 48, h = 32;
   // Classification alone: visibility (on by default) also keeps probes inside the wall out.
-  renderer::RasterOptions plain;
+  renderer::RasterOptions plain = singleSampleRaster();
   plain.visibility = false;
   renderer::RasterRenderer raster(context, s, w, h, plain);
   const renderer::CameraView cam = renderer::CameraView::fromScene(s);

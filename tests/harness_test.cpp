@@ -204,10 +204,12 @@ TEST(SceneBench, SupersamplingMatchesThePixelFootprintOfTheReference) {
   o.referenceCache = dir.string();
   o.context = test::validatedContext();
   const auto floatPsnr = [](const SceneBenchResult& r) { return r.json["representations"][0]["psnr_db"].get<double>(); };
-  const SceneBenchResult one = runSceneBench(o);
-  o.raster.samplesPerSide = 4;
-  const SceneBenchResult four = runSceneBench(o);  // the cached reference, the same probes
+  EXPECT_EQ(o.raster.samplesPerSide, 4u) << "the library's default is supersampled";
+  const SceneBenchResult four = runSceneBench(o);
+  o.raster.samplesPerSide = 1;
+  const SceneBenchResult one = runSceneBench(o);  // the cached reference, the same probes
   EXPECT_EQ(four.json["supersample"].get<uint32_t>(), 4u);
+  EXPECT_EQ(one.json["supersample"].get<uint32_t>(), 1u);
   EXPECT_GT(floatPsnr(four), floatPsnr(one) + 2.0) << "1 sample per pixel " << floatPsnr(one) << " dB, 16: "
                                                    << floatPsnr(four) << " dB";
   std::filesystem::remove_all(dir);

@@ -174,6 +174,7 @@ TEST(RasterClient, SupersampledPixelsAreTheMeanOfTheirBlockAtNTimesTheSize) {
   const ProbeVolume probes = onceUpdatedProbes(context, s, 3, 16);
   constexpr uint32_t kW = 20, kH = 16, kN = 3;
   RasterOptions one, three;
+  one.samplesPerSide = 1;
   three.samplesPerSide = kN;
   RasterRenderer small(context, s, kW, kH, one), large(context, s, kW * kN, kH * kN, one),
       supersampled(context, s, kW, kH, three);

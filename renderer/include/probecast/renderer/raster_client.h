@@ -59,8 +59,9 @@ struct RasterOptions {
   bool visibilityCulling = true;
   // Raster samples per pixel side (1..16): views are drawn at this multiple of the size and each
   // pixel is the mean of its N × N block, the footprint a path-traced reference averages. Costs
-  // about N² the shading time; the images keep the size the renderer was made with.
-  uint32_t samplesPerSide = 1;
+  // about N² the shading time; the images keep the size the renderer was made with. 4 by default,
+  // the measured best (docs/MEASUREMENTS.md, "Defaults"); 1 draws one sample per pixel.
+  uint32_t samplesPerSide = 4;
 };
 
 struct RasterTimings {
