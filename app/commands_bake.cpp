@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/probe_updater.h"
+#include "probecast/session/scene_state.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -21,6 +22,7 @@ void addBakeCommand(CLI::App& app) {
   bake->callback([=] {
     const scene::Scene s = tr->scene.load();
     const auto env = tr->scene.environment.load();
+    const service::ScenePackage package = tr->scene.package();  // the file names the scene it was traced in
     renderer::VulkanContext context(tr->device.context());
     const ProbeGrid g = tr->grid.resolve(s);
     renderer::UpdaterOptions uo = tr->updater(env);
@@ -44,6 +46,7 @@ void addBakeCommand(CLI::App& app) {
     ProbeVolume volume = updater.volume();
     volume.samplesPerProbe = tr->tracer.spp;  // as asked for (the updater traces it rounded up to 32s)
     volume.areaLights = session::areaLightRuleOf(uo.areaLights);  // so viewers light what the probes left out
+    volume.scene = session::stampOf(package, tr->scene.t);
     fmt::print("bake: client area lights {}\n",
                uo.areaLights.enabled ? fmt::format("on (emitters of at least {} of the power)", uo.areaLights.minPowerFraction)
                                      : "off (the probes hold every emitter)");
@@ -51,7 +54,7 @@ void addBakeCommand(CLI::App& app) {
     orThrow(writeProbeFile(*out, volume, error), error);
     if (context.validationMessages() > 0)
       fmt::print(stderr, "bake: {} Vulkan validation messages\n", context.validationMessages());
-    fmt::print("wrote {}\n", *out);
+    fmt::print("wrote {} ({} at scene time {})\n", *out, package.describe(), tr->scene.t);
   });
 }
 

@@ -11,6 +11,7 @@
 #include "probecast/service/client.h"
 #include "probecast/service/server.h"
 #include "probecast/session/probe_producer.h"
+#include "probecast/session/scene_state.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -32,11 +33,51 @@ struct ServeOptions {
   double hz = 10.0, seconds = 0.0, animate = 0.05;
 };
 
+// The scene package a probe file's viewers are sent: the one it names, with its files from
+// --scene (and its lighting), checked, or from the scene cache; none when the file names none.
+std::shared_ptr<const service::ScenePackage> filePackage(const SceneOptions& given, const ProbeVolume& file) {
+  std::string error;
+  if (!file.scene.known()) {
+    if (!given.sceneGiven()) {
+      fmt::print(stderr, "serve: {} names no scene (made before scenes were named): viewers must bring their own\n",
+                 "the probe file");
+      return nullptr;
+    }
+    fmt::print("serve: the probe file names no scene: describing it as {}, as given\n", given.scene);
+    return std::make_shared<const service::ScenePackage>(given.package());
+  }
+  service::ScenePackage named;
+  orThrow(service::parseManifest(file.scene.manifest, named, error), "the probe file's scene: " + error);
+  if (named.files.empty() && !given.sceneGiven()) return std::make_shared<const service::ScenePackage>(named);
+  if (given.sceneGiven()) {
+    const service::ScenePackage local = given.package();
+    if (local.hash != named.hash)
+      throw std::runtime_error("--scene " + given.scene + " (" + local.describe() + ") is not the scene the probe file "
+                               "was traced in (" + named.describe() + ")");
+    return std::make_shared<const service::ScenePackage>(local);
+  }
+  service::ScenePackage cached;
+  if (service::findCachedPackage(service::defaultSceneCache(), named.hash, cached))
+    return std::make_shared<const service::ScenePackage>(cached);
+  throw std::runtime_error("the probe file was traced in " + named.describe() + ": give --scene " + named.scene +
+                           " (and its --environment or --sky) so that viewers can be sent it");
+}
+
+// The state a file's probes were traced in: its scene time, and the lights of its scene then.
+bus::SceneState fileState(const service::ScenePackage* package, const ProbeVolume& file) {
+  scene::Scene s;
+  if (package && !package->localSceneSpec().empty())
+    s = session::loadSceneOrThrow(package->localSceneSpec(), session::animationT(file.scene.time));
+  return session::sceneStateOf(s, file.scene.time, 0.0, service::wallClockUs());
+}
+
 // The producer of a serve: the baked file (published once, then budget ticks) or the scene traced
-// live, its t advanced by --animate per second at --hz. `hub` and `what` describe it.
+// live, its scene clock run by --animate scene seconds per second. `hub`, `what` and `package`
+// (the scene viewers are sent) describe it.
 std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, ProbeVolume& file,
                                                      std::unique_ptr<renderer::VulkanContext>& context,
-                                                     service::HubConfig& hub, std::string& what) {
+                                                     service::HubConfig& hub, std::string& what,
+                                                     std::shared_ptr<const service::ScenePackage>& package) {
   const Representation repr = session::parseRepresentationOrThrow(o.repr);
   const TracingOptions& tr = o.tracing;
   EncoderOptions noiseRule;  // checked before anything is read or traced
@@ -44,18 +85,20 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   scene::Scene s;
   ProbeGrid g;
   if (!o.probes.empty()) {
-    if (tr.scene.environment.given())
-      throw std::runtime_error("--environment and --sky light live tracing; a --probes file was traced already");
     std::string error;
     orThrow(readProbeFile(o.probes, file, error), error);
     o.areaLights.follow(file.areaLights, o.probes);  // a file's rule is what it was traced with
     hub = service::hubConfigFor(file.grid, repr, o.brick, o.deadzone);
     hub.areaLights = file.areaLights;
+    package = filePackage(tr.scene, file);
+    if (package) hub.scene = session::stampOf(*package, file.scene.time);
     what = o.probes;
   } else {
     s = tr.scene.load();
     g = tr.grid.resolve(s);
     hub = service::hubConfigFor(g, repr, o.brick, o.deadzone);
+    package = std::make_shared<const service::ScenePackage>(tr.scene.package());
+    hub.scene = session::stampOf(*package, tr.scene.t);
     what = s.name;
   }
   hub.encoder.noiseScale = noiseRule.noiseScale;
@@ -72,14 +115,15 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   if (o.probes.empty()) {
     context = std::make_unique<renderer::VulkanContext>(tr.device.context());
     session::Animation animation;
-    animation.mode = o.animate > 0 ? session::Animation::Mode::PerStep : session::Animation::Mode::Still;
+    animation.mode = o.animate > 0 ? session::Animation::Mode::WallClock : session::Animation::Mode::Still;
     animation.start = tr.scene.t;
-    animation.perStep = static_cast<float>(o.animate / o.hz);
+    animation.ratePerSecond = o.animate;
     animation.reloadScene = session::sceneAnimates(tr.scene.scene);  // a glTF file is the same at every t
     renderer::UpdaterOptions uo = tr.updater(tr.scene.environment.load());
     uo.areaLights = o.areaLights.options();
     producer->traceScene(*context, tr.scene.scene, s, g, uo, animation);
   }
+  if (!o.probes.empty()) producer->hub().setSceneState(fileState(package.get(), file));
   return producer;
 }
 
@@ -109,9 +153,10 @@ void addServeCommand(CLI::App& app) {
   o->bus.add(serve, publish);
   serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
-  serve->add_option("--animate", o->animate, "live: animation parameter t advanced per second")->check(CLI::Range(0.0, 10.0));
+  serve->add_option("--animate", o->animate, "live: scene seconds per second (the scene clock's rate; 0: still)")
+      ->check(CLI::Range(0.0, 10.0));
   serve->callback([o] {
-    const service::ServerConfig sc = o->server.config();
+    service::ServerConfig sc = o->server.config();
     service::BusConfig bus;
     bus.url = o->publish;
     bus.stream = o->stream;
@@ -120,7 +165,7 @@ void addServeCommand(CLI::App& app) {
     std::unique_ptr<renderer::VulkanContext> context;
     service::HubConfig hc;
     std::string what;
-    const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what);
+    const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what, sc.scene);
     const int port = producer->serve(sc);
     if (!o->publish.empty()) {
       producer->publishTo(bus);
@@ -132,6 +177,7 @@ void addServeCommand(CLI::App& app) {
                describeSecurity(sc, "serve", port), representationName(hc.layout.repr), hc.layout.grid[0],
                hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file",
                rule.on() ? fmt::format("on ({})", rule.minPowerFraction) : "off");
+    if (sc.scene) fmt::print("serve: scene {}\n", sc.scene->describe());
     std::fflush(stdout);
     std::signal(SIGINT, [](int) { gInterrupted = true; });
     std::signal(SIGTERM, [](int) { gInterrupted = true; });
@@ -192,6 +238,13 @@ void addSubscribeCommand(CLI::App& app) {
     if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
     service::VolumeSnapshot snap;
     if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connection.connect);
+    service::ScenePackage named;
+    std::string why;
+    fmt::print("subscribe: {} at scene time {:.4f} (clock offset {:.1f} ms)\n",
+               snap.volume.scene.known() && service::parseManifest(snap.volume.scene.manifest, named, why)
+                   ? "scene " + named.describe()
+                   : std::string("no scene named"),
+               snap.volume.scene.time, static_cast<double>(snap.clockOffsetUs) / 1e3);
     if (!so->out.empty()) {
       std::string error;
       orThrow(writeProbeFile(so->out, snap.volume, error), error);

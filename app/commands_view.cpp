@@ -11,6 +11,8 @@
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/service/client.h"
+#include "probecast/session/scene_loading.h"
+#include "probecast/session/scene_state.h"
 #include "probecast/session/viewer.h"
 #include "scene_options.h"
 
@@ -33,6 +35,8 @@ struct ViewOptions {
   bool visibility = true;
   float visibilityReach = 1.0f;
   bool visibilityCulling = true;
+  std::string sceneCache;             // --connect: where fetched scenes are kept (empty: the default)
+  uint64_t sceneMaxBytes = uint64_t{4} << 30;
 };
 
 struct Rendered {
@@ -48,9 +52,11 @@ void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) 
     fmt::print("view: client area lights off (the probes hold every emitter)\n");
 }
 
-// A viewer of a server's stream: subscribe for --wait seconds, then render what it holds.
+// A viewer of a server's stream: subscribe for --wait seconds, then render what it holds at its
+// display clock (`sceneSpec` shaded at the display time).
 Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
-                          const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro) {
+                          const std::string& sceneSpec, const std::vector<renderer::ViewInfo>& views,
+                          const renderer::RasterOptions& ro) {
   session::ViewerConfig vc;
   vc.width = o.size[0];
   vc.height = o.size[1];
@@ -59,6 +65,7 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   vc.client.zh3PerPixel = true;
   if (o.repr != "float") vc.client.representation = session::parseRepresentationOrThrow(o.repr);  // transcoded
   if (o.areaLights.mode != "auto") vc.areaLights = o.areaLights.mode == "on";
+  vc.sceneSpec = sceneSpec;  // direct light at the display clock, locked to the stream's
   session::Viewer viewer(context, s, views, vc);
   viewer.start();
   viewer.waitFor(o.waitSeconds);
@@ -74,6 +81,10 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
   printAreaLights(viewer.areaLightRule(), viewer.areaLights());
+  fmt::print("view: drawn at scene time {:.4f} (display clock); probes traced at {:.4f}, {:.4f} s older; clock offset "
+             "{:.1f} ms\n",
+             viewer.displayTime(), held.volume.scene.time, viewer.probeAge(),
+             static_cast<double>(viewer.clockOffsetUs()) / 1e3);
   return {viewer.images(), viewer.timings().viewsMs, viewer.timings().shadowMs};
 }
 
@@ -114,6 +125,24 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   r.viewsMs = raster.timings().viewsMs;
   r.shadowMs = raster.timings().shadowMs;
   return r;
+}
+
+// The scene a --connect viewer draws: the stream's (fetched, or its own --scene checked against it).
+session::ViewerScene streamScene(const ViewOptions& o) {
+  const service::ClientConfig cc = o.connection.client("probecast-view");
+  SceneStamp stamp;
+  std::string error;
+  orThrow(service::describeScene(cc, stamp, error), error);
+  session::SceneChoice choice;
+  if (o.tracing.scene.sceneGiven()) choice.localSpec = o.tracing.scene.scene;
+  if (o.tracing.scene.environment.given()) choice.localLighting = o.tracing.scene.environment.request();
+  choice.cache = o.sceneCache.empty() ? service::defaultSceneCache() : std::filesystem::path(o.sceneCache);
+  choice.maxBytes = o.sceneMaxBytes;
+  service::SceneFetch fetch;
+  session::ViewerScene vs = session::resolveViewerScene(stamp, choice, cc, fetch);
+  vs.time = stamp.time;
+  fmt::print("view: {}\n", vs.note);
+  return vs;
 }
 
 // quilt.png (tone-mapped), quilt.exr and, with --exr, every view as an EXR.
@@ -171,13 +200,33 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--visibility-culling", o->visibilityCulling,
                   "on: each depth-cube face draws only the triangles within reach; off: all (same result)");
   o->areaLights.add(cmd, /*follows=*/true);
+  cmd->add_option("--scene-cache", o->sceneCache,
+                  "--connect: folder of scenes fetched from servers, by hash (default $PROBECAST_SCENE_CACHE, else "
+                  "~/.cache/probecast/scenes)");
+  cmd->add_option("--scene-max-bytes", o->sceneMaxBytes, "--connect: the largest scene this viewer fetches")
+      ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40))
+      ->capture_default_str();
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
     renderer::ViewSetSpec spec;
     std::string error;
     orThrow(renderer::parseViewSet(o->views, spec, error), error);
-    const scene::Scene s = o->tracing.scene.load();
-    const auto environment = o->tracing.scene.environment.load();  // background, and the light of live probes
+    std::string sceneSpec = o->tracing.scene.scene;
+    float t = o->tracing.scene.t;
+    std::shared_ptr<const renderer::Environment> environment;
+    if (!o->connection.connect.empty()) {
+      if (o->tracing.scene.tOption->count() > 0)
+        throw std::runtime_error("--t: a viewer of a stream draws at the stream's scene clock");
+      const session::ViewerScene vs = streamScene(*o);
+      sceneSpec = vs.spec;
+      t = session::animationT(vs.time);
+      environment = vs.environmentFile.empty() && vs.lighting.kind == service::SceneLighting::Kind::None
+                        ? o->tracing.scene.environment.load()
+                        : loadLighting(vs.lighting, vs.environmentFile);
+    } else {
+      environment = o->tracing.scene.environment.load();  // background, and the light of live probes
+    }
+    const scene::Scene s = session::loadSceneOrThrow(sceneSpec, t);
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
         renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
     renderer::VulkanContext context(o->tracing.device.context());
@@ -192,7 +241,7 @@ void addViewCommand(CLI::App& app) {
     ro.samplesPerSide = o->supersample;
     renderer::checkRasterSize(o->size[0], o->size[1], ro);  // before any tracing or connecting
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
-                                                     : renderFromServer(*o, context, s, views, ro);
+                                                     : renderFromServer(*o, context, s, sceneSpec, views, ro);
     writeViews(*o, r, views, spec);
     fmt::print("view: {} {} views of {}x{} ({}² samples per pixel) on {}: {:.1f} ms per view, shadow maps {:.1f} ms; "
                "wrote {}/quilt.png and quilt.exr\n",

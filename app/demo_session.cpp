@@ -78,7 +78,6 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
   run.viewers[1].width = 128;
   run.viewers[1].height = 80;
   run.viewers[1].budget = o.lightFieldBudget;
-  session::ProbeProducer& producer = *run.producer;
   for (DemoViewer& v : run.viewers) {
     std::string error;
     orThrow(renderer::parseViewSet(v.viewSet, v.spec, error), error);
@@ -93,10 +92,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
     vc.client.budgetBytesPerSecond = v.budget;
     vc.client.zh3PerPixel = true;
     vc.raster.environment = o.sky;  // the background; its light comes through the probes
-    if (session::sceneAnimates(o.scene)) {  // direct light is local: the light now
-      vc.sceneSpec = o.scene;
-      vc.lightT = [&producer] { return producer.t(); };
-    }
+    vc.sceneSpec = o.scene;  // direct light is local, at the display clock locked to the stream's
     v.viewer = std::make_unique<session::Viewer>(
         *run.viewerContext, run.scene0,
         renderer::makeViewSet(renderer::CameraView::fromScene(run.scene0), v.spec,

@@ -125,7 +125,8 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
     std::string why;
     std::vector<float> offsets;  // where the probes are and what they leave out: not needed to count bytes
     AreaLightRule areaLights;
-    if (!service::volumeFromWire(v, layout, bounds, offsets, areaLights, why)) {
+    SceneStamp scene;
+    if (!service::volumeFromWire(v, layout, bounds, offsets, areaLights, scene, why)) {
       tally_.error("bad volume description: " + why);
       return;
     }

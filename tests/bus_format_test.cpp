@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <limits>
 #include <random>
 
 #include "probecast/codec/crc32c.h"
@@ -70,18 +72,24 @@ void reseal(std::vector<uint8_t>& m) {
 }
 
 TEST(BusFormat, VolumeMessageGoldenBytes) {
-  // Written out by hand from the format in bus_format.h (codec format 4); the CRC-32C is of bytes
-  // 0-11 and 16-79, computed independently.
+  // Written out by hand from the format in bus_format.h (bus format 4, codec format 4); the
+  // CRC-32C is of bytes 0-11 and 16-117, computed independently.
   const uint8_t golden[] = {
-      0x50, 0x43, 0x42, 0x4d, 0x03, 0x01, 0x01, 0x00, 0x40, 0x00, 0x00, 0x00, 0x0d, 0xc6, 0xa8, 0x97,  // header
+      0x50, 0x43, 0x42, 0x4d, 0x04, 0x01, 0x01, 0x00, 0x66, 0x00, 0x00, 0x00, 0x4d, 0x3a, 0xfa, 0x93,  // header
       0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01, 0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11,  // epoch, time
       0x04, 0x03, 0x04, 0x00, 0x10, 0x00, 0x04, 0x00, 0x10, 0x00, 0x00, 0x00,                          // layout, no offsets
       0x00, 0x00, 0x00, 0xc0, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xc0,                          // min
       0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xc0, 0x3f, 0x00, 0x00, 0xb0, 0x40,                          // max
       0x00, 0x00, 0x00, 0x00,                                                                          // offsets CRC
-      0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3e};                                                 // area light rule
+      0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3e,                                                  // area light rule
+      0x00, 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0a, 0x0b, 0x0c, 0x0d, 0x0e, 0x0f,  // scene hash
+      0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16, 0x17, 0x18, 0x19, 0x1a, 0x1b, 0x1c, 0x1d, 0x1e, 0x1f,
+      0x02, 0x00, 0x00, 0x00, 0x7b, 0x7d};                                                             // manifest "{}"
+  Volume named = sampleVolume();
+  for (uint8_t i = 0; i < 32; ++i) named.sceneHash[i] = i;
+  named.sceneManifest = "{}";
   std::vector<uint8_t> out;
-  writeVolumeMessage(sampleVolume(), kEndOfBatch, out);
+  writeVolumeMessage(named, kEndOfBatch, out);
   EXPECT_EQ(out, std::vector<uint8_t>(std::begin(golden), std::end(golden)));
   Message m;
   std::string why;
@@ -94,6 +102,19 @@ TEST(BusFormat, VolumeMessageGoldenBytes) {
   EXPECT_EQ(m.volume.layout.repr, Representation::Zh3);
   EXPECT_EQ(m.volume.bounds.max[2], 5.5f);
   EXPECT_EQ(m.volume.areaLights, (AreaLightRule{kAreaLightRuleVersion, 0.25f}));
+  EXPECT_EQ(m.volume.sceneHash, named.sceneHash);
+  EXPECT_EQ(m.volume.sceneManifest, "{}");
+  // A version 3 message (no scene) is refused by its version, not misread.
+  std::vector<uint8_t> v3(std::begin(golden), std::end(golden));
+  v3[4] = 3;
+  reseal(v3);
+  EXPECT_NE(refusal(v3).find("bus format version 3, this build reads 4"), std::string::npos) << refusal(v3);
+  // A hash without a manifest (and a manifest without a hash) under a valid checksum.
+  std::vector<uint8_t> noManifest;
+  Volume hashOnly = named;
+  hashOnly.sceneManifest.clear();
+  writeVolumeMessage(hashOnly, 0, noManifest);
+  EXPECT_NE(refusal(noManifest).find("scene hash without a manifest"), std::string::npos) << refusal(noManifest);
   // The same message from a build that wrote codec format 3 (no Rice-coded deltas; bare sections
   // carry no version of their own) is refused, saying so, not misread.
   std::vector<uint8_t> older(std::begin(golden), std::end(golden));
@@ -198,7 +219,73 @@ TEST(BusFormat, FieldsBehindTheChecksumAreCheckedToo) {
   std::vector<uint8_t> asVolume = good;
   asVolume[5] = static_cast<uint8_t>(Kind::Volume);
   reseal(asVolume);
-  EXPECT_NE(refusal(asVolume).find("offset bytes, its volume 0"), std::string::npos);
+  EXPECT_NE(refusal(asVolume).find("manifest"), std::string::npos) << refusal(asVolume);
+}
+
+SceneState sampleState() {
+  SceneState st;
+  st.time = 12.375;
+  st.rate = 0.05;
+  st.clockUs = 1764950000123456ull;
+  LightState point;
+  point.position[1] = 1.9f;
+  point.color[0] = 0.5f;
+  point.intensity = 20.0f;
+  LightState spot;
+  spot.type = 1;
+  spot.direction[0] = 0.6f;
+  spot.direction[1] = -0.8f;
+  spot.innerCone = 0.2f;
+  spot.outerCone = 0.5f;
+  spot.range = 10.0f;
+  st.lights = {point, spot};
+  return st;
+}
+
+TEST(BusFormat, BrickMessagesCarryTheSceneStateOfTheirFrame) {
+  Encoded e;
+  Message m;
+  std::string why;
+  std::vector<uint8_t> bytes = e.message(6);
+  ASSERT_TRUE(readMessage(bytes.data(), bytes.size(), m, why)) << why;
+  EXPECT_EQ(m.brick.state, SceneState{});  // a frame of no known state: time 0, still, no lights
+  Brick b = m.brick;
+  b.state = sampleState();
+  std::vector<uint8_t> withState;
+  writeBrickMessage(m.volume, b, 0, withState);
+  EXPECT_EQ(withState.size(), bytes.size() + 2 * kLightStateSize);
+  ASSERT_TRUE(readMessage(withState.data(), withState.size(), m, why)) << why;
+  EXPECT_EQ(m.brick.state, sampleState());
+  // The state's fields as the format places them: time right after the brick's fixed part.
+  const size_t at = kHeaderSize + kVolumeSize + kBrickFixedSize;
+  double time = 0.0;
+  uint32_t lights = 0;
+  std::memcpy(&time, withState.data() + at, 8);
+  std::memcpy(&lights, withState.data() + at + 24, 4);
+  EXPECT_EQ(time, 12.375);
+  EXPECT_EQ(lights, 2u);
+  // Nonsense states under a valid checksum, each refused with its reason.
+  const auto refusedWith = [&](const std::function<void(SceneState&)>& breakIt, const std::string& reason) {
+    Brick bad = b;
+    breakIt(bad.state);
+    std::vector<uint8_t> out;
+    writeBrickMessage(m.volume, bad, 0, out);
+    EXPECT_NE(refusal(out).find(reason), std::string::npos) << refusal(out);
+  };
+  refusedWith([](SceneState& s) { s.time = std::nan(""); }, "scene time is not finite");
+  refusedWith([](SceneState& s) { s.rate = 1e9; }, "playback rate");
+  refusedWith([](SceneState& s) { s.lights[1].type = 7; }, "unknown type 7");
+  refusedWith([](SceneState& s) { s.lights[0].direction[1] = 0.0f; }, "not unit length");
+  refusedWith([](SceneState& s) { s.lights[0].intensity = -1.0f; }, "negative intensity");
+  refusedWith([](SceneState& s) { s.lights[1].innerCone = 0.9f; }, "cone angles");
+  refusedWith([](SceneState& s) { s.lights[0].color[2] = std::numeric_limits<float>::infinity(); }, "NaN or Inf");
+  refusedWith([](SceneState& s) { s.lights.resize(65); }, "65 lights");
+  // A light count that runs past the message.
+  std::vector<uint8_t> lying = withState;
+  const uint32_t many = 60;
+  std::memcpy(lying.data() + at + 24, &many, 4);
+  reseal(lying);
+  EXPECT_NE(refusal(lying).find("truncated in its scene state"), std::string::npos) << refusal(lying);
 }
 
 // Sample offsets for the sample volume: probe p moves (p % 7 - 3) × 20 steps along x and 5 along z.
@@ -251,7 +338,7 @@ TEST(BusFormat, MalformedOffsetsAreRefused) {
   v.offsets = sampleOffsets();
   std::vector<uint8_t> good;
   writeVolumeMessage(v, 0, good);
-  const size_t at = kHeaderSize + kVolumeSize;  // the first offset byte
+  const size_t at = kHeaderSize + kVolumeSize + 4;  // the first offset byte (after an empty manifest)
   // One offset byte short (sizes and checksums made consistent): the count is wrong.
   std::vector<uint8_t> shorter(good.begin(), good.end() - 1);
   const uint32_t body = static_cast<uint32_t>(shorter.size() - kHeaderSize);

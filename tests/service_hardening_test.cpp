@@ -30,7 +30,7 @@ std::unique_ptr<pb::ProbeStream::Stub> stubFor(int port) {
 
 pb::ClientMessage helloMessage() {
   pb::ClientMessage m;
-  m.mutable_hello()->set_protocol_version(3);
+  m.mutable_hello()->set_protocol_version(4);
   return m;
 }
 
@@ -310,7 +310,7 @@ class FixedVolumeServer final : public pb::ProbeStream::Service {
 // Defect 6, client side: a bad server's numbers are range-checked before narrowing, not wrapped.
 TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
   pb::VolumeDescription good;
-  good.set_protocol_version(3);
+  good.set_protocol_version(4);
   good.set_codec_format_version(kFormatVersion);
   good.set_grid_x(16);
   good.set_grid_y(4);
@@ -356,6 +356,27 @@ TEST(ServiceHardening, ClientRefusesOutOfRangeVolumeDescription) {
        },
        "threshold is not a power share"},
       {[](pb::VolumeDescription& v) { v.set_area_light_min(0.05f); }, "off but a threshold"},
+      // The scene: a hash that is no SHA-256, a hash without its manifest, a manifest that is not
+      // the hash's, a manifest that is not one, and an old peer.
+      {[](pb::VolumeDescription& v) {
+         v.set_scene_hash(std::string(31, 'x'));
+         v.set_scene_manifest("{}");
+       },
+       "hash of 31 bytes"},
+      {[](pb::VolumeDescription& v) { v.set_scene_hash(std::string(32, 'x')); }, "with a manifest of 0"},
+      {[](pb::VolumeDescription& v) {
+         v.set_scene_hash(std::string(32, 'x'));
+         v.set_scene_manifest(R"({"files":[],"format":1,"lighting":{},"scene":{"builtin":"cornell"}})");
+       },
+       "manifest does not match its hash"},
+      {[](pb::VolumeDescription& v) {
+         const std::string manifest = R"({"files":[],"format":1,"lighting":{},"scene":{"gltf":"../x.gltf"}})";
+         const SceneHash h = sha256(manifest);
+         v.set_scene_hash(std::string(h.begin(), h.end()));
+         v.set_scene_manifest(manifest);
+       },
+       "is not among its files"},
+      {[](pb::VolumeDescription& v) { v.set_protocol_version(3); }, "protocol version 3, not 4"},
   };
   for (const Case& c : cases) {
     pb::VolumeDescription bad = good;

@@ -152,7 +152,7 @@ TEST(Service, StalledSubscriberDoesNotDelayOthers) {
   stalledCtx.AddMetadata("authorization", std::string("Bearer ") + kToken);
   auto stalled = stub->Subscribe(&stalledCtx);
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(3);
+  hello.mutable_hello()->set_protocol_version(4);
   ASSERT_TRUE(stalled->Write(hello));
 
   Producer producer(hub, 60, 10ms);
@@ -180,7 +180,7 @@ TEST(Service, WrongTokenIsUnauthenticatedAndGetsNoPayload) {
   ctx.AddMetadata("authorization", "Bearer nope");
   auto stream = stub->Subscribe(&ctx);
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(3);
+  hello.mutable_hello()->set_protocol_version(4);
   stream->Write(hello);
   pb::ServerMessage msg;
   EXPECT_FALSE(stream->Read(&msg));
@@ -211,13 +211,13 @@ TEST(Service, MalformedMessagesAreInvalidArgumentAndOthersCarryOn) {
       grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
 
   pb::ClientMessage hello;
-  hello.mutable_hello()->set_protocol_version(3);
+  hello.mutable_hello()->set_protocol_version(4);
   pb::ClientMessage views;  // a first message that is not hello
   views.mutable_views()->add_views()->add_view_projection(1.0f);
   EXPECT_EQ(statusAfter(*stub, views).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
   pb::ClientMessage v2 = hello;
-  for (uint32_t old : {1u, 2u}) {  // before the probe offsets; before the area light rule
+  for (uint32_t old : {1u, 2u, 3u}) {  // before the probe offsets; the area light rule; the scene
     v2.mutable_hello()->set_protocol_version(old);
     const grpc::Status wrongVersion = statusAfter(*stub, v2);
     EXPECT_EQ(wrongVersion.error_code(), grpc::StatusCode::INVALID_ARGUMENT);

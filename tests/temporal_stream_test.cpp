@@ -1184,7 +1184,7 @@ TEST(ProbeFile, OffsetsRoundTripAndVersion1FilesAreStillRead) {
   ProbeVolume old = v;
   old.offsets.clear();
   serializeProbeVolume(old, bytes);
-  bytes.erase(bytes.end() - 16, bytes.end() - 4);  // the zero offset count and the rule
+  bytes.erase(bytes.end() - 60, bytes.end() - 4);  // the zero offset count, the rule and the (unknown) scene
   bytes[4] = 1;
   bytes.resize(bytes.size() - 4);
   const uint32_t crc = crc32c(bytes.data(), bytes.size());
@@ -1206,11 +1206,13 @@ TEST(ProbeFile, OffsetsRoundTripAndVersion1FilesAreStillRead) {
   refusedWith(3 * 5 + 2, 0.01f, "more than half its cell (0");  // z has one probe
 }
 
-// Bytes of `v` as a file of `version` (2: without the rule), checksum renewed.
+// Bytes of `v` (no scene) as a file of `version` (3: without the scene, 2: without the rule
+// either), checksum renewed.
 std::vector<uint8_t> probeFileAs(const ProbeVolume& v, uint8_t version) {
   std::vector<uint8_t> bytes;
   serializeProbeVolume(v, bytes);
   bytes.resize(bytes.size() - 4);
+  if (version <= 3) bytes.resize(bytes.size() - 44);
   if (version == 2) bytes.resize(bytes.size() - 8);
   bytes[4] = version;
   const uint32_t crc = crc32c(bytes.data(), bytes.size());
@@ -1247,6 +1249,42 @@ TEST(ProbeFile, AreaLightRuleRoundTripsOldFilesReadAsOffAndABadRuleIsRefused) {
   refusedWith({1, 1.5f}, "threshold is not a power share");
   refusedWith({1, std::nanf("")}, "threshold is not a power share");
   refusedWith({0, 0.05f}, "off but a threshold");
+}
+
+TEST(ProbeFile, SceneRoundTripsVersion3FilesReadAsUnknownAndBadScenesAreRefused) {
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{2, 2, 1}, {{0, 0, 0}, {1, 1, 0}}});
+  v.scene.manifest = R"({"files":[],"format":1,"lighting":{},"scene":{"builtin":"cornell"}})";
+  for (size_t i = 0; i < v.scene.hash.size(); ++i) v.scene.hash[i] = static_cast<uint8_t>(i * 7 + 1);
+  v.scene.time = 0.4375;
+  std::vector<uint8_t> bytes;
+  serializeProbeVolume(v, bytes);
+  ProbeVolume back;
+  std::string error;
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_EQ(back.scene, v.scene);
+  for (size_t len = 0; len < bytes.size(); ++len) EXPECT_FALSE(parseProbeVolume(bytes.data(), len, back, error)) << len;
+
+  // A version 3 file (before scenes were named): read, its scene unknown.
+  ProbeVolume unnamed = v;
+  unnamed.scene = {};
+  bytes = probeFileAs(unnamed, 3);
+  ASSERT_TRUE(parseProbeVolume(bytes.data(), bytes.size(), back, error)) << error;
+  EXPECT_FALSE(back.scene.known());
+
+  // A non-finite time, or a hash without a manifest, under a valid checksum.
+  const auto refusedWith = [&](const SceneStamp& scene, const std::string& why) {
+    ProbeVolume bad = v;
+    bad.scene = scene;
+    serializeProbeVolume(bad, bytes);
+    EXPECT_FALSE(parseProbeVolume(bytes.data(), bytes.size(), back, error));
+    EXPECT_NE(error.find(why), std::string::npos) << error;
+  };
+  SceneStamp nan = v.scene;
+  nan.time = std::nan("");
+  refusedWith(nan, "scene time is not finite");
+  SceneStamp hashOnly = v.scene;
+  hashOnly.manifest.clear();
+  refusedWith(hashOnly, "scene hash without its manifest");
 }
 
 }  // namespace

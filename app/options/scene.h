@@ -10,6 +10,7 @@
 
 #include "probecast/renderer/environment.h"
 #include "probecast/scene/scene.h"
+#include "probecast/service/scene_package.h"
 #include "probecast/session/scene_loading.h"
 
 namespace probecast::app {
@@ -32,6 +33,15 @@ struct EnvironmentOptions {
     cmd->add_option("--sky", sky, "uniform sky radiance R,G,B instead of a map")->delimiter(',')->expected(3)->excludes(e);
   }
   bool given() const { return !file.empty() || !sky.empty(); }
+  // As a scene package names it.
+  service::LightingRequest request() const {
+    service::LightingRequest r;
+    r.environmentFile = file;
+    r.intensity = intensity;
+    r.rotationDeg = rotationDeg;
+    r.sky = sky;
+    return r;
+  }
   // The environment, or null when neither option is given; throws with a clear message for a
   // missing or unreadable file, non-finite pixels, or a negative or NaN intensity or sky value.
   std::shared_ptr<const renderer::Environment> load() const {
@@ -45,16 +55,40 @@ struct EnvironmentOptions {
   }
 };
 
+// The distant light a stream's scene package names (service::SceneLighting), with its map at `file`.
+inline std::shared_ptr<const renderer::Environment> loadLighting(const service::SceneLighting& lighting,
+                                                                const std::filesystem::path& file) {
+  if (lighting.kind == service::SceneLighting::Kind::None) return nullptr;
+  auto env = std::make_shared<renderer::Environment>();
+  std::string error;
+  const bool ok = lighting.kind == service::SceneLighting::Kind::Environment
+                      ? renderer::loadEnvironment(file.string(), lighting.intensity, lighting.rotationDeg, *env, error)
+                      : renderer::makeUniformSky({lighting.sky[0], lighting.sky[1], lighting.sky[2]}, *env, error);
+  if (!ok) throw std::runtime_error("the stream's lighting: " + error);
+  return env;
+}
+
 struct SceneOptions {
   std::string scene = "builtin:cornell";
   float t = 0.0f;
   EnvironmentOptions environment;
+  CLI::Option* sceneOption = nullptr;
+  CLI::Option* tOption = nullptr;
   void add(CLI::App* cmd) {
-    cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
-    cmd->add_option("--t", t, "animation parameter of built-in scenes")->check(CLI::Range(0.0f, 1.0f));
+    sceneOption = cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
+    tOption = cmd->add_option("--t", t, "scene time, seconds (built-in scenes move their light once around per second)")
+                  ->check(CLI::Range(0.0f, 1.0f));
     environment.add(cmd);
   }
+  bool sceneGiven() const { return sceneOption && sceneOption->count() > 0; }
   scene::Scene load() const { return session::loadSceneOrThrow(scene, t); }
+  // The scene package (scene_package.h) these options name: what descriptions and probe files carry.
+  service::ScenePackage package() const {
+    service::ScenePackage p;
+    std::string error;
+    if (!service::makeScenePackage(scene, environment.request(), p, error)) throw std::runtime_error(error);
+    return p;
+  }
 };
 
 }  // namespace probecast::app

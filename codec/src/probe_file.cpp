@@ -15,7 +15,7 @@ namespace probecast {
 namespace {
 
 constexpr uint8_t kMagic[4] = {'P', 'C', 'P', 'V'};
-constexpr uint32_t kVersion = 3;  // 2 adds the offsets, 3 the area light rule; 1 and 2 are still read
+constexpr uint32_t kVersion = 4;  // 2 adds the offsets, 3 the area light rule, 4 the scene; 1 to 3 are still read
 constexpr size_t kHeaderBytes = 4 + 4 + 12 + 24 + 8;
 
 void putF32(std::vector<uint8_t>& out, float v) {
@@ -28,6 +28,18 @@ float getF32(const uint8_t* p) {
   float v;
   std::memcpy(&v, &bits, 4);
   return v;
+}
+
+// Version 4's scene: u8 hash[32] | f64 time (two u32, low first) | u32 m | manifest[m].
+bool readScene(const uint8_t* p, uint64_t manifestBytes, SceneStamp& scene, std::string& error) {
+  std::memcpy(scene.hash.data(), p, 32);
+  const uint64_t timeBits = getU32(p + 32) | (static_cast<uint64_t>(getU32(p + 36)) << 32);
+  std::memcpy(&scene.time, &timeBits, 8);
+  if (!std::isfinite(scene.time)) return error = "probe file scene time is not finite", false;
+  scene.manifest.assign(reinterpret_cast<const char*>(p + 44), manifestBytes);
+  if (scene.manifest.empty() && scene.hash != SceneStamp{}.hash)
+    return error = "probe file names a scene hash without its manifest", false;
+  return true;
 }
 
 }  // namespace
@@ -47,6 +59,13 @@ void serializeProbeVolume(const ProbeVolume& v, std::vector<uint8_t>& out) {
   for (float f : v.offsets) putF32(out, f);
   putU32(out, v.areaLights.version);
   putF32(out, v.areaLights.minPowerFraction);
+  out.insert(out.end(), v.scene.hash.begin(), v.scene.hash.end());
+  uint64_t timeBits;
+  std::memcpy(&timeBits, &v.scene.time, 8);
+  putU32(out, static_cast<uint32_t>(timeBits));
+  putU32(out, static_cast<uint32_t>(timeBits >> 32));
+  putU32(out, static_cast<uint32_t>(v.scene.manifest.size()));
+  out.insert(out.end(), v.scene.manifest.begin(), v.scene.manifest.end());
   putU32(out, crc32c(out.data(), out.size()));
 }
 
@@ -55,7 +74,7 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
   if (std::memcmp(data, kMagic, 4) != 0) return error = "not a probecast probe file (bad magic)", false;
   const uint32_t version = getU32(data + 4);
   if (version < 1 || version > kVersion)
-    return error = "unsupported probe file version " + std::to_string(version) + " (this build reads 1 to 3)", false;
+    return error = "unsupported probe file version " + std::to_string(version) + " (this build reads 1 to 4)", false;
   ProbeVolume out;
   uint64_t count = 1;
   for (int a = 0; a < 3; ++a) {
@@ -83,7 +102,16 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
              false;
   }
   const uint64_t ruleAt = samplesEnd + (version >= 2 ? 4 + offsetFloats * 4 : 0);
-  const uint64_t expected = ruleAt + (version >= 3 ? 8 : 0) + 4;
+  const uint64_t sceneAt = ruleAt + (version >= 3 ? 8 : 0);
+  uint64_t manifestBytes = 0;
+  if (version >= 4) {
+    if (size < sceneAt + 44 + 4) return error = "probe file truncated before its scene", false;
+    manifestBytes = getU32(data + sceneAt + 40);
+    if (manifestBytes > kMaxSceneManifestBytes)
+      return error = "probe file scene manifest of " + std::to_string(manifestBytes) + " bytes (at most " +
+                     std::to_string(kMaxSceneManifestBytes) + ")", false;
+  }
+  const uint64_t expected = sceneAt + (version >= 4 ? 44 + manifestBytes : 0) + 4;
   if (size != expected)
     return error = "probe file is " + std::to_string(size) + " bytes, expected " + std::to_string(expected), false;
   if (crc32c(data, size - 4) != getU32(data + size - 4)) return error = "probe file checksum mismatch", false;
@@ -104,6 +132,7 @@ bool parseProbeVolume(const uint8_t* data, size_t size, ProbeVolume& v, std::str
     out.areaLights.minPowerFraction = getF32(data + ruleAt + 4);
     if (!checkAreaLightRule(out.areaLights, error)) return false;
   }
+  if (version >= 4 && !readScene(data + sceneAt, manifestBytes, out.scene, error)) return false;
   v = std::move(out);
   return true;
 }

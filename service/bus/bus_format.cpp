@@ -62,6 +62,54 @@ void writeVolume(const Volume& v, std::vector<uint8_t>& out) {
   put(out, v.offsets.empty() ? v.offsetsCrc : offsetsChecksum(v.offsets));
   put(out, v.areaLights.version);
   put(out, v.areaLights.minPowerFraction);
+  put(out, v.sceneHash.data(), v.sceneHash.size());
+}
+
+void writeState(const SceneState& st, std::vector<uint8_t>& out) {
+  put(out, st.time);
+  put(out, st.rate);
+  put(out, st.clockUs);
+  put(out, static_cast<uint32_t>(st.lights.size()));
+  for (const LightState& l : st.lights) {
+    put(out, l.type);
+    for (float f : l.position) put(out, f);
+    for (float f : l.direction) put(out, f);
+    for (float f : l.color) put(out, f);
+    put(out, l.intensity);
+    put(out, l.range);
+    put(out, l.innerCone);
+    put(out, l.outerCone);
+  }
+}
+
+// The state at `p` within `bytes`; `used` is its size.
+bool readState(const uint8_t* p, size_t bytes, SceneState& st, size_t& used, std::string& why) {
+  if (bytes < kStateFixedSize) return why = "brick message truncated in its scene state", false;
+  st.time = get<double>(p);
+  st.rate = get<double>(p + 8);
+  st.clockUs = get<uint64_t>(p + 16);
+  const uint32_t n = get<uint32_t>(p + 24);
+  if (n > kMaxStateLights)
+    return why = "scene state with " + std::to_string(n) + " lights (at most " + std::to_string(kMaxStateLights) + ")",
+           false;
+  used = kStateFixedSize + static_cast<size_t>(n) * kLightStateSize;
+  if (bytes < used) return why = "brick message truncated in its scene state's lights", false;
+  st.lights.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint8_t* q = p + kStateFixedSize + i * kLightStateSize;
+    LightState& l = st.lights[i];
+    l.type = get<uint32_t>(q);
+    for (int a = 0; a < 3; ++a) {
+      l.position[a] = get<float>(q + 4 + 4 * a);
+      l.direction[a] = get<float>(q + 16 + 4 * a);
+      l.color[a] = get<float>(q + 28 + 4 * a);
+    }
+    l.intensity = get<float>(q + 40);
+    l.range = get<float>(q + 44);
+    l.innerCone = get<float>(q + 48);
+    l.outerCone = get<float>(q + 52);
+  }
+  return checkSceneState(st, why);
 }
 
 bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
@@ -79,6 +127,8 @@ bool readVolume(const uint8_t* p, Volume& v, std::string& why) {
   v.offsets.clear();
   if (!v.hasOffsets && v.offsetsCrc != 0) return why = "a volume without offsets announces an offsets checksum", false;
   v.areaLights = {get<uint32_t>(p + 56), get<float>(p + 60)};
+  std::memcpy(v.sceneHash.data(), p + 64, 32);
+  v.sceneManifest.clear();
   if (!checkAreaLightRule(v.areaLights, why)) return false;
   v.layout.repr = static_cast<Representation>(p[17]);
   v.layout.brickDim = p[18];
@@ -133,6 +183,32 @@ bool readOffsets(const uint8_t* p, size_t bytes, Volume& v, std::string& why) {
 
 }  // namespace
 
+bool checkSceneState(const SceneState& st, std::string& why) {
+  if (!std::isfinite(st.time)) return why = "scene time is not finite", false;
+  if (!std::isfinite(st.rate) || std::fabs(st.rate) > kMaxSceneRate)
+    return why = "scene playback rate is not a finite value within +-1000", false;
+  if (st.lights.size() > kMaxStateLights) return why = "scene state has more than 64 lights", false;
+  for (size_t i = 0; i < st.lights.size(); ++i) {
+    const LightState& l = st.lights[i];
+    const std::string which = "scene light " + std::to_string(i);
+    if (l.type > 2) return why = which + " is of unknown type " + std::to_string(l.type), false;
+    float len2 = 0.0f;
+    bool finite = std::isfinite(l.intensity) && std::isfinite(l.range) && std::isfinite(l.innerCone) &&
+                  std::isfinite(l.outerCone);
+    for (int a = 0; a < 3; ++a) {
+      finite = finite && std::isfinite(l.position[a]) && std::isfinite(l.direction[a]) && std::isfinite(l.color[a]);
+      len2 += l.direction[a] * l.direction[a];
+      if (l.color[a] < 0.0f) return why = which + " has a negative colour", false;
+    }
+    if (!finite) return why = which + " holds NaN or Inf", false;
+    if (l.intensity < 0.0f || l.range < 0.0f) return why = which + " has a negative intensity or range", false;
+    if (std::fabs(len2 - 1.0f) > 2e-3f) return why = which + "'s direction is not unit length", false;
+    if (l.innerCone < 0.0f || l.outerCone > 1.5707964f || l.innerCone > l.outerCone)
+      return why = which + "'s cone angles are not 0 <= inner <= outer <= pi/2", false;
+  }
+  return true;
+}
+
 uint32_t offsetsChecksum(const std::vector<int8_t>& offsets) {
   return offsets.empty() ? 0 : crc32c(reinterpret_cast<const uint8_t*>(offsets.data()), offsets.size());
 }
@@ -140,6 +216,8 @@ uint32_t offsetsChecksum(const std::vector<int8_t>& offsets) {
 void writeVolumeMessage(const Volume& volume, uint16_t flags, std::vector<uint8_t>& out) {
   writeHeader(Kind::Volume, flags, out);
   writeVolume(volume, out);
+  put(out, static_cast<uint32_t>(volume.sceneManifest.size()));
+  put(out, volume.sceneManifest.data(), volume.sceneManifest.size());
   put(out, volume.offsets.data(), volume.offsets.size());
   finish(out);
 }
@@ -153,6 +231,7 @@ void writeBrickMessage(const Volume& volume, const Brick& brick, uint16_t flags,
   put(out, brick.change);
   put(out, static_cast<uint32_t>(brick.keyframe.size()));
   put(out, static_cast<uint32_t>(brick.delta.size()));
+  writeState(brick.state, out);
   put(out, brick.keyframe.data(), brick.keyframe.size());
   put(out, brick.delta.data(), brick.delta.size());
   finish(out);
@@ -186,7 +265,18 @@ bool readMessage(const uint8_t* data, size_t size, Message& out, std::string& wh
                  (out.kind == Kind::Volume ? "volume message has " : "brick message has ") + "at least " +
                  std::to_string(fixed), false;
   if (!readVolume(p, out.volume, why)) return false;
-  if (out.kind == Kind::Volume) return readOffsets(p + kVolumeSize, body - kVolumeSize, out.volume, why);
+  if (out.kind == Kind::Volume) {
+    if (body < kVolumeSize + 4) return why = "volume message truncated before its scene manifest", false;
+    const uint64_t manifestBytes = get<uint32_t>(p + kVolumeSize);
+    if (manifestBytes > kMaxSceneManifestBytes || manifestBytes > body - kVolumeSize - 4)
+      return why = "volume message announces a scene manifest of " + std::to_string(manifestBytes) +
+                   " bytes in a body of " + std::to_string(body), false;
+    if ((manifestBytes == 0) != !out.volume.hasScene())
+      return why = "volume message has a scene hash without a manifest, or a manifest without a hash", false;
+    out.volume.sceneManifest.assign(reinterpret_cast<const char*>(p + kVolumeSize + 4), manifestBytes);
+    const size_t offsetsAt = kVolumeSize + 4 + manifestBytes;
+    return readOffsets(p + offsetsAt, body - offsetsAt, out.volume, why);
+  }
 
   p += kVolumeSize;
   Brick& b = out.brick;
@@ -202,10 +292,13 @@ bool readMessage(const uint8_t* data, size_t size, Message& out, std::string& wh
   if (b.version == 0) return why = "brick version 0 (nothing) is never published", false;
   if (!std::isfinite(b.change) || b.change < 0.0f || b.change > kMaxChange)
     return why = "brick change is not a finite value in [0, 1e6]", false;
-  if (keyBytes + deltaBytes != body - fixed)
-    return why = "sections of " + std::to_string(keyBytes) + " + " + std::to_string(deltaBytes) + " bytes in " +
-                 std::to_string(body - fixed) + " bytes", false;
   p += kBrickFixedSize;
+  size_t stateBytes = 0;
+  if (!readState(p, body - fixed, b.state, stateBytes, why)) return false;
+  if (keyBytes + deltaBytes != body - fixed - stateBytes)
+    return why = "sections of " + std::to_string(keyBytes) + " + " + std::to_string(deltaBytes) + " bytes in " +
+                 std::to_string(body - fixed - stateBytes) + " bytes", false;
+  p += stateBytes;
   b.keyframe = {p, static_cast<size_t>(keyBytes)};
   b.delta = {p + keyBytes, static_cast<size_t>(deltaBytes)};
   if (!checkSection(layout, b.keyframe, b, SectionKind::Keyframe, why)) return false;

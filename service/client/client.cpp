@@ -2,6 +2,7 @@
 #include "probecast/service/client.h"
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <condition_variable>
 #include <thread>
@@ -16,6 +17,29 @@ namespace probecast::service {
 namespace pb = probecast::v1;
 using Stream = grpc::ClientReaderWriter<pb::ClientMessage, pb::ServerMessage>;
 
+namespace {
+
+std::shared_ptr<grpc::Channel> makeChannel(const ClientConfig& config, const std::string& address) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(256 << 20);
+  args.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, config.keepaliveMs);
+  args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, config.keepaliveTimeoutMs);
+  args.SetInt(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);  // a still volume sends nothing for long
+  std::shared_ptr<grpc::ChannelCredentials> creds;
+  if (config.tls) {
+    grpc::SslCredentialsOptions options;
+    options.pem_root_certs = config.rootCertPem;
+    creds = grpc::SslCredentials(options);
+    if (!config.tlsServerName.empty()) args.SetSslTargetNameOverride(config.tlsServerName);
+  } else {
+    creds = grpc::InsecureChannelCredentials();
+  }
+  return grpc::CreateCustomChannel(address, creds, args);
+}
+
+}  // namespace
+
 struct ProbeClient::Impl {
   ClientConfig config;
   std::thread worker;
@@ -27,6 +51,11 @@ struct ProbeClient::Impl {
   GridBounds bounds;
   std::vector<float> offsets;  // the description's probe offsets, metres
   AreaLightRule areaLights;    // the description's client area light rule
+  SceneStamp scene;            // the description's scene (time: of the newest state)
+  bus::SceneState state;       // of the newest frame
+  bool hasState = false;
+  std::vector<int64_t> offsets64;  // receive − send of the most recent 64 frames, µs
+  size_t offsetNext = 0;
   uint64_t epoch = 0;
   uint64_t newestServerTimeUs = 0;
   std::vector<uint32_t> latencies;  // ring of the most recent 4096
@@ -47,24 +76,7 @@ struct ProbeClient::Impl {
     return s && s->Write(m);
   }
 
-  std::shared_ptr<grpc::Channel> channel(const std::string& address) const {
-    grpc::ChannelArguments args;
-    args.SetMaxReceiveMessageSize(256 << 20);
-    args.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, config.keepaliveMs);
-    args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, config.keepaliveTimeoutMs);
-    args.SetInt(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
-    args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);  // a still volume sends nothing for long
-    std::shared_ptr<grpc::ChannelCredentials> creds;
-    if (config.tls) {
-      grpc::SslCredentialsOptions options;
-      options.pem_root_certs = config.rootCertPem;
-      creds = grpc::SslCredentials(options);
-      if (!config.tlsServerName.empty()) args.SetSslTargetNameOverride(config.tlsServerName);
-    } else {
-      creds = grpc::InsecureChannelCredentials();
-    }
-    return grpc::CreateCustomChannel(address, creds, args);
-  }
+  std::shared_ptr<grpc::Channel> channel(const std::string& address) const { return makeChannel(config, address); }
 
   // False for a description the client cannot use: the connection is dropped and retried later.
   bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
@@ -72,10 +84,13 @@ struct ProbeClient::Impl {
     GridBounds b;
     std::vector<float> o;
     AreaLightRule r;
+    SceneStamp sc;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
-    if (!volumeFromWire(v, l, b, o, r, why)) {
-      stats.lastError = "bad volume description: " + why;
+    ScenePackage named;
+    if (!volumeFromWire(v, l, b, o, r, sc, why) ||
+        (sc.known() && (sha256(sc.manifest) != sc.hash || !parseManifest(sc.manifest, named, why)))) {
+      stats.lastError = "bad volume description: " + (why.empty() ? "its scene manifest does not match its hash" : why);
       return false;
     }
     if (config.representation && l.repr != *config.representation) {
@@ -85,7 +100,7 @@ struct ProbeClient::Impl {
     }
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
-    if (!same || v.stream_epoch() != epoch || !(r == areaLights)) {  // nothing held is valid
+    if (!same || v.stream_epoch() != epoch || !(r == areaLights) || sc.hash != scene.hash) {  // nothing held is valid
       decoder = std::make_unique<StreamDecoder>(l);
       decoder->setZh3PerPixel(config.zh3PerPixel);
     }
@@ -93,6 +108,8 @@ struct ProbeClient::Impl {
     bounds = b;
     offsets = std::move(o);
     areaLights = r;
+    if (sc.hash != scene.hash) hasState = false;
+    scene = std::move(sc);
     epoch = v.stream_epoch();
     stats.connected = true;
     stats.connects += 1;
@@ -107,6 +124,13 @@ struct ProbeClient::Impl {
       stats.lastError = "frame before volume description";
       return false;
     }
+    bus::SceneState frameState;
+    std::string why;
+    if (f.has_scene_state() && !stateFromWire(f.scene_state(), frameState, why)) {
+      stats.framesRejected += 1;
+      stats.lastError = "frame refused: " + why;
+      return false;
+    }
     const auto* data = reinterpret_cast<const uint8_t*>(f.payload().data());
     const CodecStatus st = decoder->apply(data, f.payload().size());
     if (st != CodecStatus::Ok) {
@@ -118,9 +142,14 @@ struct ProbeClient::Impl {
     stats.bytesReceived += f.payload().size();
     stats.keyframesReceived += f.keyframes();
     stats.deltasReceived += f.deltas();
-    const uint64_t now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
-                                                   std::chrono::system_clock::now().time_since_epoch())
-                                                   .count());
+    const uint64_t now = wallClockUs();
+    if (f.has_scene_state()) {
+      state = std::move(frameState);
+      hasState = true;
+      const int64_t sample = static_cast<int64_t>(now) - static_cast<int64_t>(f.sent_us());
+      if (offsets64.size() < 64) offsets64.push_back(sample);
+      else offsets64[offsetNext++ % 64] = sample;
+    }
     const uint32_t latency = static_cast<uint32_t>(std::min<uint64_t>(now - std::min(now, f.server_time_us()), UINT32_MAX));
     if (latencies.size() < 4096) latencies.push_back(latency);
     else latencies[latencyNext++ % 4096] = latency;
@@ -289,6 +318,11 @@ bool ProbeClient::snapshot(VolumeSnapshot& out) const {
   impl_->decoder->copyVolume(impl_->bounds, out.volume);
   out.volume.offsets = impl_->offsets;
   out.volume.areaLights = impl_->areaLights;
+  out.volume.scene = impl_->scene;
+  out.state = impl_->state;
+  out.hasState = impl_->hasState;
+  if (out.hasState) out.volume.scene.time = out.state.time;
+  out.clockOffsetUs = impl_->offsets64.empty() ? 0 : *std::min_element(impl_->offsets64.begin(), impl_->offsets64.end());
   out.framesApplied = impl_->stats.framesApplied;
   out.newestServerTimeUs = impl_->newestServerTimeUs;
   return true;
@@ -307,6 +341,110 @@ std::vector<uint32_t> ProbeClient::latenciesUs() const {
 void ProbeClient::dropConnection() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (impl_->context) impl_->context->TryCancel();
+}
+
+uint64_t wallClockUs() {
+  return static_cast<uint64_t>(
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+
+double serverSceneTime(const VolumeSnapshot& s, uint64_t localUs) {
+  if (!s.hasState) return s.volume.scene.time;
+  const double serverUs = static_cast<double>(localUs) - static_cast<double>(s.clockOffsetUs);
+  return s.state.time + s.state.rate * (serverUs - static_cast<double>(s.state.clockUs)) * 1e-6;
+}
+
+double DisplayClock::at(const VolumeSnapshot& s, uint64_t localUs) {
+  const double target = serverSceneTime(s, localUs);
+  const double second = std::fabs(s.hasState ? s.state.rate : 0.0);  // scene seconds per second of playback
+  if (!started_ || target >= last_ || last_ - target > second || second == 0.0) last_ = target;
+  started_ = true;
+  age_ = last_ - (s.hasState ? s.state.time : s.volume.scene.time);
+  return last_;
+}
+
+bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& error) {
+  const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
+                                                                    : config.addresses;
+  std::string errors;
+  for (const std::string& server : servers) {
+    grpc::ClientContext ctx;
+    if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    pb::VolumeDescription v;
+    const grpc::Status status = pb::ProbeStream::NewStub(makeChannel(config, server))->GetVolume(&ctx, {}, &v);
+    if (!status.ok()) {
+      errors += (errors.empty() ? "" : "; ") + server + ": " + status.error_message();
+      if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) break;
+      continue;
+    }
+    StreamLayout l;
+    GridBounds b;
+    std::vector<float> o;
+    AreaLightRule r;
+    std::string why;
+    ScenePackage named;
+    if (!volumeFromWire(v, l, b, o, r, out, why) ||
+        (out.known() && (sha256(out.manifest) != out.hash || !parseManifest(out.manifest, named, why))))
+      return error = server + ": bad volume description: " + (why.empty() ? "its scene manifest does not match its hash" : why), false;
+    return true;
+  }
+  return error = "no server described its stream: " + errors, false;
+}
+
+bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::filesystem::path& cache,
+                uint64_t maxBytes, ScenePackage& out, SceneFetch& fetch, std::string& error) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsedMs = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
+  fetch = {};
+  if (findCachedPackage(cache, scene.hash, out)) {
+    fetch.fromCache = true;
+    fetch.ms = elapsedMs();
+    return true;
+  }
+  ScenePackage named;
+  if (!parseManifest(scene.manifest, named, error) || named.hash != scene.hash)
+    return error = "the scene's manifest " + (error.empty() ? "does not match its hash" : error), false;
+  if (named.totalBytes() > maxBytes)
+    return error = "the scene " + named.describe() + " is " + std::to_string(named.totalBytes()) +
+                   " bytes, more than the " + std::to_string(maxBytes) + " this viewer accepts", false;
+  if (named.files.empty()) {  // a built-in: the manifest is the whole package
+    out = std::move(named);
+    fetch.ms = elapsedMs();
+    return true;
+  }
+  const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
+                                                                    : config.addresses;
+  std::string errors;
+  for (const std::string& server : servers) {
+    grpc::ClientContext ctx;
+    if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+    pb::GetSceneRequest request;
+    request.set_scene_hash(reinterpret_cast<const char*>(scene.hash.data()), scene.hash.size());
+    std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(makeChannel(config, server));
+    std::unique_ptr<grpc::ClientReader<pb::SceneChunk>> reader = stub->GetScene(&ctx, request);
+    PackageWriter writer(cache, named);
+    pb::SceneChunk chunk;
+    bool ok = writer.begin(error) && reader->Read(&chunk);
+    if (ok && chunk.manifest() != scene.manifest) ok = false, error = server + " sent another manifest than its description";
+    uint64_t bytes = 0;
+    while (ok && reader->Read(&chunk)) {
+      ok = writer.write(chunk.path(), chunk.offset(), chunk.data(), error);
+      bytes += chunk.data().size();
+    }
+    if (!ok) ctx.TryCancel();
+    const grpc::Status status = reader->Finish();
+    if (ok && status.ok() && writer.finish(out, error)) {
+      fetch.bytes = bytes;
+      fetch.ms = elapsedMs();
+      return true;
+    }
+    errors += (errors.empty() ? "" : "; ") + server + ": " + (status.ok() ? error : status.error_message());
+    if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) break;
+  }
+  return error = "cannot fetch the scene: " + errors, false;
 }
 
 }  // namespace probecast::service

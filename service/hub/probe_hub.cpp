@@ -21,10 +21,10 @@ uint64_t randomEpoch() {
 }
 
 bool sameVolume(const bus::Volume& a, const StreamLayout& layout, const GridBounds& bounds, bool hasOffsets,
-                uint32_t offsetsCrc, const AreaLightRule& areaLights) {
+                uint32_t offsetsCrc, const AreaLightRule& areaLights, const SceneStamp& scene) {
   const StreamLayout& l = a.layout;
   bool same = l.repr == layout.repr && l.brickDim == layout.brickDim && a.hasOffsets == hasOffsets &&
-              a.offsetsCrc == offsetsCrc && a.areaLights == areaLights;
+              a.offsetsCrc == offsetsCrc && a.areaLights == areaLights && a.sceneHash == scene.hash;
   for (int i = 0; i < 3; ++i)
     same = same && l.grid[i] == layout.grid[i] && a.bounds.min[i] == bounds.min[i] && a.bounds.max[i] == bounds.max[i];
   return same;
@@ -46,6 +46,7 @@ bus::Brick busBrick(const BrickVersionBytes& v) {
   b.change = v.change;
   b.keyframe = v.keyframe;
   b.delta = v.delta;
+  b.state = v.state;
   return b;
 }
 
@@ -65,7 +66,8 @@ ProbeHub::~ProbeHub() = default;
 
 bool ProbeHub::ready() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return source_ != nullptr && (!hasOffsets_ || !config_.offsets.empty());
+  return source_ != nullptr && (!hasOffsets_ || !config_.offsets.empty()) &&
+         (config_.scene.hash == SceneStamp{}.hash || config_.scene.known());
 }
 
 StreamLayout ProbeHub::layout() const {
@@ -94,7 +96,35 @@ bus::Volume ProbeHub::volume() const {
   v.hasOffsets = hasOffsets_;
   v.offsetsCrc = offsetsCrc_;
   v.areaLights = config_.areaLights;
+  v.sceneHash = config_.scene.hash;
+  v.sceneManifest = config_.scene.manifest;
   return v;
+}
+
+void ProbeHub::setScene(const SceneStamp& scene) {
+  std::vector<std::function<void()>> wakes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    encoderSource("setScene");
+    if (scene.hash == config_.scene.hash && scene.manifest == config_.scene.manifest) return;
+    config_.scene.hash = scene.hash;
+    config_.scene.manifest = scene.manifest;
+    describedAnew(wakes);
+  }
+  for (auto& w : wakes) w();
+}
+
+void ProbeHub::setSceneState(const bus::SceneState& state) {
+  std::string why;
+  if (!bus::checkSceneState(state, why)) throw std::invalid_argument(why);
+  std::lock_guard<std::mutex> lock(mutex_);
+  encoderSource("setSceneState");
+  state_ = state;
+}
+
+bus::SceneState ProbeHub::sceneState() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_;
 }
 
 void ProbeHub::setProbeOffsets(const std::vector<float>& offsets) {
@@ -231,6 +261,7 @@ BrickVersionBytes ProbeHub::versionBytes(uint32_t brick) {
   v.producerFrame = frame_;
   v.publishedUs = publishedUs_;
   v.change = e.brickChange(brick);
+  v.state = state_;
   const std::span<const uint8_t> key = e.keyframeSection(brick), delta = e.deltaSection(brick);
   v.keyframe.assign(key.begin(), key.end());
   v.delta.assign(delta.begin(), delta.end());
@@ -261,6 +292,10 @@ void ProbeHub::startEpoch(const bus::Volume& volume, std::vector<std::function<v
   hasOffsets_ = volume.hasOffsets;
   offsetsCrc_ = volume.offsetsCrc;
   config_.areaLights = volume.areaLights;
+  config_.scene.hash = volume.sceneHash;
+  config_.scene.manifest = volume.sceneManifest;  // none yet when a brick message opens the epoch
+  state_ = {};
+  stateFrame_ = 0;
   epoch_ = volume.epoch;
   auto source = std::make_unique<BusBricks>(volume.layout);
   bus_ = source.get();
@@ -290,12 +325,17 @@ ProbeHub::Received ProbeHub::receive(const bus::Message& m, bool wake, std::stri
     if (!source_ || m.volume.epoch != epoch_) {
       startEpoch(m.volume, wakes);
       result = Received::NewEpoch;
-    } else if (!sameVolume(m.volume, config_.layout, config_.bounds, hasOffsets_, offsetsCrc_, config_.areaLights)) {
+    } else if (!sameVolume(m.volume, config_.layout, config_.bounds, hasOffsets_, offsetsCrc_, config_.areaLights,
+                           config_.scene)) {
       why = "a message of stream epoch " + std::to_string(epoch_) + " describes another volume than the epoch's";
       return Received::Refused;
     } else if (m.kind == bus::Kind::Volume && config_.offsets.empty() && !m.volume.offsets.empty()) {
       config_.offsets = m.volume.offsets;  // the offsets the epoch's brick messages announced (checksum checked)
       result = Received::Applied;
+    }
+    if (m.kind == bus::Kind::Volume && !config_.scene.known() && !m.volume.sceneManifest.empty()) {
+      config_.scene.manifest = m.volume.sceneManifest;  // the manifest of the hash the epoch announced
+      if (result != Received::NewEpoch) result = Received::Applied;
     }
     if (m.kind == bus::Kind::Brick) {
       const BusBricks::Accepted a = bus_->accept(m.brick, why);
@@ -304,6 +344,10 @@ ProbeHub::Received ProbeHub::receive(const bus::Message& m, bool wake, std::stri
       } else if (a == BusBricks::Accepted::Applied) {
         frame_ = std::max(frame_, m.brick.producerFrame);
         publishedUs_ = std::max(publishedUs_, m.volume.publishedUs);
+        if (m.brick.producerFrame >= stateFrame_) {
+          stateFrame_ = m.brick.producerFrame;
+          state_ = m.brick.state;
+        }
         markStale(m.brick.brick);
         transcodedBehind_ = !transcoded_.empty();
         if (result != Received::NewEpoch) result = Received::Applied;
@@ -514,6 +558,8 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, con
   }
   frame.sequence = ++s.sequence;
   frame.serverTimeUs = publishedUs_;
+  frame.state = state_;
+  frame.sentUs = nowUs();
   frame.payloadBytes = frameSize(sections);
   if (storage)
     writeFrame(s.layout, frame.sequence, sections, (*storage)(frame, frame.payloadBytes));
@@ -578,6 +624,9 @@ ProbeVolume ProbeHub::reconstruction() const {
   if (source_) return reconstructionLocked(*source_);
   ProbeVolume v;
   v.areaLights = config_.areaLights;
+  v.scene.hash = config_.scene.hash;
+  v.scene.manifest = config_.scene.manifest;
+  v.scene.time = state_.time;
   return v;
 }
 
@@ -588,6 +637,9 @@ ProbeVolume ProbeHub::reconstructionLocked(const BrickSource& source) const {
   if (!dequantizeProbeOffsets(v.grid, config_.offsets.data(), config_.offsets.size(), v.offsets, why))
     v.offsets.clear();  // never: offsets are checked when they arrive
   v.areaLights = config_.areaLights;
+  v.scene.hash = config_.scene.hash;
+  v.scene.manifest = config_.scene.manifest;
+  v.scene.time = state_.time;
   return v;
 }
 

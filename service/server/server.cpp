@@ -5,7 +5,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <condition_variable>
+#include <fstream>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -52,6 +54,63 @@ bool authorized(grpc::CallbackServerContext* ctx, const std::string& token, bool
   for (size_t i = 0; i < got.size(); ++i) diff |= static_cast<unsigned>(got[i] ^ want[i]);
   return diff == 0;
 }
+
+// Sends a scene package: the manifest, then every file in pieces, one write in flight.
+class RefusedSceneReactor : public grpc::ServerWriteReactor<pb::SceneChunk> {
+  void OnDone() override { delete this; }
+};
+
+class SceneReactor : public grpc::ServerWriteReactor<pb::SceneChunk> {
+ public:
+  SceneReactor(std::shared_ptr<const ScenePackage> package, size_t chunkBytes)
+      : package_(std::move(package)), buffer_(chunkBytes) {
+    chunk_.set_manifest(package_->manifest);
+    StartWrite(&chunk_);
+  }
+  void OnWriteDone(bool ok) override {
+    if (!ok) return Finish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "write failed"));
+    next();
+  }
+  void OnDone() override { delete this; }
+
+ private:
+  void next() {
+    chunk_.Clear();
+    while (file_ < package_->files.size()) {
+      const PackageFile& f = package_->files[file_];
+      if (!in_.is_open()) {
+        in_.open(f.source, std::ios::binary);
+        offset_ = 0;
+        if (!in_) return changed(f);
+      }
+      if (offset_ == f.bytes) {
+        in_.close();
+        ++file_;
+        continue;
+      }
+      const auto n = static_cast<std::streamsize>(std::min<uint64_t>(buffer_.size(), f.bytes - offset_));
+      if (!in_.read(buffer_.data(), n)) return changed(f);
+      chunk_.set_path(f.path);
+      chunk_.set_offset(offset_);
+      chunk_.set_data(buffer_.data(), static_cast<size_t>(n));
+      offset_ += static_cast<uint64_t>(n);
+      return StartWrite(&chunk_);
+    }
+    Finish(grpc::Status::OK);
+  }
+  void changed(const PackageFile& f) {
+    fmt::print(stderr, "probecast server: the scene file {} cannot be read as it was packaged\n", f.source.string());
+    Finish(grpc::Status(grpc::StatusCode::INTERNAL, "the server's copy of " + f.path + " changed or vanished since "
+                                                    "the scene was named; the server must be restarted"));
+  }
+
+  std::shared_ptr<const ScenePackage> package_;
+  std::vector<char> buffer_;
+  pb::SceneChunk chunk_;
+  size_t file_ = 0;
+  uint64_t offset_ = 0;
+  std::ifstream in_;
+};
 
 // An edge that has not yet heard from its producer: another edge may have (the client moves on).
 grpc::Status notReady() {
@@ -174,8 +233,15 @@ class SubscribeReactor : public RawReactor {
     // The hub writes the payload straight into the message's one slice: its sections are copied
     // once on their way to the transport.
     grpc_slice slice = grpc_empty_slice();
-    const FrameStorage storage = [&slice](const OutgoingFrame& f, size_t payloadBytes) {
-      const FrameFields fields{f.sequence, f.serverTimeUs, payloadBytes, f.keyframes, f.deltas};
+    const FrameStorage storage = [this, &slice](const OutgoingFrame& f, size_t payloadBytes) {
+      if (!stateSerialised_ || !(f.state == state_)) {
+        state_ = f.state;
+        pb::SceneState w;
+        stateToWire(state_, w);
+        stateBytes_ = w.SerializeAsString();
+        stateSerialised_ = true;
+      }
+      const FrameFields fields{f.sequence, f.serverTimeUs, payloadBytes, f.keyframes, f.deltas, &stateBytes_, f.sentUs};
       slice = grpc_slice_malloc(framePrefixBytes(fields) + payloadBytes + frameSuffixBytes(fields));
       uint8_t* payload = writeFramePrefix(fields, GRPC_SLICE_START_PTR(slice));
       writeFrameSuffix(fields, payload + payloadBytes);
@@ -318,6 +384,9 @@ class SubscribeReactor : public RawReactor {
   static constexpr uint32_t kFramesPerStats = 16;
   uint32_t framesSinceStats_ = 0;
   uint64_t frameServerTimeUs_ = 0;  // of the frame being written (0: no frame in flight)
+  bus::SceneState state_;           // the scene state last serialised, and its bytes
+  std::string stateBytes_;
+  bool stateSerialised_ = false;
   uint64_t id_ = 0;
   bool counted_ = false;
   bool writing_ = false;
@@ -325,8 +394,10 @@ class SubscribeReactor : public RawReactor {
   std::optional<grpc::Status> pendingFinish_;
 };
 
-using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<
-    pb::ProbeStream::WithCallbackMethod_GetVolume<pb::ProbeStream::Service>>;
+using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<pb::ProbeStream::WithCallbackMethod_GetVolume<
+    pb::ProbeStream::WithCallbackMethod_GetScene<pb::ProbeStream::Service>>>;
+
+constexpr uint32_t kDefaultSceneChunk = 1u << 20, kMaxSceneChunk = 4u << 20;
 
 class Service final : public RawSubscribeService {
  public:
@@ -352,6 +423,29 @@ class Service final : public RawSubscribeService {
     volumeToWire(hub_.volume(), *response);
     reactor->Finish(grpc::Status::OK);
     return reactor;
+  }
+
+  grpc::ServerWriteReactor<pb::SceneChunk>* GetScene(grpc::CallbackServerContext* ctx,
+                                                     const pb::GetSceneRequest* request) override {
+    const auto refuse = [](grpc::StatusCode code, const std::string& why) {
+      auto* r = new RefusedSceneReactor();
+      r->Finish(grpc::Status(code, why));
+      return r;
+    };
+    if (!authorized(ctx, config_.token, config_.noAuth))
+      return refuse(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token");
+    if (request->scene_hash().size() != 32)
+      return refuse(grpc::StatusCode::INVALID_ARGUMENT,
+                    "scene_hash of " + std::to_string(request->scene_hash().size()) + " bytes (a SHA-256 has 32)");
+    if (request->chunk_bytes() > kMaxSceneChunk)
+      return refuse(grpc::StatusCode::INVALID_ARGUMENT,
+                    "chunk_bytes " + std::to_string(request->chunk_bytes()) + " is above the limit of 4 MiB");
+    const std::shared_ptr<const ScenePackage> package = config_.scene;
+    if (!package || std::memcmp(package->hash.data(), request->scene_hash().data(), 32) != 0)
+      return refuse(grpc::StatusCode::NOT_FOUND,
+                    package ? "this server delivers scene " + shortHex(package->hash) + ", not the one asked for"
+                            : "this server has no scene to deliver (start it with the scene's files)");
+    return new SceneReactor(package, request->chunk_bytes() ? request->chunk_bytes() : kDefaultSceneChunk);
   }
 
   FrameWriteTimes& writeTimes() { return writeTimes_; }

@@ -1,6 +1,7 @@
 #include "wire_convert.h"
 
 #include <cmath>
+#include <cstring>
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/wire_format_lite.h>
@@ -34,10 +35,17 @@ void volumeToWire(const bus::Volume& v, v1::VolumeDescription& out) {
   out.set_probe_offsets(reinterpret_cast<const char*>(v.offsets.data()), v.offsets.size());
   out.set_area_light_rule(v.areaLights.version);
   out.set_area_light_min(v.areaLights.minPowerFraction);
+  if (v.hasScene()) {
+    out.set_scene_hash(reinterpret_cast<const char*>(v.sceneHash.data()), v.sceneHash.size());
+    out.set_scene_manifest(v.sceneManifest);
+  } else {
+    out.clear_scene_hash();
+    out.clear_scene_manifest();
+  }
 }
 
 bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds,
-                    std::vector<float>& offsets, AreaLightRule& areaLights, std::string& why) {
+                    std::vector<float>& offsets, AreaLightRule& areaLights, SceneStamp& scene, std::string& why) {
   if (in.protocol_version() != kProtocolVersion)
     return why = "server speaks protocol version " + std::to_string(in.protocol_version()) + ", not " +
                  std::to_string(kProtocolVersion), false;
@@ -75,8 +83,18 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
   const std::string& q = in.probe_offsets();
   if (!dequantizeProbeOffsets(gridOf(l, bounds), reinterpret_cast<const int8_t*>(q.data()), q.size(), offsets, why))
     return false;
+  SceneStamp named;
+  if (!in.scene_hash().empty() || !in.scene_manifest().empty()) {
+    if (in.scene_hash().size() != named.hash.size() || in.scene_manifest().empty())
+      return why = "the scene is named by a hash of " + std::to_string(in.scene_hash().size()) +
+                   " bytes (32) with a manifest of " + std::to_string(in.scene_manifest().size()), false;
+    if (in.scene_manifest().size() > kMaxSceneManifestBytes) return why = "the scene manifest is over 256 KiB", false;
+    std::memcpy(named.hash.data(), in.scene_hash().data(), named.hash.size());
+    named.manifest = in.scene_manifest();
+  }
   layout = l;
   areaLights = rule;
+  scene = std::move(named);
   return true;
 }
 
@@ -125,11 +143,16 @@ uint8_t* putVarintField(int field, uint64_t v, uint8_t* out) {
   return CodedOutputStream::WriteVarint64ToArray(v, out);
 }
 
+// The scene_state field (a present message is written even when empty).
+size_t stateFieldBytes(const FrameFields& f) {
+  return f.sceneState ? 1 + CodedOutputStream::VarintSize64(f.sceneState->size()) + f.sceneState->size() : 0;
+}
+
 // The Frame message's own size (without the ServerMessage field that holds it).
 size_t frameMessageBytes(const FrameFields& f) {
   const size_t payload = f.payloadBytes == 0 ? 0 : 1 + CodedOutputStream::VarintSize64(f.payloadBytes) + f.payloadBytes;
   return varintFieldBytes(f.sequence) + varintFieldBytes(f.serverTimeUs) + payload + varintFieldBytes(f.keyframes) +
-         varintFieldBytes(f.deltas);
+         varintFieldBytes(f.deltas) + stateFieldBytes(f) + varintFieldBytes(f.sentUs);
 }
 
 }  // namespace
@@ -140,7 +163,9 @@ size_t framePrefixBytes(const FrameFields& f) {
          (f.payloadBytes == 0 ? 0 : 1 + CodedOutputStream::VarintSize64(f.payloadBytes));
 }
 
-size_t frameSuffixBytes(const FrameFields& f) { return varintFieldBytes(f.keyframes) + varintFieldBytes(f.deltas); }
+size_t frameSuffixBytes(const FrameFields& f) {
+  return varintFieldBytes(f.keyframes) + varintFieldBytes(f.deltas) + stateFieldBytes(f) + varintFieldBytes(f.sentUs);
+}
 
 uint8_t* writeFramePrefix(const FrameFields& f, uint8_t* out) {
   out = CodedOutputStream::WriteTagToArray(
@@ -156,7 +181,62 @@ uint8_t* writeFramePrefix(const FrameFields& f, uint8_t* out) {
 
 uint8_t* writeFrameSuffix(const FrameFields& f, uint8_t* out) {
   out = putVarintField(v1::Frame::kKeyframesFieldNumber, f.keyframes, out);
-  return putVarintField(v1::Frame::kDeltasFieldNumber, f.deltas, out);
+  out = putVarintField(v1::Frame::kDeltasFieldNumber, f.deltas, out);
+  if (f.sceneState) {
+    out = CodedOutputStream::WriteTagToArray(
+        WireFormatLite::MakeTag(v1::Frame::kSceneStateFieldNumber, WireFormatLite::WIRETYPE_LENGTH_DELIMITED), out);
+    out = CodedOutputStream::WriteVarint64ToArray(f.sceneState->size(), out);
+    out = CodedOutputStream::WriteRawToArray(f.sceneState->data(), static_cast<int>(f.sceneState->size()), out);
+  }
+  return putVarintField(v1::Frame::kSentUsFieldNumber, f.sentUs, out);
+}
+
+void stateToWire(const bus::SceneState& in, v1::SceneState& out) {
+  out.Clear();
+  out.set_time_s(in.time);
+  out.set_rate(in.rate);
+  out.set_clock_us(in.clockUs);
+  for (const bus::LightState& l : in.lights) {
+    v1::Light* w = out.add_lights();
+    w->set_type(l.type);
+    for (int a = 0; a < 3; ++a) {
+      w->add_position(l.position[a]);
+      w->add_direction(l.direction[a]);
+      w->add_color(l.color[a]);
+    }
+    w->set_intensity(l.intensity);
+    w->set_range(l.range);
+    w->set_inner_cone(l.innerCone);
+    w->set_outer_cone(l.outerCone);
+  }
+}
+
+bool stateFromWire(const v1::SceneState& in, bus::SceneState& out, std::string& why) {
+  if (static_cast<uint32_t>(in.lights_size()) > bus::kMaxStateLights)
+    return why = "scene state with " + std::to_string(in.lights_size()) + " lights (at most 64)", false;
+  bus::SceneState st;
+  st.time = in.time_s();
+  st.rate = in.rate();
+  st.clockUs = in.clock_us();
+  for (const v1::Light& w : in.lights()) {
+    if (w.position_size() != 3 || w.direction_size() != 3 || w.color_size() != 3)
+      return why = "a scene light needs 3 floats of position, direction and colour", false;
+    bus::LightState l;
+    l.type = w.type();
+    for (int a = 0; a < 3; ++a) {
+      l.position[a] = w.position(a);
+      l.direction[a] = w.direction(a);
+      l.color[a] = w.color(a);
+    }
+    l.intensity = w.intensity();
+    l.range = w.range();
+    l.innerCone = w.inner_cone();
+    l.outerCone = w.outer_cone();
+    st.lights.push_back(l);
+  }
+  if (!bus::checkSceneState(st, why)) return false;
+  out = std::move(st);
+  return true;
 }
 
 }  // namespace probecast::service

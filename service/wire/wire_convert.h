@@ -11,15 +11,20 @@
 
 namespace probecast::service {
 
-constexpr uint32_t kProtocolVersion = 3;  // 2: VolumeDescription.probe_offsets; 3: area_light_rule
+// 2: VolumeDescription.probe_offsets; 3: area_light_rule; 4: the scene (hash, manifest, state, GetScene)
+constexpr uint32_t kProtocolVersion = 4;
 extern const char* const kShConvention;
 
 // The hub's volume (bus_format.h): layout, bounds, epoch, quantised offsets and area light rule.
 void volumeToWire(const bus::Volume& volume, v1::VolumeDescription& out);
 // Validates a volume description from a server, its probe offsets (returned in metres, empty for
-// none) and area light rule too; `why` says what is wrong.
+// none), area light rule and scene (a 32-byte hash with its manifest, or neither; the hash is the
+// caller's to check) too; `why` says what is wrong.
 bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds,
-                    std::vector<float>& offsets, AreaLightRule& areaLights, std::string& why);
+                    std::vector<float>& offsets, AreaLightRule& areaLights, SceneStamp& scene, std::string& why);
+void stateToWire(const bus::SceneState& in, v1::SceneState& out);
+// Checks a frame's scene state (bus::checkSceneState, 3 floats per light vector).
+bool stateFromWire(const v1::SceneState& in, bus::SceneState& out, std::string& why);
 // Validates and converts views: count, 16 finite matrix entries each, finite eyes.
 bool viewsFromWire(const v1::ViewUpdate& in, uint32_t maxViews, std::vector<View>& out, std::string& why);
 void viewsToWire(const std::vector<View>& views, v1::ViewUpdate& out);
@@ -33,6 +38,8 @@ struct FrameFields {
   size_t payloadBytes = 0;
   uint32_t keyframes = 0;
   uint32_t deltas = 0;
+  const std::string* sceneState = nullptr;  // a serialised SceneState (null: the field is left out)
+  uint64_t sentUs = 0;
 };
 // Bytes before the payload and after it.
 size_t framePrefixBytes(const FrameFields& f);

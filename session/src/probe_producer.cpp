@@ -7,6 +7,7 @@
 
 #include "probecast/renderer/probe_interest.h"
 #include "probecast/session/scene_loading.h"
+#include "probecast/session/scene_state.h"
 #include "probecast/session/volumes.h"
 
 namespace probecast::session {
@@ -57,6 +58,8 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   rayBudget_ = options.raysPerUpdate > 0;
   animation_ = animation;
   t_ = animation.start;
+  sceneTime_ = animation.start;
+  lights_ = lightStates(first);
 }
 
 void ProbeProducer::serveVolume(const ProbeVolume& volume) {
@@ -66,11 +69,13 @@ void ProbeProducer::serveVolume(const ProbeVolume& volume) {
 
 void ProbeProducer::generate(FrameGenerator generator) { generator_ = std::move(generator); }
 
-float ProbeProducer::t() const {
+float ProbeProducer::t() const { return animationT(sceneTime()); }
+
+double ProbeProducer::sceneTime() const {
   if (frozen_) return frozenT_;
-  if (animation_.mode != Animation::Mode::WallClock || !running_) return t_;
+  if (animation_.mode != Animation::Mode::WallClock || !running_) return sceneTime_;
   const double seconds = std::chrono::duration<double>(Clock::now() - started_).count();
-  return static_cast<float>(std::fmod(animation_.start + animation_.ratePerSecond * seconds, 1.0));
+  return animation_.start + animation_.ratePerSecond * seconds;
 }
 
 void ProbeProducer::freeze() { freeze(t()); }
@@ -83,10 +88,16 @@ void ProbeProducer::freeze(float at) {
 void ProbeProducer::step() {
   if (updater_) {
     const bool wasFrozen = frozen_;
-    if (!wasFrozen && animation_.mode == Animation::Mode::PerStep) t_ = std::fmod(t_ + animation_.perStep, 1.0f);
-    if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) t_ = t();  // what t() says once the loop ends
+    const uint64_t clockUs = service::wallClockUs();
+    if (!wasFrozen && animation_.mode == Animation::Mode::PerStep) sceneTime_ = sceneTime_ + animation_.perStep;
+    if (!wasFrozen && animation_.mode == Animation::Mode::WallClock) sceneTime_ = sceneTime();  // what it says once the loop ends
+    if (wasFrozen) sceneTime_ = frozenT_.load();
+    const double time = sceneTime_;
+    t_ = animationT(time);
+    const bool playing = !wasFrozen && animation_.mode == Animation::Mode::WallClock;
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene) {
-      const scene::Scene next = loadSceneOrThrow(sceneSpec_, t());
+      const scene::Scene next = loadSceneOrThrow(sceneSpec_, t_);
+      lights_ = lightStates(next);
       updater_->setScene(next);
       if (next.positions != geometry_.positions || next.indices != geometry_.indices ||
           next.triangleMaterial != geometry_.triangleMaterial) {
@@ -112,6 +123,7 @@ void ProbeProducer::step() {
         updater_->setViewWeights(renderer::probeViewWeights(updater_->grid(), updater_->volume().offsets, views));
     }
     const renderer::UpdateStats st = updater_->update();
+    hub_.setSceneState({time, playing ? animation_.ratePerSecond : 0.0, clockUs, lights_});
     const auto t0 = Clock::now();
     hub_.publish(updater_->volume());
     const double publishMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();

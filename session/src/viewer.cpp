@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "probecast/session/scene_loading.h"
+#include "probecast/session/scene_state.h"
 #include "probecast/session/volumes.h"
 
 namespace probecast::session {
@@ -33,6 +34,18 @@ Viewer::Viewer(renderer::VulkanContext& context, const scene::Scene& scene, std:
   client_->setViews(priorityViews(views_));
   config_.raster.areaLights = {};  // until a stream states its rule: a volume without one holds every emitter
   raster_ = std::make_unique<renderer::RasterRenderer>(context, scene, config_.width, config_.height, config_.raster);
+  animates_ = !config_.sceneSpec.empty() && sceneAnimates(config_.sceneSpec);
+}
+
+void Viewer::shadeAt(double displayTime) {
+  if (animates_) {
+    raster_->setShading(loadSceneOrThrow(config_.sceneSpec, animationT(displayTime)));
+  } else if (!config_.sceneSpec.empty() && held_.hasState && !(held_.state.lights == shadedState_.lights)) {
+    scene::Scene lit = scene_;
+    applyLights(held_.state, lit);
+    raster_->setShading(lit);
+    shadedState_ = held_.state;
+  }
 }
 
 void Viewer::followAreaLights(const AreaLightRule& rule) {
@@ -60,7 +73,7 @@ bool Viewer::render() {
   if (!client_->snapshot(held_)) return false;  // into the storage of the last snapshot
   followAreaLights(held_.volume.areaLights);
   stats_.framesSeen = held_.framesApplied;
-  if (config_.lightT) raster_->setShading(loadSceneOrThrow(config_.sceneSpec, config_.lightT()));
+  shadeAt(clock_.at(held_, service::wallClockUs()));
   raster_->setProbes(held_.volume);
   images_ = raster_->renderViews(views_);
   stats_.renderMsPerView.push_back(raster_->timings().viewsMs / static_cast<double>(views_.size()));

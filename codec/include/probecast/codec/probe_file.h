@@ -1,13 +1,15 @@
 // Probe volume files: a baked grid of float L2 SH probes plus the active mask, for inspection,
 // the codec benchmark and serving without tracing.
 //
-// Little-endian: magic "PCPV" | u32 version (3) | u32 nx, ny, nz | f32 min[3], max[3] (metres,
+// Little-endian: magic "PCPV" | u32 version (4) | u32 nx, ny, nz | f32 min[3], max[3] (metres,
 // positions of the first and last probe) | u32 updates | u32 samplesPerProbe | f32 probes[n × 27]
 // (sh.h layout: coefficient-major RGB, no Condon-Shortley phase, radiance) | u8 active[n] |
 // u32 m | f32 offsets[m] (m = 0 or 3n, ProbeVolume::offsets in metres) | u32 area light rule version
-// | f32 its threshold (ProbeVolume::areaLights) | u32 CRC-32C of everything before it. Version 2 files
-// (no rule) and version 1 files (no m, no offsets either) are still read, their rule as none: they
-// were made before any emitter was left out of the probes.
+// | f32 its threshold (ProbeVolume::areaLights) | u8 scene hash[32] | f64 scene time | u32 s |
+// scene manifest[s] (ProbeVolume::scene; s = 0: unknown, hash all zero) | u32 CRC-32C of everything
+// before it. Version 3 files (no scene: unknown), version 2 files (no rule) and version 1 files (no
+// m, no offsets either) are still read, their rule as none: they were made before any emitter was
+// left out of the probes.
 #pragma once
 
 #include <cstdint>

@@ -8,6 +8,7 @@
 // probe (1 = active, 0 = inside geometry: never sent, never interpolated from).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -51,6 +52,18 @@ struct AreaLightRule {
 // False with the reason in `error`.
 bool checkAreaLightRule(const AreaLightRule& rule, std::string& error);
 
+// The scene a volume was traced in: its package's hash and manifest (service/scene_package.h: the
+// scene with every file it uses, and the distant light around it) and the scene time, seconds.
+// An empty manifest: unknown (a volume made before scenes were named, or generated in code).
+constexpr size_t kMaxSceneManifestBytes = 256 * 1024;
+struct SceneStamp {
+  std::array<uint8_t, 32> hash{};  // SHA-256 of the manifest
+  std::string manifest;
+  double time = 0.0;
+  bool known() const { return !manifest.empty(); }
+  bool operator==(const SceneStamp&) const = default;
+};
+
 struct ProbeVolume {
   ProbeGrid grid;
   std::vector<float> probes;    // 27 floats per probe
@@ -84,6 +97,8 @@ struct ProbeVolume {
   std::vector<float> offsets;
   // The emitters these probes leave out (none unless the producer says so).
   AreaLightRule areaLights;
+  // The scene and time the samples were traced in.
+  SceneStamp scene;
 
   uint32_t count() const { return grid.count(); }
 };

@@ -37,12 +37,13 @@ struct Pacing {
   double seconds = 0.0;  // the loop ends after this long (0 = when stopped or interrupted)
 };
 
-// The animation parameter t of a traced scene (built-in scenes move their light once around per unit of t).
+// The scene clock of a traced scene, seconds (built-in scenes move their light once around per
+// scene second: their animation parameter t is the scene time mod 1).
 struct Animation {
   enum class Mode {
-    Still,      // t stays at `start`
-    WallClock,  // t = start + ratePerSecond × seconds since the loop started (mod 1)
-    PerStep,    // t advances by `perStep` before every update (mod 1)
+    Still,      // the scene time stays at `start`
+    WallClock,  // scene time = start + ratePerSecond × seconds since the loop started (frames say the rate)
+    PerStep,    // the scene time advances by `perStep` before every update (frames say rate 0: steps)
   };
   Mode mode = Mode::Still;
   float start = 0.0f;
@@ -110,7 +111,9 @@ class ProbeProducer {
   void freeze(float at);
   // Generated frames: false holds the lighting (steps only tick), true moves on.
   void setMoving(bool moving) { moving_ = moving; }
-  // The animation parameter now (wall-clock animation: at this moment; otherwise of the last update).
+  // The scene time now (wall-clock animation: at this moment; otherwise of the last update), and
+  // the built-in scenes' animation parameter t of it.
+  double sceneTime() const;
   float t() const;
   // When the loop (start or run) began.
   Clock::time_point started() const { return started_; }
@@ -153,6 +156,8 @@ class ProbeProducer {
   std::thread thread_;
   std::atomic<bool> stop_{false}, running_{false}, moving_{true}, frozen_{false};
   std::atomic<float> t_{0.0f}, frozenT_{0.0f};
+  std::atomic<double> sceneTime_{0.0};
+  std::vector<bus::LightState> lights_;  // of the scene at the last update
   Clock::time_point started_ = Clock::now();
   mutable std::mutex mutex_;
   ProducerStats stats_;

@@ -31,9 +31,11 @@ struct ViewerConfig {
   // neither counted twice nor lost. Set, the viewer asks for area lights on (true) or off (false)
   // and render() throws std::runtime_error, rendering nothing, when the stream says otherwise.
   std::optional<bool> areaLights;
-  // Direct light is local: when set, every render first shades with `sceneSpec` at lightT().
+  // Direct light is local, at the viewer's display clock (service::DisplayClock, locked to the
+  // stream's scene clock): when set, a scene that animates (sceneAnimates) is shaded as `sceneSpec`
+  // at the display time before every render; one that does not takes the lights of the newest
+  // frame's scene state.
   std::string sceneSpec;
-  std::function<float()> lightT;
 };
 
 struct ViewerStats {
@@ -68,6 +70,11 @@ class Viewer {
   // The rule the viewer lights by now (that of the last volume rendered).
   const AreaLightRule& areaLightRule() const { return lit_; }
   const scene::AreaLightSet& areaLights() const { return raster_->areaLights(); }
+  // The scene time the last render drew at, the probes' age then (scene seconds), and the clock
+  // offset it was locked with (the server's clock is ours minus this).
+  double displayTime() const { return clock_.last(); }
+  double probeAge() const { return clock_.probeAge(); }
+  int64_t clockOffsetUs() const { return held_.clockOffsetUs; }
 
  private:
   ViewerConfig config_;
@@ -80,6 +87,11 @@ class Viewer {
   std::unique_ptr<renderer::RasterRenderer> raster_;
   AreaLightRule lit_;
   service::VolumeSnapshot held_;  // what it rendered last; its storage is reused
+  service::DisplayClock clock_;
+  bool animates_ = false;         // sceneSpec moves with the scene time
+  bus::SceneState shadedState_;  // the state whose lights it shades with (scenes that do not animate)
+  // Shades direct light for the display time (see ViewerConfig::sceneSpec).
+  void shadeAt(double displayTime);
   std::vector<renderer::Image> images_;
   ViewerStats stats_;
 };

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,6 +13,8 @@
 
 #include "probecast/codec/priority.h"
 #include "probecast/codec/stream.h"
+#include "probecast/service/bus_format.h"
+#include "probecast/service/scene_package.h"
 
 namespace probecast::service {
 
@@ -48,11 +51,60 @@ struct ClientConfig {
 
 struct VolumeSnapshot {
   ProbeVolume volume;           // the last good volume (decodedFrom: the stream's representation;
-                                // offsets and areaLights: the description's)
+                                // offsets, areaLights and scene: the description's, scene.time the
+                                // newest frame's)
   StreamLayout layout;          // the stream's grid, brick edge and representation
   uint32_t framesApplied = 0;
   uint64_t newestServerTimeUs = 0;
+  // The scene state of the newest frame applied (hasState false before the first, or from a
+  // server that sent none).
+  bus::SceneState state;
+  bool hasState = false;
+  // The server's wall clock is this client's minus clockOffsetUs (estimated from the frames: the
+  // smallest receive − send time of the most recent 64, so one-way delay included).
+  int64_t clockOffsetUs = 0;
 };
+
+// The scene time the server's clock stands at when this client's wall clock reads `localUs`
+// (µs since 1970): the newest state extrapolated at its rate (its time when it holds still).
+double serverSceneTime(const VolumeSnapshot& snapshot, uint64_t localUs);
+
+// A viewer's display clock, locked to the server's scene clock. Each frame it is asked for the
+// scene time to draw at: the server's (serverSceneTime), held where it would step back by less than
+// one second of playback (so small corrections never run the picture backwards) and followed at once
+// when it jumps ahead or is more than one second behind (a stream that restarted or rewound).
+// While the stream stalls, the estimate runs on at the last rate: direct light keeps moving, the
+// probes keep their light and grow older (probeAge).
+class DisplayClock {
+ public:
+  double at(const VolumeSnapshot& snapshot, uint64_t localUs);
+  // Scene seconds between the time last drawn and the time the newest probes were traced at.
+  double probeAge() const { return age_; }
+  double last() const { return last_; }
+
+ private:
+  bool started_ = false;
+  double last_ = 0.0, age_ = 0.0;
+};
+
+// Microseconds since 1970 on this machine's wall clock.
+uint64_t wallClockUs();
+
+// The scene a server's stream names (GetVolume from the config's servers in turn; an unknown
+// stamp when it names none). False with `error` when no server answers or the description is bad.
+bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& error);
+
+struct SceneFetch {
+  uint64_t bytes = 0;     // file bytes received (0 when the cache held the package)
+  double ms = 0.0;
+  bool fromCache = false;
+};
+// The scene package of `scene` (a description's stamp): from `cache` when it holds it whole,
+// else fetched with GetScene from the config's servers in turn, checked (every file's size and
+// SHA-256) and stored in the cache. Refuses a package of more than maxBytes before fetching it.
+// False with `error` naming the reason (refused, not found, too large, a file that does not match).
+bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::filesystem::path& cache,
+                uint64_t maxBytes, ScenePackage& out, SceneFetch& fetch, std::string& error);
 
 struct ClientStats {
   bool connected = false;

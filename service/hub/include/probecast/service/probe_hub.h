@@ -38,6 +38,9 @@ struct HubConfig {
   std::vector<int8_t> offsets;
   // The emitters the probes leave out for viewers to light (ProbeVolume::areaLights); none by default.
   AreaLightRule areaLights;
+  // The scene the probes are traced in (hash and manifest; its time is the scene state's): what
+  // every description names. Unknown by default.
+  SceneStamp scene;
 };
 
 // The hub of a probe grid streamed as `repr` in bricks of brickDim³ probes, dropping changes of
@@ -58,6 +61,7 @@ struct BrickVersionBytes {
   uint64_t publishedUs = 0;  // when the lighting of this version was published (wall clock)
   float change = 0.0f;
   std::vector<uint8_t> keyframe, delta;
+  bus::SceneState state;  // of the frame that made it
 };
 
 // The bus message fields of a version (its sections view `v`).
@@ -83,6 +87,8 @@ struct OutgoingFrame {
   size_t payloadBytes = 0;       // its size
   uint32_t keyframes = 0;
   uint32_t deltas = 0;
+  bus::SceneState state;  // the scene state of the newest lighting in it
+  uint64_t sentUs = 0;    // wall clock when it was made, µs since 1970
 };
 
 // Where nextFrame writes a frame's payload instead of OutgoingFrame::payload: called under the
@@ -119,6 +125,14 @@ class ProbeHub {
   // once the hub has published or has subscribers starts a new epoch: every stream ends, and
   // clients subscribe again and get the new description.
   void setProbeOffsets(const std::vector<float>& offsets);
+  // A producer's scene (hash and manifest). A change once the hub has published or has
+  // subscribers starts a new epoch, as for the offsets.
+  void setScene(const SceneStamp& scene);
+  // A producer's scene state for the publishes that follow (checkSceneState; std::invalid_argument
+  // otherwise): every frame and bus message of their lighting carries it.
+  void setSceneState(const bus::SceneState& state);
+  // The state of the newest lighting (an edge's: of the newest producer frame received).
+  bus::SceneState sceneState() const;
   // A producer's client area light rule (checkAreaLightRule; std::invalid_argument otherwise). A
   // change once the hub has published or has subscribers starts a new epoch, as for the offsets:
   // light held by the old rule would be counted twice or lost by the new one.
@@ -245,6 +259,8 @@ class ProbeHub {
   std::vector<uint32_t> lastOutput_;  // version last handed to busOutput_, per brick
   uint32_t frame_ = 0;
   uint64_t publishedUs_ = 0;
+  bus::SceneState state_;
+  uint32_t stateFrame_ = 0;  // an edge's: the producer frame state_ is of
   uint64_t nextId_ = 1;
   std::map<uint64_t, Subscriber> subscribers_;
   std::vector<BrickCandidate> candidates_;

@@ -8,6 +8,7 @@
 
 #include "probecast/service/latency_histogram.h"
 #include "probecast/service/probe_hub.h"
+#include "probecast/service/scene_package.h"
 
 namespace probecast::service {
 
@@ -33,6 +34,9 @@ struct ServerConfig {
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
   static constexpr int kTickMs = 50;
+  // The scene package GetScene delivers (its files read from their sources on this machine); none:
+  // GetScene answers NOT_FOUND. It should be the one the hub's descriptions name.
+  std::shared_ptr<const ScenePackage> scene;
 };
 
 class ProbeServer {
