@@ -23,6 +23,8 @@ std::vector<std::vector<uint8_t>> sampleBusMessages() {
     // The same volume with probe offsets (3 bytes per probe in the volume message, their checksum
     // in every brick message below) and client area lights.
     volume.areaLights = {kAreaLightRuleVersion, 0.05f};
+    volume.sceneHash.fill(0xa5);  // and a scene: its manifest in the volume message, its hash in every one
+    volume.sceneManifest = R"({"files":[],"format":1,"lighting":{},"scene":{"builtin":"cornell"}})";
     volume.offsets.resize(static_cast<size_t>(n) * 3);
     for (size_t i = 0; i < volume.offsets.size(); ++i) volume.offsets[i] = static_cast<int8_t>(static_cast<int>(i % 11) * 23 - 115);
     bus::writeVolumeMessage(volume, 0, m);
@@ -44,6 +46,14 @@ std::vector<std::vector<uint8_t>> sampleBusMessages() {
       const std::vector<uint8_t> keyCopy(key.begin(), key.end());
       b.keyframe = keyCopy;
       b.delta = f == 0 ? std::span<const uint8_t>{} : enc.deltaSection(brick);
+      b.state.time = 0.5 * f;  // the scene state: a still frame, then a playing one with two lights
+      if (f == 1) {
+        b.state.rate = 0.05;
+        b.state.clockUs = 1700000000000000ull;
+        b.state.lights.resize(2);
+        b.state.lights[1].type = 1;
+        b.state.lights[1].outerCone = 0.5f;
+      }
       bus::writeBrickMessage(volume, b, f == 0 ? 0 : bus::kEndOfBatch, m);
       out.push_back(m);
     }

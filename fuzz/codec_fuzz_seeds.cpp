@@ -70,5 +70,11 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> bytes;
   serializeProbeVolume(volume, bytes);
   write(dir, "probe-volume", 0x40, bytes);
+  // With the scene it was traced in (probe file version 4's scene block).
+  volume.scene.manifest = R"({"files":[],"format":1,"lighting":{"sky":[0.5,0.5,0.5]},"scene":{"builtin":"cornell"}})";
+  volume.scene.hash.fill(0x5a);
+  volume.scene.time = 0.25;
+  serializeProbeVolume(volume, bytes);
+  write(dir, "probe-volume-scene", 0x40, bytes);
   return 0;
 }

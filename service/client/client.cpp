@@ -427,21 +427,23 @@ bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::
     std::unique_ptr<grpc::ClientReader<pb::SceneChunk>> reader = stub->GetScene(&ctx, request);
     PackageWriter writer(cache, named);
     pb::SceneChunk chunk;
-    bool ok = writer.begin(error) && reader->Read(&chunk);
-    if (ok && chunk.manifest() != scene.manifest) ok = false, error = server + " sent another manifest than its description";
+    bool ok = writer.begin(error);  // false: a local failure, the call is cancelled
+    const bool answered = ok && reader->Read(&chunk);
+    if (answered && chunk.manifest() != scene.manifest) ok = false, error = "it sent another manifest than its description";
     uint64_t bytes = 0;
-    while (ok && reader->Read(&chunk)) {
+    while (ok && answered && reader->Read(&chunk)) {
       ok = writer.write(chunk.path(), chunk.offset(), chunk.data(), error);
       bytes += chunk.data().size();
     }
     if (!ok) ctx.TryCancel();
     const grpc::Status status = reader->Finish();
-    if (ok && status.ok() && writer.finish(out, error)) {
+    if (ok && answered && status.ok() && writer.finish(out, error)) {
       fetch.bytes = bytes;
       fetch.ms = elapsedMs();
       return true;
     }
-    errors += (errors.empty() ? "" : "; ") + server + ": " + (status.ok() ? error : status.error_message());
+    if (ok && status.ok() && !answered) error = "it sent nothing";
+    errors += (errors.empty() ? "" : "; ") + server + ": " + (ok && !status.ok() ? status.error_message() : error);
     if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) break;
   }
   return error = "cannot fetch the scene: " + errors, false;
