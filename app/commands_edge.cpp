@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "probecast/service/edge_server.h"
+#include "options/connect.h"
 #include "scene_options.h"
 
 namespace probecast::app {
@@ -25,6 +26,8 @@ void addEdgeCommand(CLI::App& app) {
     BusOptions busLink;
     uint32_t maxSubscribers = 1024;
     double seconds = 0.0;
+    ConnectOptions sceneFrom;
+    std::string sceneCache;
   };
   auto o = std::make_shared<EdgeOptions>();
   edge->add_option("--nats", o->bus.url, "NATS server(s) holding the stream: nats://host:port, comma-separated")
@@ -34,12 +37,23 @@ void addEdgeCommand(CLI::App& app) {
   o->server.add(edge);
   edge->add_option("--max-subscribers", o->maxSubscribers, "subscribers served at once")->check(CLI::Range(1, 1000000));
   edge->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
+  edge->add_option("--scene-from", o->sceneFrom.connect,
+                   "fetch the scene the bus names from this server (the producer or another edge, host:port), to "
+                   "deliver it to viewers; built-in scenes need nothing");
+  edge->add_option("--scene-from-token-file", o->sceneFrom.tokenFile, "bearer token for --scene-from")
+      ->check(CLI::ExistingFile);
+  edge->add_option("--scene-from-ca", o->sceneFrom.tlsCa, "PEM root certificate of --scene-from (enables TLS)")
+      ->check(CLI::ExistingFile);
+  edge->add_option("--scene-cache", o->sceneCache,
+                   "folder of scenes by hash (default $PROBECAST_SCENE_CACHE, else ~/.cache/probecast/scenes)");
   edge->callback([o] {
     service::EdgeConfig ec;
     ec.bus = o->bus;
     o->busLink.apply(ec.bus);
     ec.server = o->server.config();
     ec.server.maxSubscribers = o->maxSubscribers;
+    if (!o->sceneFrom.connect.empty()) ec.sceneSource = o->sceneFrom.client("probecast-edge");
+    if (!o->sceneCache.empty()) ec.sceneCache = o->sceneCache;
     service::EdgeServer server(ec);
     fmt::print("edge: stream {} from {} on port {} ({})\n", service::busStreamName(ec.bus.stream), ec.bus.url,
                server.port(), describeSecurity(ec.server, "edge", server.port()));
@@ -55,9 +69,10 @@ void addEdgeCommand(CLI::App& app) {
       if (now - lastReport < std::chrono::seconds(5)) continue;
       lastReport = now;
       const service::EdgeStats st = server.stats();
-      fmt::print("edge: bus {}, {} messages ({} applied, {} stale, {} refused), {} subscribers{}\n",
+      fmt::print("edge: bus {}, {} messages ({} applied, {} stale, {} refused), {} subscribers, scene {}{}\n",
                  st.busConnected ? "connected" : "away", st.received, st.applied, st.stale, st.refused,
-                 server.hub().subscriberCount(), st.lastError.empty() ? "" : ", last error: " + st.lastError);
+                 server.hub().subscriberCount(), st.scene.empty() ? "not yet held" : st.scene,
+                 st.lastError.empty() ? "" : ", last error: " + st.lastError);
       std::fflush(stdout);
     }
     server.shutdown();

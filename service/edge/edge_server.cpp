@@ -23,7 +23,46 @@ struct EdgeServer::Impl {
   natsSubscription* subscription = nullptr;
   EdgeStats stats;
   std::unique_ptr<NatsLink> link;
-  std::thread worker;
+  std::thread worker, sceneWorker;
+  SceneHash servedScene{};
+
+  // Keeps the server's scene package that of the scene the bus names (see EdgeConfig).
+  void keepScene() {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stopping) {
+      lock.unlock();
+      const bus::Volume v = hub.volume();
+      std::string error;
+      bool retryLater = false;
+      if (v.hasScene() && !v.sceneManifest.empty() && v.sceneHash != servedScene) {
+        SceneStamp stamp;
+        stamp.hash = v.sceneHash;
+        stamp.manifest = v.sceneManifest;
+        ScenePackage p;
+        SceneFetch fetch;
+        // Without a source, only what the cache holds (or a built-in, whose manifest is all of it).
+        const bool ok = config.sceneSource
+                            ? fetchScene(*config.sceneSource, stamp, config.sceneCache, config.sceneMaxBytes, p, fetch, error)
+                            : findCachedPackage(config.sceneCache, stamp.hash, p) ||
+                                  (parseManifest(stamp.manifest, p, error) && p.files.empty());
+        if (ok && p.hash == stamp.hash) {
+          servedScene = p.hash;
+          const std::string what = p.describe();
+          server->setScene(std::make_shared<const ScenePackage>(std::move(p)));
+          lock.lock();
+          stats.scene = what;
+          stats.sceneFetch = fetch;
+          lock.unlock();
+        } else {
+          retryLater = true;
+          if (error.empty()) error = "the scene's files are not in " + config.sceneCache.string() + " and no --scene-from is given";
+        }
+      }
+      lock.lock();
+      if (retryLater) stats.lastError = "scene: " + error;
+      wake.wait_for(lock, std::chrono::milliseconds(retryLater ? 5000 : 200), [this] { return stopping; });
+    }
+  }
 
   explicit Impl(const EdgeConfig& c) : config(c), hub(c.hub, FromBus{}) {}
 
@@ -151,7 +190,9 @@ EdgeServer::EdgeServer(const EdgeConfig& config) : impl_(std::make_unique<Impl>(
         s.wake.notify_all();
       },
       [&s] { s.wake.notify_all(); });
+  if (s.config.sceneCache.empty()) s.config.sceneCache = defaultSceneCache();
   s.worker = std::thread([&s] { s.run(); });
+  s.sceneWorker = std::thread([&s] { s.keepScene(); });
 }
 
 EdgeServer::~EdgeServer() { shutdown(); }
@@ -181,6 +222,7 @@ void EdgeServer::shutdown() {
   }
   s.wake.notify_all();
   if (s.worker.joinable()) s.worker.join();
+  if (s.sceneWorker.joinable()) s.sceneWorker.join();
   s.link.reset();
 }
 

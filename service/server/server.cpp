@@ -401,7 +401,16 @@ constexpr uint32_t kDefaultSceneChunk = 1u << 20, kMaxSceneChunk = 4u << 20;
 
 class Service final : public RawSubscribeService {
  public:
-  Service(ProbeHub& hub, const ServerConfig& config) : hub_(hub), config_(config) {}
+  Service(ProbeHub& hub, const ServerConfig& config) : hub_(hub), config_(config), scene_(config.scene) {}
+
+  void setScene(std::shared_ptr<const ScenePackage> scene) {
+    std::lock_guard<std::mutex> lock(sceneMutex_);
+    scene_ = std::move(scene);
+  }
+  std::shared_ptr<const ScenePackage> scene() const {
+    std::lock_guard<std::mutex> lock(sceneMutex_);
+    return scene_;
+  }
 
   RawReactor* Subscribe(grpc::CallbackServerContext* ctx) override {
     if (!authorized(ctx, config_.token, config_.noAuth))
@@ -440,7 +449,7 @@ class Service final : public RawSubscribeService {
     if (request->chunk_bytes() > kMaxSceneChunk)
       return refuse(grpc::StatusCode::INVALID_ARGUMENT,
                     "chunk_bytes " + std::to_string(request->chunk_bytes()) + " is above the limit of 4 MiB");
-    const std::shared_ptr<const ScenePackage> package = config_.scene;
+    const std::shared_ptr<const ScenePackage> package = scene();
     if (!package || std::memcmp(package->hash.data(), request->scene_hash().data(), 32) != 0)
       return refuse(grpc::StatusCode::NOT_FOUND,
                     package ? "this server delivers scene " + shortHex(package->hash) + ", not the one asked for"
@@ -455,6 +464,8 @@ class Service final : public RawSubscribeService {
   const ServerConfig& config_;
   std::atomic<uint32_t> subscribers_{0};
   FrameWriteTimes writeTimes_;
+  mutable std::mutex sceneMutex_;
+  std::shared_ptr<const ScenePackage> scene_;
 };
 
 }  // namespace
@@ -554,6 +565,8 @@ ProbeServer::ProbeServer(const ServerConfig& config, ProbeHub& hub) : impl_(std:
 ProbeServer::~ProbeServer() { shutdown(); }
 
 int ProbeServer::port() const { return impl_->port; }
+
+void ProbeServer::setScene(std::shared_ptr<const ScenePackage> scene) { impl_->service->setScene(std::move(scene)); }
 
 LatencyHistogram ProbeServer::takeFrameWriteLatency() { return impl_->service->writeTimes().take(); }
 

@@ -6,10 +6,13 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "probecast/service/bus_nats.h"
+#include "probecast/service/client.h"
 #include "probecast/service/probe_hub.h"
 #include "probecast/service/server.h"
 
@@ -19,6 +22,12 @@ struct EdgeConfig {
   BusConfig bus;
   ServerConfig server;
   HubConfig hub;  // priority and burst; layout, bounds and encoder come from the bus
+  // Scene delivery: the bus names the producer's scene; the edge serves its package (GetScene)
+  // from `sceneCache` when it holds it, else fetched once from `sceneSource` (the producer or
+  // another edge) into the cache. Neither: built-in scenes only (their manifest is the package).
+  std::filesystem::path sceneCache;
+  std::optional<ClientConfig> sceneSource;
+  uint64_t sceneMaxBytes = uint64_t{4} << 30;
 };
 
 struct EdgeStats {
@@ -30,6 +39,8 @@ struct EdgeStats {
   uint32_t epochs = 0;    // producer epochs seen
   uint32_t subscribes = 0;  // times the bus subscription was (re)made
   std::string lastError;
+  std::string scene;        // the scene package it delivers (ScenePackage::describe), empty: none yet
+  SceneFetch sceneFetch;    // how it got it
 };
 
 class EdgeServer {

@@ -50,6 +50,8 @@ class ProbeServer {
 
   int port() const;
   void shutdown();
+  // Replaces the scene package GetScene delivers (ServerConfig::scene), e.g. once an edge has it.
+  void setScene(std::shared_ptr<const ScenePackage> scene);
 
   // Instrumentation for load tests: the time from the publish of a frame's newest lighting
   // (OutgoingFrame::serverTimeUs, system clock) to gRPC's write-done for it, over all frames
