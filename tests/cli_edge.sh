@@ -21,13 +21,17 @@ printf 'authorization { token: "%s" }\n' "$(cat "$work/bus-token")" >"$work/nats
 "$nats" -c "$work/nats.conf" -a 127.0.0.1 -p "$np" -js -sd "$work/nats" >"$work/nats.log" 2>&1 &
 pids+=($!)
 bus=(--nats-token-file "$work/bus-token" --nats-plaintext)
-"$probecast" bake --scene builtin:cornell --grid 6,6,6 --spp 32 --updates 1 --out "$work/served.pcpv" >/dev/null
-"$probecast" serve --probes "$work/served.pcpv" --listen "127.0.0.1:$sp" --plaintext --token t0k --seconds 30 \
+# A glTF scene: its files go to the viewers with the stream (through the edges too).
+scene=$(dirname "$0")/data/scenes/cornell-box/CornellBox-Original.gltf
+"$probecast" bake --scene "$scene" --area-lights off --grid 6,6,6 --spp 32 --updates 1 --out "$work/served.pcpv" >/dev/null
+"$probecast" serve --probes "$work/served.pcpv" --scene "$scene" --listen "127.0.0.1:$sp" --plaintext --token t0k --seconds 30 \
   --publish "nats://127.0.0.1:$np" --stream cli "${bus[@]}" >"$work/serve.log" 2>&1 &
 pids+=($!)
+printf 't0k\n' >"$work/scene-token"
 for port in $ea $eb; do
   "$probecast" edge --nats "nats://127.0.0.1:$np" --stream cli "${bus[@]}" --listen "127.0.0.1:$port" --plaintext \
-    --token t0k --seconds 30 >"$work/edge-$port.log" 2>&1 &
+    --token t0k --seconds 30 --scene-from "127.0.0.1:$sp" --scene-from-token-file "$work/scene-token" \
+    --scene-cache "$work/edge-cache-$port" >"$work/edge-$port.log" 2>&1 &
   pids+=($!)
 done
 for log in serve "edge-$ea" "edge-$eb"; do
@@ -42,4 +46,16 @@ if "$probecast" subscribe --connect "127.0.0.1:$eb" --token wrong --seconds 1 2>
   echo "an edge accepted a wrong token"; exit 1
 fi
 grep -q "wrong bearer token" "$work/refused.log"
+# A viewer of an edge without --scene: the scene arrives once (the edge fetched it from the
+# producer), then comes from the viewer's cache; the image is the in-process one of the same file.
+export PROBECAST_SCENE_CACHE="$work/viewer-cache"
+for _ in $(seq 50); do grep -q "scene CornellBox" "$work/edge-$ea.log" 2>/dev/null && break; sleep 0.2; done
+"$probecast" view --connect "127.0.0.1:$ea" --token t0k --wait 1 --views mono --size 24x16 --exr --out "$work/v1" \
+  | tee "$work/v1.log" | grep -q "fetched from the server: [0-9]* bytes"
+"$probecast" view --connect "127.0.0.1:$ea" --token t0k --wait 1 --views mono --size 24x16 --exr --out "$work/v2" \
+  | grep -q "from the cache"
+"$probecast" view --scene "$scene" --probes "$work/served.pcpv" --repr zh3 --views mono --size 24x16 --exr \
+  --out "$work/local" >/dev/null
+cmp "$work/v1/view_00.exr" "$work/local/view_00.exr"
+cmp "$work/v2/view_00.exr" "$work/local/view_00.exr"
 echo "edge round trip ok"

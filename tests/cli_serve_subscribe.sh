@@ -91,4 +91,24 @@ PY
 # A 9x9 light field (81 views) subscribes over gRPC as well.
 "$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views lf:9x9 --size 8x8 --out "$work/view-lf" \
   | grep -q "81 views"
+# The stream names its scene: a viewer without --scene draws the same image as one given the
+# scene and the probe file in-process (same camera, same representation), bit for bit.
+export PROBECAST_SCENE_CACHE="$work/scene-cache"
+"$probecast" view --connect "127.0.0.1:$port" --token s3cret --wait 1 --views mono --size 24x16 --exr \
+  --out "$work/remote" | tee "$work/remote.log" | grep -q "named by the stream"
+"$probecast" view --scene builtin:cornell --probes "$work/served.pcpv" --repr l2 --views mono --size 24x16 --exr \
+  --out "$work/local" >/dev/null
+cmp "$work/remote/view_00.exr" "$work/local/view_00.exr"
+# Another scene than the stream's is refused, naming both; so is a time of the viewer's own.
+if "$probecast" view --connect "127.0.0.1:$port" --token s3cret --scene builtin:hall --wait 1 --views mono \
+  --size 8x8 --out "$work/wrong" 2>"$work/wrong.log"; then
+  echo "a viewer drew another scene than the stream's"; exit 1
+fi
+grep -q "not the scene the server traces: yours is builtin:hall (scene [0-9a-f]*), the stream's builtin:cornell" \
+  "$work/wrong.log"
+if "$probecast" view --connect "127.0.0.1:$port" --token s3cret --t 0.5 --views mono --size 8x8 \
+  --out "$work/t" 2>"$work/t.log"; then
+  echo "a viewer of a stream drew at a time of its own"; exit 1
+fi
+grep -q "draws at the stream's scene clock" "$work/t.log"
 echo "serve/subscribe round trip ok"
