@@ -140,6 +140,53 @@ TEST(EdgeHub, ProbeOffsetsComeOnceInTheVolumeMessageAndTheEdgeWaitsForThem) {
   EXPECT_EQ(edge.reconstruction().offsets, offsets);
 }
 
+// The scene: brick messages name its hash and carry the state of their frame; the manifest comes
+// in the volume message, and the edge describes nothing before it has it. Subscribers' frames
+// carry the newest state, as the producer's do.
+TEST(EdgeHub, TheSceneAndItsStateComeThroughTheBus) {
+  Producer p;
+  SceneStamp stamp;
+  stamp.hash.fill(0x42);
+  stamp.manifest = R"({"files":[],"format":1,"lighting":{},"scene":{"builtin":"cornell"}})";
+  p.hub.setScene(stamp);
+  bus::SceneState st;
+  st.rate = 0.25;
+  st.clockUs = 1764950000000000ull;
+  st.lights.resize(1);
+  for (int f = 0; f < 3; ++f) {
+    st.time = 0.5 * f;
+    st.lights[0].position[0] = static_cast<float>(f);
+    p.hub.setSceneState(st);
+    p.publish();
+  }
+  ProbeHub edge(gridConfig(), FromBus{});
+  feedAll(edge, p.messages);
+  EXPECT_FALSE(edge.ready()) << "an edge must not describe the volume before the scene's manifest arrives";
+  std::vector<uint8_t> volume;
+  bus::writeVolumeMessage(p.hub.volume(), bus::kEndOfBatch, volume);
+  EXPECT_EQ(feed(edge, volume), ProbeHub::Received::Applied);
+  ASSERT_TRUE(edge.ready());
+  EXPECT_EQ(edge.volume().sceneHash, stamp.hash);
+  EXPECT_EQ(edge.volume().sceneManifest, stamp.manifest);
+  EXPECT_EQ(edge.sceneState(), st);  // the newest frame's, whatever order its bricks came in
+  const uint64_t id = edge.addSubscriber(0, 0, {}, [] {});
+  const auto frame = edge.nextFrame(id);
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->state, st);
+  EXPECT_EQ(edge.reconstruction().scene.time, 1.0);
+  // Another scene in the same epoch is refused; a new scene is a new epoch.
+  bus::Volume other = p.hub.volume();
+  other.sceneHash[0] ^= 1;
+  bus::writeVolumeMessage(other, 0, volume);
+  std::string why;
+  EXPECT_EQ(feed(edge, volume, &why), ProbeHub::Received::Refused);
+  EXPECT_NE(why.find("another volume"), std::string::npos) << why;
+  const uint64_t epoch = p.hub.epoch();
+  stamp.hash.fill(0x43);
+  p.hub.setScene(stamp);
+  EXPECT_NE(p.hub.epoch(), epoch);
+}
+
 // Every bus message states the area light rule: an edge describes its volume with the producer's,
 // a message of the same epoch with another rule is refused, and a new rule is a new epoch.
 TEST(EdgeHub, TheAreaLightRuleComesWithEveryMessageAndAChangeIsANewEpoch) {
