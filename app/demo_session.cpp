@@ -12,6 +12,7 @@
 #include "demo.h"
 #include "progress.h"
 #include "probecast/imaging/image_io.h"
+#include "probecast/session/scene_state.h"
 #include "probecast/session/representation.h"
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/volumes.h"
@@ -41,6 +42,10 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   service::HubConfig hub = service::hubConfigFor(run.grid, session::parseRepresentationOrThrow(o.repr), 4, 1);
   hub.encoder.noiseScale = o.encoder.noiseScale;
   hub.encoder.refinementInterval = o.encoder.refinementInterval;
+  service::ScenePackage package;  // the scene and sky the descriptions name, as serve's do
+  std::string error;
+  if (!service::makeScenePackage(o.scene, o.environment.request(), package, error)) throw std::runtime_error(error);
+  hub.scene = session::stampOf(package, 0.0);
   run.producer = std::make_unique<session::ProbeProducer>(hub);
   renderer::UpdaterOptions uo;
   uo.samplesPerProbe = o.spp;
@@ -55,6 +60,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   sc.plaintext = true;  // loopback only
   std::random_device rd;
   sc.token = fmt::format("demo-{:08x}{:08x}", rd(), rd());
+  sc.scene = std::make_shared<const service::ScenePackage>(std::move(package));
   const int port = run.producer->serve(sc);
   sc.listen = fmt::format("127.0.0.1:{}", port);
   fmt::print(
