@@ -485,12 +485,25 @@ PYBIND11_MODULE(probecast, m) {
         d["active"] = maskArray(v.active.data(), v.count());
         d["updates"] = v.updates;
         d["samples_per_probe"] = v.samplesPerProbe;
+        if (v.scene.known()) {
+          static const char* digits = "0123456789abcdef";
+          std::string hex;
+          for (uint8_t b : v.scene.hash) hex += {digits[b >> 4], digits[b & 15]};
+          d["scene_hash"] = hex;
+          d["scene_manifest"] = v.scene.manifest;
+        } else {
+          d["scene_hash"] = py::none();
+          d["scene_manifest"] = py::none();
+        }
+        d["scene_time"] = v.scene.time;
         return d;
       },
       py::arg("path"),
       "Reads a probe volume file (probecast bake): dict with dims (nx, ny, nz), bounds_min/bounds_max (metres, "
       "positions of the first and last probe), probes (N, 27) float32, active (N,) uint8, updates, "
-      "samples_per_probe. Raises ValueError naming what failed.");
+      "samples_per_probe, and the scene it was traced in: scene_hash (hex SHA-256 of scene_manifest, the scene "
+      "package's JSON; both None when the file names no scene) and scene_time (seconds). Raises ValueError naming "
+      "what failed.");
 
   m.def(
       "write_probe_file",

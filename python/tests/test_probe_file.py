@@ -40,3 +40,28 @@ def test_probe_file_errors(tmp_path, rng):
         probecast.write_probe_file(str(tmp_path / "nan.pcpv"), (2, 2, 2), p)
     with pytest.raises(ValueError, match="dimension 0 must be 8"):
         probecast.write_probe_file(str(tmp_path / "x.pcpv"), (2, 2, 2), random_probes(rng, 7))
+
+
+def _crc32c(data):
+    crc = 0xFFFFFFFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = (crc >> 1) ^ (0x82F63B78 if crc & 1 else 0)
+    return crc ^ 0xFFFFFFFF
+
+
+def test_probe_file_names_its_scene(tmp_path, rng):
+    import hashlib
+    import struct
+    path = tmp_path / "v.pcpv"
+    probecast.write_probe_file(str(path), (2, 1, 1), random_probes(rng, 2))
+    v = probecast.read_probe_file(str(path))
+    assert v["scene_hash"] is None and v["scene_manifest"] is None and v["scene_time"] == 0.0
+    # The same file naming a scene at scene time 0.75 (version 4's tail: hash, time, manifest, CRC).
+    manifest = b'{"files":[],"format":1,"lighting":{},"scene":{"builtin":"cornell"}}'
+    digest = hashlib.sha256(manifest).digest()
+    body = path.read_bytes()[:-48] + digest + struct.pack("<dI", 0.75, len(manifest)) + manifest
+    path.write_bytes(body + struct.pack("<I", _crc32c(body)))
+    v = probecast.read_probe_file(str(path))
+    assert v["scene_hash"] == digest.hex() and v["scene_manifest"] == manifest.decode() and v["scene_time"] == 0.75
