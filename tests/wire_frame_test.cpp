@@ -55,5 +55,43 @@ TEST(WireFrame, HandWrittenFrameIsTheBytesProtobufWrites) {
   EXPECT_EQ(cases, 6 * 4 * 8 * 4);
 }
 
+TEST(WireFrame, SceneStateAndSendTimeAreTheBytesProtobufWrites) {
+  bus::SceneState still;  // all zero: an empty message that is still present
+  bus::SceneState playing;
+  playing.time = 12.5;
+  playing.rate = 0.05;
+  playing.clockUs = 1764950000123456ull;
+  playing.lights.resize(3);
+  playing.lights[1].type = 2;
+  playing.lights[2].intensity = 0.0f;
+  for (const bus::SceneState* st : {&still, &playing})
+    for (uint64_t sent : {uint64_t{0}, uint64_t{1}, uint64_t{1764950000654321ull}})
+      for (size_t bytes : {size_t{0}, size_t{300}}) {
+        v1::SceneState wire;
+        stateToWire(*st, wire);
+        const std::string state = wire.SerializeAsString();
+        const std::string payload(bytes, 'p');
+        FrameFields f{9, 77, bytes, 2, 1, &state, sent};
+        v1::ServerMessage m;
+        v1::Frame* frame = m.mutable_frame();
+        frame->set_sequence(9);
+        frame->set_server_time_us(77);
+        frame->set_payload(payload);
+        frame->set_keyframes(2);
+        frame->set_deltas(1);
+        *frame->mutable_scene_state() = wire;
+        frame->set_sent_us(sent);
+        const std::string mine = handWritten(f, payload);
+        ASSERT_EQ(mine, m.SerializeAsString()) << "lights " << st->lights.size() << " sent " << sent;
+        v1::ServerMessage back;
+        ASSERT_TRUE(back.ParseFromString(mine));
+        bus::SceneState parsed;
+        std::string why;
+        ASSERT_TRUE(stateFromWire(back.frame().scene_state(), parsed, why)) << why;
+        EXPECT_EQ(parsed, *st);
+        EXPECT_EQ(back.frame().sent_us(), sent);
+      }
+}
+
 }  // namespace
 }  // namespace probecast::service
