@@ -38,6 +38,26 @@ std::shared_ptr<grpc::Channel> makeChannel(const ClientConfig& config, const std
   return grpc::CreateCustomChannel(address, creds, args);
 }
 
+// The servers to try, in order.
+std::vector<std::string> serversOf(const ClientConfig& config) {
+  return config.addresses.empty() ? std::vector<std::string>{config.address} : config.addresses;
+}
+
+// A call's context with the config's bearer token.
+void authorize(const ClientConfig& config, grpc::ClientContext& ctx) {
+  if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+}
+
+// volumeFromWire, and a scene the description names checked: its manifest hashes to its hash and parses.
+bool readDescription(const pb::VolumeDescription& v, StreamLayout& l, GridBounds& b, std::vector<float>& o,
+                     AreaLightRule& r, SceneStamp& scene, std::string& why) {
+  ScenePackage named;
+  if (!volumeFromWire(v, l, b, o, r, scene, why)) return false;
+  if (!scene.known()) return true;
+  if (sha256(scene.manifest) != scene.hash) return why = "its scene manifest does not match its hash", false;
+  return parseManifest(scene.manifest, named, why);
+}
+
 }  // namespace
 
 struct ProbeClient::Impl {
@@ -87,10 +107,8 @@ struct ProbeClient::Impl {
     SceneStamp sc;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
-    ScenePackage named;
-    if (!volumeFromWire(v, l, b, o, r, sc, why) ||
-        (sc.known() && (sha256(sc.manifest) != sc.hash || !parseManifest(sc.manifest, named, why)))) {
-      stats.lastError = "bad volume description: " + (why.empty() ? "its scene manifest does not match its hash" : why);
+    if (!readDescription(v, l, b, o, r, sc, why)) {
+      stats.lastError = "bad volume description: " + why;
       return false;
     }
     if (config.representation && l.repr != *config.representation) {
@@ -178,14 +196,13 @@ struct ProbeClient::Impl {
   }
 
   void run() {
-    const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
-                                                                      : config.addresses;
+    const std::vector<std::string> servers = serversOf(config);
     size_t at = 0;
     size_t failedInTurn = 0;  // servers tried since the last one that answered
     int backoff = config.reconnectMinMs;
     while (!stopping) {
       grpc::ClientContext ctx;
-      if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+      authorize(config, ctx);
       std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel(servers[at]));
       std::unique_ptr<Stream> rw = stub->Subscribe(&ctx);
       {
@@ -364,12 +381,11 @@ double DisplayClock::at(const VolumeSnapshot& s, uint64_t localUs) {
 }
 
 bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& error) {
-  const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
-                                                                    : config.addresses;
+  const std::vector<std::string> servers = serversOf(config);
   std::string errors;
   for (const std::string& server : servers) {
     grpc::ClientContext ctx;
-    if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+    authorize(config, ctx);
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
     pb::VolumeDescription v;
     const grpc::Status status = pb::ProbeStream::NewStub(makeChannel(config, server))->GetVolume(&ctx, {}, &v);
@@ -383,10 +399,7 @@ bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& err
     std::vector<float> o;
     AreaLightRule r;
     std::string why;
-    ScenePackage named;
-    if (!volumeFromWire(v, l, b, o, r, out, why) ||
-        (out.known() && (sha256(out.manifest) != out.hash || !parseManifest(out.manifest, named, why))))
-      return error = server + ": bad volume description: " + (why.empty() ? "its scene manifest does not match its hash" : why), false;
+    if (!readDescription(v, l, b, o, r, out, why)) return error = server + ": bad volume description: " + why, false;
     return true;
   }
   return error = "no server described its stream: " + errors, false;
@@ -415,12 +428,11 @@ bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::
     fetch.ms = elapsedMs();
     return true;
   }
-  const std::vector<std::string> servers = config.addresses.empty() ? std::vector<std::string>{config.address}
-                                                                    : config.addresses;
+  const std::vector<std::string> servers = serversOf(config);
   std::string errors;
   for (const std::string& server : servers) {
     grpc::ClientContext ctx;
-    if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
+    authorize(config, ctx);
     pb::GetSceneRequest request;
     request.set_scene_hash(reinterpret_cast<const char*>(scene.hash.data()), scene.hash.size());
     std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(makeChannel(config, server));
