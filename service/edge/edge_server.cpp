@@ -31,13 +31,10 @@ struct EdgeServer::Impl {
     std::unique_lock<std::mutex> lock(mutex);
     while (!stopping) {
       lock.unlock();
-      const bus::Volume v = hub.volume();
+      const SceneStamp stamp = hub.scene();
       std::string error;
       bool retryLater = false;
-      if (v.hasScene() && !v.sceneManifest.empty() && v.sceneHash != servedScene) {
-        SceneStamp stamp;
-        stamp.hash = v.sceneHash;
-        stamp.manifest = v.sceneManifest;
+      if (stamp.known() && stamp.hash != servedScene) {
         ScenePackage p;
         SceneFetch fetch;
         // Without a source, only what the cache holds (or a built-in, whose manifest is all of it).

@@ -127,6 +127,13 @@ bus::SceneState ProbeHub::sceneState() const {
   return state_;
 }
 
+SceneStamp ProbeHub::scene() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  SceneStamp s = config_.scene;
+  s.time = state_.time;
+  return s;
+}
+
 void ProbeHub::setProbeOffsets(const std::vector<float>& offsets) {
   std::vector<std::function<void()>> wakes;
   {

@@ -133,6 +133,8 @@ class ProbeHub {
   void setSceneState(const bus::SceneState& state);
   // The state of the newest lighting (an edge's: of the newest producer frame received).
   bus::SceneState sceneState() const;
+  // The scene descriptions name (hash and manifest; on an edge the manifest may still be on its way).
+  SceneStamp scene() const;
   // A producer's client area light rule (checkAreaLightRule; std::invalid_argument otherwise). A
   // change once the hub has published or has subscribers starts a new epoch, as for the offsets:
   // light held by the old rule would be counted twice or lost by the new one.
