@@ -67,7 +67,7 @@ std::shared_ptr<const service::ScenePackage> filePackage(const SceneOptions& giv
 bus::SceneState fileState(const service::ScenePackage* package, const ProbeVolume& file) {
   scene::Scene s;
   if (package && !package->localSceneSpec().empty())
-    s = session::loadSceneOrThrow(package->localSceneSpec(), session::animationT(file.scene.time));
+    s = session::loadSceneOrThrow(package->localSceneSpec(), file.scene.time);
   return session::sceneStateOf(s, file.scene.time, 0.0, service::wallClockUs());
 }
 
@@ -118,7 +118,7 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
     animation.mode = o.animate > 0 ? session::Animation::Mode::WallClock : session::Animation::Mode::Still;
     animation.start = tr.scene.t;
     animation.ratePerSecond = o.animate;
-    animation.reloadScene = session::sceneAnimates(tr.scene.scene);  // a glTF file is the same at every t
+    animation.reloadScene = session::sceneMoves(tr.scene.scene, s);  // built-ins and animated glTF files
     renderer::UpdaterOptions uo = tr.updater(tr.scene.environment.load());
     uo.areaLights = o.areaLights.options();
     producer->traceScene(*context, tr.scene.scene, s, g, uo, animation);

@@ -212,14 +212,14 @@ void addViewCommand(CLI::App& app) {
     std::string error;
     orThrow(renderer::parseViewSet(o->views, spec, error), error);
     std::string sceneSpec = o->tracing.scene.scene;
-    float t = o->tracing.scene.t;
+    double t = o->tracing.scene.t;
     std::shared_ptr<const renderer::Environment> environment;
     if (!o->connection.connect.empty()) {
       if (o->tracing.scene.tOption->count() > 0)
-        throw std::runtime_error("--t: a viewer of a stream draws at the stream's scene clock");
+        throw std::runtime_error("--time: a viewer of a stream draws at the stream's scene clock");
       const session::ViewerScene vs = streamScene(*o);
       sceneSpec = vs.spec;
-      t = session::animationT(vs.time);
+      t = vs.time;
       environment = vs.environmentFile.empty() && vs.lighting.kind == service::SceneLighting::Kind::None
                         ? o->tracing.scene.environment.load()
                         : loadLighting(vs.lighting, vs.environmentFile);

@@ -54,7 +54,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   session::Animation animation;
   animation.mode = session::Animation::Mode::WallClock;
   animation.ratePerSecond = o.turnsPerMinute / 60.0;
-  animation.reloadScene = session::sceneAnimates(o.scene);  // built-in scenes move their light with t
+  animation.reloadScene = session::sceneMoves(o.scene, run.scene0);  // built-ins and animated glTF files
   run.producer->traceScene(*run.serverContext, o.scene, run.scene0, run.grid, uo, animation);
   service::ServerConfig sc;
   sc.plaintext = true;  // loopback only
@@ -159,8 +159,8 @@ void settle(const DemoOptions& o, DemoRun& run) {
   session::ProbeProducer& producer = *run.producer;
   // Where the light stands after exactly o.seconds, whatever the loop's timing: the same final
   // scene every run, so its references come from the cache.
-  producer.freeze(static_cast<float>(std::fmod(o.seconds * o.turnsPerMinute / 60.0, 1.0)));
-  run.finalT = producer.t();
+  producer.freeze(static_cast<float>(o.seconds * o.turnsPerMinute / 60.0));
+  run.finalT = static_cast<float>(producer.sceneTime());
   while (producer.running() && producer.stats().settledUpdates < o.settleUpdates) {
     const uint32_t settled = producer.stats().settledUpdates;
     progress.update(static_cast<double>(settled) / o.settleUpdates,

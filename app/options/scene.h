@@ -1,4 +1,4 @@
-// The scene a command loads and the distant light around it: --scene, --t, --environment, --sky.
+// The scene a command loads and the distant light around it: --scene, --time, --environment, --sky.
 #pragma once
 
 #include <memory>
@@ -76,8 +76,10 @@ struct SceneOptions {
   CLI::Option* tOption = nullptr;
   void add(CLI::App* cmd) {
     sceneOption = cmd->add_option("--scene", scene, "glTF file or builtin:NAME (cornell, closed-box, thin-wall, hall)");
-    tOption = cmd->add_option("--t", t, "scene time, seconds (built-in scenes move their light once around per second)")
-                  ->check(CLI::Range(0.0f, 1.0f));
+    tOption = cmd->add_option("--time,--t", t,
+                              "scene time, seconds (built-in scenes move their light once around per second; glTF "
+                              "animations loop over their longest clip)")
+                  ->check(CLI::Range(0.0f, 1.0e6f));
     environment.add(cmd);
   }
   bool sceneGiven() const { return sceneOption && sceneOption->count() > 0; }

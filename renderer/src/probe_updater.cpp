@@ -97,6 +97,48 @@ ProbeGrid sceneGrid(const scene::Scene& scene, const std::array<uint32_t, 3>& di
   return cellCentredGrid(dims.data(), &scene.boundsMin.x, &scene.boundsMax.x);
 }
 
+// The probes within one cell of a triangle that moved between `before` and `after` (positions of
+// the same triangles): every cell box the triangle's old or new corners touch, grown by a cell.
+std::vector<uint32_t> probesNearMoved(const ProbeGrid& grid, const std::vector<glm::vec3>& before,
+                                      const std::vector<glm::vec3>& after, const std::vector<uint32_t>& indices) {
+  std::vector<uint8_t> near(grid.count(), 0);
+  glm::vec3 lo, cell;
+  glm::ivec3 dims;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = grid.bounds.min[a];
+    dims[a] = static_cast<int>(grid.dims[a]);
+    cell[a] = grid.dims[a] > 1 ? probeCellSize(grid, a) : 0.0f;
+  }
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const uint32_t v[3] = {indices[t], indices[t + 1], indices[t + 2]};
+    if (before[v[0]] == after[v[0]] && before[v[1]] == after[v[1]] && before[v[2]] == after[v[2]]) continue;
+    glm::vec3 bmin(INFINITY), bmax(-INFINITY);
+    for (uint32_t i : v) {
+      bmin = glm::min(bmin, glm::min(before[i], after[i]));
+      bmax = glm::max(bmax, glm::max(before[i], after[i]));
+    }
+    glm::ivec3 from, to;
+    for (int a = 0; a < 3; ++a) {
+      if (cell[a] <= 0.0f) {
+        from[a] = 0;
+        to[a] = dims[a] - 1;
+        continue;
+      }
+      const float f = std::floor((bmin[a] - cell[a] - lo[a]) / cell[a]), c = std::ceil((bmax[a] + cell[a] - lo[a]) / cell[a]);
+      from[a] = static_cast<int>(std::clamp(f, 0.0f, static_cast<float>(dims[a] - 1)));
+      to[a] = static_cast<int>(std::clamp(c, 0.0f, static_cast<float>(dims[a] - 1)));
+    }
+    for (int z = from.z; z <= to.z; ++z)
+      for (int y = from.y; y <= to.y; ++y)
+        for (int x = from.x; x <= to.x; ++x)
+          near[static_cast<size_t>(x) + static_cast<size_t>(dims.x) * (static_cast<size_t>(y) + static_cast<size_t>(dims.y) * z)] = 1;
+  }
+  std::vector<uint32_t> out;
+  for (uint32_t p = 0; p < grid.count(); ++p)
+    if (near[p]) out.push_back(p);
+  return out;
+}
+
 struct ProbeUpdater::Impl {
   VulkanDevice* d = nullptr;
   ProbeVolume volume;  // grid, samples, active mask, updates
@@ -260,6 +302,47 @@ struct ProbeUpdater::Impl {
     summarizeClassification(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
 
+  // After moved geometry: the probes of `near` classified again where they stand (one round, their
+  // offsets kept, so a stream needs no new epoch) and restarted; the rest keep their state.
+  void reclassify(const std::vector<uint32_t>& near) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<float> offsets = volume.offsets;
+    classifyStats = ClassifyStats{};
+    classifyStats.partial = true;
+    classifyStats.nearMoved = static_cast<uint32_t>(near.size());
+    std::vector<uint32_t> pending;
+    for (uint32_t p : near) {
+      if (options.surfaceProbesOnly && !nearSurface[p]) volume.active[p] = 0;
+      else pending.push_back(p);
+      history[p] = ProbeHistory{};  // its surroundings moved: the next estimate starts it afresh
+      if (!volume.stillUpdates.empty()) volume.stillUpdates[p] = 0;
+    }
+    if (options.classify && !pending.empty()) {
+      const uint32_t n = roundUpLanes(options.classifySamples);
+      uploadProbeList(pending);
+      dispatch(static_cast<uint32_t>(pending.size()), n, classifyDirections, PT_MODE_CLASSIFY, identity());
+      classifyStats.rounds = 1;
+      for (size_t i = 0; i < pending.size(); ++i)
+        volume.active[pending[i]] = classifyHits(i, n).backFraction > options.backFaceThreshold ? 0 : 1;
+    } else {
+      for (uint32_t p : pending) volume.active[p] = 1;
+    }
+    activeList.clear();
+    for (uint32_t p = 0; p < volume.count(); ++p) {
+      if (volume.active[p]) {
+        activeList.push_back(p);
+        continue;
+      }
+      std::fill_n(volume.probes.begin() + p * 27, 27, 0.0f);
+      history[p] = ProbeHistory{};
+      if (!volume.noise.empty()) volume.noise[p] = 0.0f;
+      if (!volume.stillUpdates.empty()) volume.stillUpdates[p] = 0;
+    }
+    uploadProbeList(activeList);
+    summarizeClassification(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    volume.offsets = offsets;  // as before, even when every moved probe went inactive
+  }
+
   void summarizeClassification(double milliseconds) {
     ClassifyStats& c = classifyStats;
     c.milliseconds = milliseconds;
@@ -360,10 +443,16 @@ ProbeUpdater::~ProbeUpdater() {
 void ProbeUpdater::setScene(const scene::Scene& scene) {
   Impl& s = *impl_;
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
-  const bool geometryChanged = scene.positions != s.geometryPositions || scene.indices != s.geometryIndices;
+  const bool sameTriangles = scene.indices == s.geometryIndices && scene.positions.size() == s.geometryPositions.size();
+  const bool geometryChanged = !sameTriangles || scene.positions != s.geometryPositions;
   const bool surfacesChanged = s.surfaces.changedBy(scene);
   const bool shadingChanged = s.shadingChanged(scene);
-  if (geometryChanged) {
+  if (geometryChanged && sameTriangles) {
+    // Moved geometry: only the probes around it are classified again and restarted.
+    const std::vector<uint32_t> near = probesNearMoved(s.volume.grid, s.geometryPositions, scene.positions, scene.indices);
+    s.setGeometry(scene);
+    s.reclassify(near);
+  } else if (geometryChanged) {
     s.setGeometry(scene);
     s.classify();
   } else {

@@ -142,6 +142,11 @@ struct RasterRenderer::Impl {
   RasterTimings timings;
   SurfaceRecord surfaces;  // as uploaded last
   size_t vertexCount = 0;
+  std::vector<glm::vec3> positions;  // as uploaded last (setShading moves them)
+  // The last visibility build's inputs, to draw it again when the geometry moves.
+  std::vector<float> visibilityProbes;
+  float visibilityFar = 0.0f, visibilityReach = 0.0f;
+  bool visibilityBuilt = false;
   uint32_t width = 0, height = 0, chunk = 1;  // of the targets: samplesPerSide × the images' size
   GpuScene gpu;
   GpuImage color, depth;  // `chunk` layers each
@@ -451,6 +456,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   uploadGpuScene(d, scene, s.gpu);
   s.surfaces.changedBy(scene);
   s.vertexCount = scene.positions.size();
+  s.positions = scene.positions;
   s.indexCount = static_cast<uint32_t>(scene.indices.size());
   s.drawnOpaque = scene::leadingTrianglesBelowClass(scene, 2);
   s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {s.width, s.height}, s.chunk,
@@ -577,6 +583,10 @@ void RasterRenderer::setProbes(const ProbeVolume& volume) {
     const float reach = s.options.visibilityReach > 0.0f
                             ? s.options.visibilityReach * probeVisibilityReach(volume.grid, hi - lo)
                             : std::numeric_limits<float>::infinity();
+    s.visibilityProbes = positions;
+    s.visibilityFar = farDistance;
+    s.visibilityReach = reach;
+    s.visibilityBuilt = true;
     if (buildProbeVisibility(*s.d, s.gpu, s.set, positions, farDistance, reach, s.options.visibilityCulling,
                              s.visibility)) {
       s.timings.visibilityRenderMs = s.visibility.renderMs;
@@ -606,8 +616,24 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   if (scene.triangleMaterial.size() != s.indexCount / 3 || scene.positions.size() != s.vertexCount)
     throw std::invalid_argument("setShading needs the same geometry (" + scene.name + " differs)");
   vkDeviceWaitIdle(s.d->device);
+  const bool moved = scene.positions != s.positions;
+  if (moved) {  // moving geometry: the vertex stream every pass draws from, in place
+    std::memcpy(s.gpu.accel.positions.mapped, scene.positions.data(), scene.positions.size() * sizeof(glm::vec3));
+    s.positions = scene.positions;
+  }
   if (s.surfaces.changedBy(scene)) uploadGpuSurfaces(*s.d, scene, s.gpu);  // and the shading
   else uploadGpuShading(*s.d, scene, s.gpu);
+  if (moved) {
+    setProbeVisibilityScene(scene, s.visibility);  // new clusters; the probes' depth cubes are drawn again
+    s.timings.geometryMoves += 1;
+    if (s.visibilityBuilt && s.push.visibility &&
+        buildProbeVisibility(*s.d, s.gpu, s.set, s.visibilityProbes, s.visibilityFar, s.visibilityReach,
+                             s.options.visibilityCulling, s.visibility)) {
+      s.timings.visibilityRenderMs = s.visibility.renderMs;
+      s.timings.visibilityMomentsMs = s.visibility.momentsMs;
+      s.timings.visibilityTriangles = s.visibility.trianglesDrawn;
+    }
+  }
   s.push.lightCount = s.gpu.lightCount;
   planShadowMaps(*s.d, scene, s.shadows);
   s.planAreaLights(scene);

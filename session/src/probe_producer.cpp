@@ -46,6 +46,7 @@ void ProbeProducer::traceScene(renderer::VulkanContext& context, const std::stri
   hub_.setProbeOffsets(updater_->volume().offsets);  // in the description before anyone subscribes
   hub_.setAreaLightRule(areaLightRuleOf(options.areaLights));  // what the probes leave out for viewers
   sceneSpec_ = sceneSpec;
+  current_ = first;
   geometry_.positions = first.positions;
   geometry_.indices = first.indices;
   geometry_.triangleMaterial = first.triangleMaterial;
@@ -78,7 +79,7 @@ double ProbeProducer::sceneTime() const {
   return animation_.start + animation_.ratePerSecond * seconds;
 }
 
-void ProbeProducer::freeze() { freeze(t()); }
+void ProbeProducer::freeze() { freeze(static_cast<float>(sceneTime())); }
 
 void ProbeProducer::freeze(float at) {
   frozenT_ = at;
@@ -96,7 +97,8 @@ void ProbeProducer::step() {
     t_ = animationT(time);
     const bool playing = !wasFrozen && animation_.mode == Animation::Mode::WallClock;
     if (animation_.mode != Animation::Mode::Still && animation_.reloadScene) {
-      const scene::Scene next = loadSceneOrThrow(sceneSpec_, t_);
+      advanceScene(sceneSpec_, time, current_);
+      const scene::Scene& next = current_;
       lights_ = lightStates(next);
       updater_->setScene(next);
       if (next.positions != geometry_.positions || next.indices != geometry_.indices ||

@@ -2,15 +2,28 @@
 
 #include <stdexcept>
 
+#include "probecast/scene/animation.h"
+
 namespace probecast::session {
 
-scene::Scene loadSceneOrThrow(const std::string& spec, float t) {
+scene::Scene loadSceneOrThrow(const std::string& spec, double seconds) {
   scene::Scene s;
   std::string error;
-  if (!scene::loadScene(spec, t, s, error)) throw std::runtime_error(error);
+  if (!scene::loadScene(spec, seconds, s, error)) throw std::runtime_error(error);
   return s;
 }
 
-bool sceneAnimates(const std::string& spec) { return spec.rfind("builtin:", 0) == 0; }
+namespace {
+bool builtin(const std::string& spec) { return spec.rfind("builtin:", 0) == 0; }
+}  // namespace
+
+bool sceneMoves(const std::string& spec, const scene::Scene& scene) {
+  return builtin(spec) || scene::sceneAnimates(scene);
+}
+
+void advanceScene(const std::string& spec, double seconds, scene::Scene& scene) {
+  if (scene.rig) scene::poseScene(scene, seconds);
+  else if (builtin(spec)) scene = loadSceneOrThrow(spec, seconds);
+}
 
 }  // namespace probecast::session

@@ -34,12 +34,13 @@ Viewer::Viewer(renderer::VulkanContext& context, const scene::Scene& scene, std:
   client_->setViews(priorityViews(views_));
   config_.raster.areaLights = {};  // until a stream states its rule: a volume without one holds every emitter
   raster_ = std::make_unique<renderer::RasterRenderer>(context, scene, config_.width, config_.height, config_.raster);
-  animates_ = !config_.sceneSpec.empty() && sceneAnimates(config_.sceneSpec);
+  animates_ = !config_.sceneSpec.empty() && sceneMoves(config_.sceneSpec, scene_);
 }
 
 void Viewer::shadeAt(double displayTime) {
   if (animates_) {
-    raster_->setShading(loadSceneOrThrow(config_.sceneSpec, animationT(displayTime)));
+    advanceScene(config_.sceneSpec, displayTime, scene_);
+    raster_->setShading(scene_);
   } else if (!config_.sceneSpec.empty() && held_.hasState && !(held_.state.lights == shadedState_.lights)) {
     scene::Scene lit = scene_;
     applyLights(held_.state, lit);

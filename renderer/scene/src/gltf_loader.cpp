@@ -11,6 +11,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <tiny_gltf.h>
 
+#include "probecast/scene/animation.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::scene {
@@ -96,6 +97,15 @@ class AccessorReader {
         uint16_t v;
         std::memcpy(&v, p, 2);
         return acc_->normalized ? v / 65535.0f : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        const auto v = static_cast<int8_t>(*p);
+        return acc_->normalized ? std::max(v / 127.0f, -1.0f) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        std::memcpy(&v, p, 2);
+        return acc_->normalized ? std::max(v / 32767.0f, -1.0f) : v;
       }
       default: return 0.0f;
     }
@@ -233,8 +243,87 @@ void convertMaterials(const tinygltf::Model& model, Scene& scene) {
   scene.materials.push_back(fallback);
 }
 
+// Reads `accessorIndex` as `count` vectors of `n` floats (n ≤ 4) into out.
+bool readVectors(const tinygltf::Model& model, int accessorIndex, size_t count, int n, const char* what,
+                 std::vector<glm::vec4>& out, std::string& error) {
+  AccessorReader r(model, accessorIndex, error);
+  if (!r.ok()) return false;
+  if (r.count() != count || r.components() != n) {
+    error = std::string(what) + " must hold " + std::to_string(count) + " elements of " + std::to_string(n) +
+            " components";
+    return false;
+  }
+  out.assign(count, glm::vec4(0.0f));
+  for (size_t i = 0; i < count; ++i)
+    for (int c = 0; c < n; ++c) {
+      const float v = r.component(i, c);
+      if (!std::isfinite(v)) {
+        error = std::string(what) + " holds NaN or Inf";
+        return false;
+      }
+      out[i][c] = v;
+    }
+  return true;
+}
+
+// The skin, morph targets and rest data of a primitive that moves (`rig` filled; `skin` the
+// node's skin or -1, `jointCount` its joints).
+bool rigPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim, size_t count, int skin,
+                  size_t jointCount, RigPrimitive& rig, std::string& error) {
+  rig.skin = skin;
+  if (skin >= 0) {
+    for (int set = 0; set < 2; ++set) {
+      auto j = prim.attributes.find(set == 0 ? "JOINTS_0" : "JOINTS_1");
+      auto w = prim.attributes.find(set == 0 ? "WEIGHTS_0" : "WEIGHTS_1");
+      if (j == prim.attributes.end() && w == prim.attributes.end()) continue;
+      if (j == prim.attributes.end() || w == prim.attributes.end()) {
+        error = "a skinned primitive has JOINTS_" + std::to_string(set) + " without WEIGHTS_" + std::to_string(set) +
+                " or the other way round";
+        return false;
+      }
+      std::vector<glm::vec4> joints, weights;
+      if (!readVectors(model, j->second, count, 4, "JOINTS", joints, error) ||
+          !readVectors(model, w->second, count, 4, "WEIGHTS", weights, error))
+        return false;
+      rig.joints[set].resize(count);
+      rig.weights[set] = weights;
+      for (size_t i = 0; i < count; ++i)
+        for (int c = 0; c < 4; ++c) {
+          const float v = joints[i][c];
+          if (v < 0.0f || v >= static_cast<float>(jointCount) || v != std::floor(v)) {
+            error = "JOINTS names joint " + std::to_string(v) + " of a skin with " + std::to_string(jointCount);
+            return false;
+          }
+          rig.joints[set][i][c] = static_cast<uint32_t>(v);
+        }
+    }
+    if (rig.joints[0].empty() && rig.joints[1].empty()) {
+      error = "a skinned primitive has no JOINTS_0/WEIGHTS_0";
+      return false;
+    }
+  }
+  for (const auto& target : prim.targets) {
+    std::vector<glm::vec3> dp, dn;
+    std::vector<glm::vec4> v;
+    auto p = target.find("POSITION");
+    if (p != target.end()) {
+      if (!readVectors(model, p->second, count, 3, "a morph target's POSITION", v, error)) return false;
+      for (const glm::vec4& x : v) dp.emplace_back(x);
+    }
+    auto n = target.find("NORMAL");
+    if (n != target.end()) {
+      if (!readVectors(model, n->second, count, 3, "a morph target's NORMAL", v, error)) return false;
+      for (const glm::vec4& x : v) dn.emplace_back(x);
+    }
+    rig.targetPositions.push_back(std::move(dp));
+    rig.targetNormals.push_back(std::move(dn));
+  }
+  return true;
+}
+
+// `rig`: null for a primitive that never moves; otherwise filled with what poseScene needs.
 bool addPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim, const glm::mat4& world, Scene& scene,
-                  std::string& error) {
+                  std::string& error, RigPrimitive* rig = nullptr, int skin = -1, size_t jointCount = 0) {
   if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) return true;  // points and lines carry no surface
   auto pos = prim.attributes.find("POSITION");
   if (pos == prim.attributes.end()) {
@@ -277,18 +366,35 @@ bool addPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim,
   auto nrm = prim.attributes.find("NORMAL");
   std::vector<glm::vec3> normals(positions.count(), glm::vec3(0.0f));
   bool haveNormals = false;
+  if (rig) {
+    rig->firstVertex = base;
+    rig->vertexCount = static_cast<uint32_t>(positions.count());
+    rig->flip = flip;
+    rig->positions.resize(positions.count());
+    for (size_t i = 0; i < positions.count(); ++i)
+      rig->positions[i] = {positions.component(i, 0), positions.component(i, 1), positions.component(i, 2)};
+    rig->normals.assign(positions.count(), glm::vec3(0.0f));
+    rig->triangles = idx;
+    if (!rigPrimitive(model, prim, positions.count(), skin, jointCount, *rig, error)) return false;
+  }
   if (nrm != prim.attributes.end()) {
     AccessorReader n(model, nrm->second, error);
     if (!n.ok()) return false;
     if (n.count() == positions.count() && n.components() == 3) {
       for (size_t i = 0; i < n.count(); ++i) {
-        const glm::vec3 v = normalMatrix * glm::vec3(n.component(i, 0), n.component(i, 1), n.component(i, 2));
+        const glm::vec3 raw(n.component(i, 0), n.component(i, 1), n.component(i, 2));
+        const glm::vec3 v = normalMatrix * raw;
         const float len = glm::length(v);
         normals[i] = len > 0.0f && std::isfinite(len) ? v / len : glm::vec3(0.0f);
+        if (rig) {
+          const float rl = glm::length(raw);
+          rig->normals[i] = rl > 0.0f && std::isfinite(rl) ? raw / rl : glm::vec3(0.0f);
+        }
       }
       haveNormals = true;
     }
   }
+  if (rig) rig->normalsGiven = haveNormals;
   if (!haveNormals) {  // flat normals accumulated per vertex
     for (size_t t = 0; t + 2 < idx.size(); t += 3) {
       const glm::vec3 a = scene.positions[base + idx[t]], b = scene.positions[base + idx[t + 1]],
@@ -364,9 +470,210 @@ void addCamera(const tinygltf::Model& model, const tinygltf::Node& node, const g
   scene.cameras.push_back(out);
 }
 
+// Every node's rest transform and morph weights, its parent, and an order with parents first.
+bool rigNodes(const tinygltf::Model& model, Rig& rig, std::string& error) {
+  const size_t n = model.nodes.size();
+  rig.nodes.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const tinygltf::Node& node = model.nodes[i];
+    RigNode& r = rig.nodes[i];
+    if (node.matrix.size() == 16) {
+      r.hasMatrix = true;
+      r.matrix = nodeMatrix(node);
+    }
+    if (node.translation.size() == 3) r.translation = vec3Of(node.translation, glm::vec3(0.0f));
+    if (node.rotation.size() == 4)
+      r.rotation = glm::quat(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                             static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]));
+    if (node.scale.size() == 3) r.scale = vec3Of(node.scale, glm::vec3(1.0f));
+    if (node.mesh >= 0 && node.mesh < static_cast<int>(model.meshes.size()))
+      for (double w : model.meshes[node.mesh].weights) r.weights.push_back(static_cast<float>(w));
+    if (!node.weights.empty()) {
+      r.weights.clear();
+      for (double w : node.weights) r.weights.push_back(static_cast<float>(w));
+    }
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (int c : model.nodes[i].children) {
+      if (c < 0 || static_cast<size_t>(c) >= n || rig.nodes[c].parent >= 0 || static_cast<size_t>(c) == i) {
+        error = "bad node hierarchy at node " + std::to_string(c);
+        return false;
+      }
+      rig.nodes[c].parent = static_cast<int32_t>(i);
+    }
+  for (size_t i = 0; i < n; ++i)
+    if (rig.nodes[i].parent < 0) rig.order.push_back(static_cast<uint32_t>(i));
+  for (size_t k = 0; k < rig.order.size(); ++k)
+    for (int c : model.nodes[rig.order[k]].children) rig.order.push_back(static_cast<uint32_t>(c));
+  if (rig.order.size() != n) {
+    error = "bad node hierarchy: a cycle of nodes";
+    return false;
+  }
+  return true;
+}
+
+bool rigSkins(const tinygltf::Model& model, Rig& rig, std::string& error) {
+  for (size_t k = 0; k < model.skins.size(); ++k) {
+    const tinygltf::Skin& skin = model.skins[k];
+    RigSkin out;
+    const std::string name = "skin " + std::to_string(k);
+    for (int j : skin.joints) {
+      if (j < 0 || j >= static_cast<int>(model.nodes.size())) {
+        error = name + " names a missing joint node " + std::to_string(j);
+        return false;
+      }
+      out.joints.push_back(static_cast<uint32_t>(j));
+    }
+    out.inverseBind.assign(out.joints.size(), glm::mat4(1.0f));
+    if (skin.inverseBindMatrices >= 0) {
+      AccessorReader r(model, skin.inverseBindMatrices, error);
+      if (!r.ok()) return false;
+      if (r.components() != 16 || r.count() < out.joints.size()) {
+        error = name + ": inverseBindMatrices must hold a MAT4 per joint";
+        return false;
+      }
+      for (size_t j = 0; j < out.joints.size(); ++j)
+        for (int c = 0; c < 16; ++c) {
+          const float v = r.component(j, c);
+          if (!std::isfinite(v)) {
+            error = name + ": inverseBindMatrices hold NaN or Inf";
+            return false;
+          }
+          glm::value_ptr(out.inverseBind[j])[c] = v;
+        }
+    }
+    rig.skins.push_back(std::move(out));
+  }
+  return true;
+}
+
+bool rigClips(const tinygltf::Model& model, Rig& rig, std::string& error) {
+  for (size_t a = 0; a < model.animations.size(); ++a) {
+    const tinygltf::Animation& anim = model.animations[a];
+    const std::string name = "animation " + std::to_string(a) + (anim.name.empty() ? "" : " (" + anim.name + ")");
+    AnimationClip clip;
+    clip.name = anim.name;
+    std::vector<int> samplerPath(anim.samplers.size(), -1);  // the path each sampler animates
+    for (const tinygltf::AnimationChannel& c : anim.channels) {
+      if (c.target_node < 0) continue;  // no target: ignored, as glTF allows
+      if (c.target_node >= static_cast<int>(model.nodes.size()) || c.sampler < 0 ||
+          c.sampler >= static_cast<int>(anim.samplers.size())) {
+        error = name + ": a channel names a missing node or sampler";
+        return false;
+      }
+      AnimationChannel ch;
+      ch.node = static_cast<uint32_t>(c.target_node);
+      ch.sampler = static_cast<uint32_t>(c.sampler);
+      if (c.target_path == "translation") ch.path = AnimatedPath::Translation;
+      else if (c.target_path == "rotation") ch.path = AnimatedPath::Rotation;
+      else if (c.target_path == "scale") ch.path = AnimatedPath::Scale;
+      else if (c.target_path == "weights") ch.path = AnimatedPath::Weights;
+      else continue;  // "pointer" and other paths this renderer does not animate
+      if (ch.path != AnimatedPath::Weights && rig.nodes[ch.node].hasMatrix) {
+        error = name + ": node " + std::to_string(ch.node) + " has a matrix and cannot be animated";
+        return false;
+      }
+      if (samplerPath[ch.sampler] >= 0 && samplerPath[ch.sampler] != static_cast<int>(ch.path)) {
+        error = name + ": sampler " + std::to_string(ch.sampler) + " drives paths of different sizes";
+        return false;
+      }
+      samplerPath[ch.sampler] = static_cast<int>(ch.path);
+      clip.channels.push_back(ch);
+    }
+    for (size_t k = 0; k < anim.samplers.size(); ++k) {
+      const tinygltf::AnimationSampler& in = anim.samplers[k];
+      const std::string sname = name + " sampler " + std::to_string(k);
+      AnimationSampler out;
+      out.interpolation = in.interpolation == "STEP"          ? Interpolation::Step
+                          : in.interpolation == "CUBICSPLINE" ? Interpolation::CubicSpline
+                                                              : Interpolation::Linear;
+      if (!in.interpolation.empty() && in.interpolation != "LINEAR" && in.interpolation != "STEP" &&
+          in.interpolation != "CUBICSPLINE") {
+        error = sname + ": unknown interpolation " + in.interpolation;
+        return false;
+      }
+      AccessorReader times(model, in.input, error);
+      if (!times.ok()) return false;
+      AccessorReader values(model, in.output, error);
+      if (!values.ok()) return false;
+      if (times.components() != 1 || times.count() == 0) {
+        error = sname + ": input must be SCALAR key times";
+        return false;
+      }
+      for (size_t i = 0; i < times.count(); ++i) {
+        const float t = times.component(i, 0);
+        if (!std::isfinite(t) || t < 0.0f || (i > 0 && !(t > out.input.back()))) {
+          error = sname + ": key times must be finite, not negative and increasing";
+          return false;
+        }
+        out.input.push_back(t);
+      }
+      const size_t keys = out.input.size();
+      const size_t perKey = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
+      const size_t total = values.count() * static_cast<size_t>(values.components());
+      if (total % (keys * perKey) != 0 || total == 0) {
+        error = sname + ": output does not hold a value per key";
+        return false;
+      }
+      out.width = static_cast<uint32_t>(total / (keys * perKey));
+      const int path = samplerPath[k];
+      const uint32_t want = path == static_cast<int>(AnimatedPath::Rotation) ? 4u
+                            : path == static_cast<int>(AnimatedPath::Weights) || path < 0 ? out.width
+                                                                                         : 3u;
+      if (out.width != want || out.width > 4096) {
+        error = sname + ": output has " + std::to_string(out.width) + " components per key, the path needs " +
+                std::to_string(want);
+        return false;
+      }
+      out.output.reserve(total);
+      for (size_t i = 0; i < values.count(); ++i)
+        for (int c = 0; c < values.components(); ++c) {
+          const float v = values.component(i, c);
+          if (!std::isfinite(v)) {
+            error = sname + ": output holds NaN or Inf";
+            return false;
+          }
+          out.output.push_back(v);
+        }
+      clip.end = std::max(clip.end, out.input.back());
+      clip.samplers.push_back(std::move(out));
+    }
+    for (const AnimationChannel& ch : clip.channels) {
+      if (ch.path != AnimatedPath::Weights) continue;
+      const size_t targets = rig.nodes[ch.node].weights.size();
+      const tinygltf::Node& node = model.nodes[ch.node];
+      const size_t meshTargets = node.mesh >= 0 && node.mesh < static_cast<int>(model.meshes.size()) &&
+                                         !model.meshes[node.mesh].primitives.empty()
+                                     ? model.meshes[node.mesh].primitives[0].targets.size()
+                                     : targets;
+      if (clip.samplers[ch.sampler].width != std::max(targets, meshTargets)) {
+        error = name + ": a weights channel of node " + std::to_string(ch.node) + " has " +
+                std::to_string(clip.samplers[ch.sampler].width) + " weights for " +
+                std::to_string(std::max(targets, meshTargets)) + " morph targets";
+        return false;
+      }
+    }
+    rig.duration = std::max(rig.duration, clip.end);
+    rig.clips.push_back(std::move(clip));
+  }
+  return true;
+}
+
+// Every key time of the clips, and `uniform` times between 0 and the duration (at most 1024 in all):
+// the poses whose vertices the bounds must hold.
+std::vector<double> poseTimes(const Rig& rig, int uniform) {
+  std::set<double> times;
+  for (int i = 0; i <= uniform; ++i) times.insert(static_cast<double>(rig.duration) * i / uniform);
+  for (const AnimationClip& c : rig.clips)
+    for (const AnimationSampler& s : c.samplers)
+      for (float t : s.input)
+        if (times.size() < 1024) times.insert(t);
+  return {times.begin(), times.end()};
+}
+
 }  // namespace
 
-bool loadGltf(const std::string& path, Scene& scene, std::string& error) {
+bool loadGltf(const std::string& path, Scene& scene, std::string& error, double seconds) {
   scene = Scene{};
   scene.name = std::filesystem::path(path).filename().string();
   const auto fail = [&](const std::string& why) {
@@ -386,6 +693,17 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error) {
     if (!kSupportedRequired.count(ext)) return fail("requires unsupported extension " + ext);
   convertMaterials(model, scene);
 
+  auto rig = std::make_shared<Rig>();
+  std::string rigError;
+  if (!rigNodes(model, *rig, rigError) || !rigSkins(model, *rig, rigError) || !rigClips(model, *rig, rigError))
+    return fail(rigError);
+  // Nodes that move: a channel's target (translation, rotation, scale) and everything below it.
+  std::vector<uint8_t> moving(model.nodes.size(), 0), morphing(model.nodes.size(), 0);
+  for (const AnimationClip& c : rig->clips)
+    for (const AnimationChannel& ch : c.channels) (ch.path == AnimatedPath::Weights ? morphing : moving)[ch.node] = 1;
+  for (uint32_t i : rig->order)
+    if (rig->nodes[i].parent >= 0 && moving[rig->nodes[i].parent]) moving[i] = 1;
+
   std::string nodeError;
   std::set<int> visiting;
   std::function<bool(int, const glm::mat4&)> visit = [&](int index, const glm::mat4& parent) {
@@ -401,11 +719,31 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error) {
         nodeError = "node " + std::to_string(index) + " names a missing mesh";
         return false;
       }
-      for (const tinygltf::Primitive& prim : model.meshes[node.mesh].primitives)
-        if (!addPrimitive(model, prim, world, scene, nodeError)) return false;
+      const int skin = node.skin >= 0 && node.skin < static_cast<int>(rig->skins.size()) ? node.skin : -1;
+      if (node.skin >= 0 && skin < 0) {
+        nodeError = "node " + std::to_string(index) + " names a missing skin";
+        return false;
+      }
+      for (const tinygltf::Primitive& prim : model.meshes[node.mesh].primitives) {
+        // Skinned and morphed primitives are posed even when nothing plays (their rest pose is
+        // the skin's, with the default weights).
+        const bool posed = moving[index] || morphing[index] || skin >= 0 || !prim.targets.empty();
+        RigPrimitive rp;
+        rp.node = static_cast<uint32_t>(index);
+        const size_t before = scene.positions.size();
+        if (!addPrimitive(model, prim, world, scene, nodeError, posed ? &rp : nullptr, skin,
+                          skin >= 0 ? rig->skins[skin].joints.size() : 0))
+          return false;
+        if (posed && scene.positions.size() > before) rig->primitives.push_back(std::move(rp));
+      }
     }
+    const size_t lights = scene.lights.size(), cameras = scene.cameras.size();
     addLight(model, node, world, scene);
     addCamera(model, node, world, scene);
+    if (moving[index] && scene.lights.size() > lights)
+      rig->lights.push_back({static_cast<uint32_t>(index), static_cast<uint32_t>(lights)});
+    if (moving[index] && scene.cameras.size() > cameras)
+      rig->cameras.push_back({static_cast<uint32_t>(index), static_cast<uint32_t>(cameras)});
     for (int child : node.children)
       if (!visit(child, world)) return false;
     visiting.erase(index);
@@ -425,7 +763,27 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error) {
   for (int root : roots)
     if (!visit(root, glm::mat4(1.0f))) return fail(nodeError);
   if (scene.triangleCount() == 0) return fail("no triangles");
-  finalizeScene(scene);
+  if (rig->primitives.empty() && rig->lights.empty() && rig->cameras.empty()) {
+    finalizeScene(scene);
+    return true;
+  }
+  scene.rig = rig;
+  poseScene(scene, 0.0);
+  finalizeScene(scene);  // triangle order of the first pose
+  // The bounds hold every pose (probe grids fitted to them stay put while things move).
+  glm::vec3 lo = scene.boundsMin, hi = scene.boundsMax;
+  if (rig->duration > 0.0f) {
+    for (double t : poseTimes(*rig, 64)) {
+      poseScene(scene, std::min(t, rig->duration * (1.0 - 1e-6)));
+      for (const glm::vec3& p : scene.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+    }
+  }
+  scene.boundsMin = lo;
+  scene.boundsMax = hi;
+  poseScene(scene, seconds);
   return true;
 }
 

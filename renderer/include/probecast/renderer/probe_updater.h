@@ -108,6 +108,11 @@ struct ClassifyStats {
   uint32_t moved = 0;            // active probes with a nonzero offset
   double meanOffsetMetres = 0.0; // mean |offset| of the moved probes
   double maxOffsetCells = 0.0;   // largest |offset component| / cell
+  // Moving geometry (setScene with the same triangles, moved): the probes within a cell of a moved
+  // triangle, classified again where they stand (their offsets kept: a stream's epoch stays) and
+  // restarted, so they follow the geometry within an update.
+  uint32_t nearMoved = 0;
+  bool partial = false;          // this classification was of the probes near moved geometry only
 };
 
 class ProbeUpdater {

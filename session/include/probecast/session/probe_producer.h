@@ -137,6 +137,7 @@ class ProbeProducer {
   // the views show are found again when the views or the geometry change, weighed by the volume's
   // light at every update, and blended into the weights slowly (blendViewWeights).
   std::vector<float> viewFootprints(const std::vector<View>& views);
+  scene::Scene current_;   // the scene at the last update's time (posed or made again per update)
   scene::Scene geometry_;  // the triangles traced (positions, indices, materials of the last scene set)
   scene::AreaLightOptions areaLights_;      // the updater's: what viewers light themselves
   renderer::SurfaceLighting lighting_;      // of the last scene set

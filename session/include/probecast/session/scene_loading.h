@@ -7,11 +7,16 @@
 
 namespace probecast::session {
 
-// The scene `spec` (glTF path or builtin:NAME) at animation parameter t; throws
+// The scene `spec` (glTF path or builtin:NAME) at scene time `seconds`; throws
 // std::runtime_error with the loader's message when it cannot be loaded.
-scene::Scene loadSceneOrThrow(const std::string& spec, float t);
+scene::Scene loadSceneOrThrow(const std::string& spec, double seconds);
 
-// Whether the scene moves its light with t (the built-in scenes do; glTF files do not).
-bool sceneAnimates(const std::string& spec);
+// Whether `scene` (loaded from `spec`) changes with the scene time: the built-ins move their light,
+// glTF files with animation move nodes, skins and morph targets (scene/animation.h).
+bool sceneMoves(const std::string& spec, const scene::Scene& scene);
+
+// `scene` (loaded from `spec`) at scene time `seconds`: a glTF scene is posed in place, a built-in
+// made again. Nothing happens to a scene that does not move.
+void advanceScene(const std::string& spec, double seconds, scene::Scene& scene);
 
 }  // namespace probecast::session

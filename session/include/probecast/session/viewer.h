@@ -32,7 +32,7 @@ struct ViewerConfig {
   // and render() throws std::runtime_error, rendering nothing, when the stream says otherwise.
   std::optional<bool> areaLights;
   // Direct light is local, at the viewer's display clock (service::DisplayClock, locked to the
-  // stream's scene clock): when set, a scene that animates (sceneAnimates) is shaded as `sceneSpec`
+  // stream's scene clock): when set, a scene that moves (sceneMoves) is posed or made as `sceneSpec`
   // at the display time before every render; one that does not takes the lights of the newest
   // frame's scene state.
   std::string sceneSpec;

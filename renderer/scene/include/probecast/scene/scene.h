@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,8 @@ struct Camera {
   float zfar = 100.0f;
 };
 
+struct Rig;  // animation.h
+
 struct Scene {
   std::string name;
   std::vector<glm::vec3> positions;  // world space
@@ -103,6 +106,9 @@ struct Scene {
   std::vector<Camera> cameras;
   glm::vec3 boundsMin{0.0f};
   glm::vec3 boundsMax{0.0f};
+  // What moves with the scene clock (glTF animation, skins, morph targets; animation.h), shared by
+  // copies; null when nothing does. The bounds hold every pose of it.
+  std::shared_ptr<const Rig> rig;
 
   uint32_t triangleCount() const { return static_cast<uint32_t>(indices.size() / 3); }
 };
@@ -112,8 +118,9 @@ uint32_t triangleClass(const Scene& scene, uint32_t triangle);
 // Length of the leading run of triangles of class < `cls` (the whole scene when not finalized).
 uint32_t leadingTrianglesBelowClass(const Scene& scene, uint32_t cls);
 
-// Loads a .gltf or .glb file. On failure returns false and `error` names the file and the problem.
-bool loadGltf(const std::string& path, Scene& scene, std::string& error);
+// Loads a .gltf or .glb file posed at scene time `seconds` (animation.h). On failure returns false
+// and `error` names the file and the problem.
+bool loadGltf(const std::string& path, Scene& scene, std::string& error, double seconds = 0.0);
 
 // Built-in scenes, generated in code. `t` in [0, 1) is the animation parameter.
 //   cornell     Cornell box (open front), ceiling panel + a point light circling under the ceiling
@@ -122,8 +129,8 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error);
 std::vector<std::string> builtinSceneNames();
 bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error);
 
-// "builtin:NAME" or a glTF path.
-bool loadScene(const std::string& spec, float t, Scene& scene, std::string& error);
+// "builtin:NAME" or a glTF path, at scene time `seconds` (built-ins: t = seconds mod 1).
+bool loadScene(const std::string& spec, double seconds, Scene& scene, std::string& error);
 
 // Recomputes the bounds and reorders triangles by the Morton code of their centroids, so BVH
 // builders that split at the index midpoint get spatially coherent halves. Triangles come in three
