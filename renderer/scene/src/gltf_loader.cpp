@@ -291,7 +291,8 @@ bool rigPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim,
         for (int c = 0; c < 4; ++c) {
           const float v = joints[i][c];
           if (v < 0.0f || v >= static_cast<float>(jointCount) || v != std::floor(v)) {
-            error = "JOINTS names joint " + std::to_string(v) + " of a skin with " + std::to_string(jointCount);
+            error = "JOINTS names joint " + std::to_string(static_cast<long long>(v)) + " of a skin with " +
+                    std::to_string(jointCount);
             return false;
           }
           rig.joints[set][i][c] = static_cast<uint32_t>(v);
