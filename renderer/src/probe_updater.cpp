@@ -98,7 +98,7 @@ ProbeGrid sceneGrid(const scene::Scene& scene, const std::array<uint32_t, 3>& di
 }
 
 // The probes within one cell of a triangle that moved between `before` and `after` (positions of
-// the same triangles): every cell box the triangle's old or new corners touch, grown by a cell.
+// the same triangles): the grid points in the box around its old and new corners, grown by a cell.
 std::vector<uint32_t> probesNearMoved(const ProbeGrid& grid, const std::vector<glm::vec3>& before,
                                       const std::vector<glm::vec3>& after, const std::vector<uint32_t>& indices) {
   std::vector<uint8_t> near(grid.count(), 0);
@@ -124,7 +124,7 @@ std::vector<uint32_t> probesNearMoved(const ProbeGrid& grid, const std::vector<g
         to[a] = dims[a] - 1;
         continue;
       }
-      const float f = std::floor((bmin[a] - cell[a] - lo[a]) / cell[a]), c = std::ceil((bmax[a] + cell[a] - lo[a]) / cell[a]);
+      const float f = std::ceil((bmin[a] - cell[a] - lo[a]) / cell[a]), c = std::floor((bmax[a] + cell[a] - lo[a]) / cell[a]);
       from[a] = static_cast<int>(std::clamp(f, 0.0f, static_cast<float>(dims[a] - 1)));
       to[a] = static_cast<int>(std::clamp(c, 0.0f, static_cast<float>(dims[a] - 1)));
     }
