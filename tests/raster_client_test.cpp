@@ -93,6 +93,36 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+TEST(RasterClient, MovedGeometryIsDrawnWhereItIsNow) {
+  // The animated Cornell box posed at 2 s and given through setShading draws exactly what a
+  // renderer made at 2 s draws (vertices, shadow maps and the probes' visibility all moved with
+  // it), and differs from the picture at 0 s.
+  VulkanContext context(test::validatedContext());
+  const std::string path = std::string(PROBECAST_TEST_DATA) + "/scenes/cornell-animated/cornell-animated.gltf";
+  scene::Scene at0, at2;
+  std::string error;
+  ASSERT_TRUE(scene::loadScene(path, 0.0, at0, error)) << error;
+  ASSERT_TRUE(scene::loadScene(path, 2.0, at2, error)) << error;
+  const ProbeVolume v = onceUpdatedProbes(context, at2, 4, 64);
+  const CameraView cam = CameraView::fromScene(at0);
+  RasterRenderer moving(context, at0, 64, 48);
+  moving.setProbes(v);
+  const Image before = moving.render(moving.viewProjection(cam), cam.position);
+  EXPECT_EQ(moving.timings().geometryMoves, 0u);
+  moving.setShading(at2);
+  EXPECT_EQ(moving.timings().geometryMoves, 1u);
+  const Image after = moving.render(moving.viewProjection(cam), cam.position);
+  RasterRenderer direct(context, at2, 64, 48);
+  direct.setProbes(v);
+  const Image want = direct.render(direct.viewProjection(cam), cam.position);
+  EXPECT_EQ(after.rgb, want.rgb);
+  size_t differing = 0;
+  for (size_t i = 0; i < before.rgb.size(); i += 3)
+    differing += std::fabs(before.rgb[i] - after.rgb[i]) + std::fabs(before.rgb[i + 1] - after.rgb[i + 1]) > 0.02f;
+  EXPECT_GT(differing, before.rgb.size() / 3 / 50);  // the cube and the arm moved: > 2 % of the pixels
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
 TEST(RasterClient, ShadingWithOtherTexturesDrawsThem) {
   // The box's materials take their base colour from one 1×1 texture, white; setShading with it dark
   // grey (same geometry and probes) must darken the directly lit picture: the raster draws the
