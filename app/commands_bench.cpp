@@ -1,4 +1,4 @@
-// `probecast bench codec|update|raster|scene|pipeline|environment|stability|stream|edge|adaptive`.
+// `probecast bench codec|update|raster|scene|pipeline|environment|stability|stream|edge|adaptive|motion`.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -8,9 +8,11 @@
 #include "adaptive_bench.h"
 #include "codec_bench.h"
 #include "edge_bench.h"
+#include "motion_bench.h"
 #include "environment_bench.h"
 #include "probecast/codec/probe_file.h"
 #include "probecast/renderer/view_sets.h"
+#include "probecast/session/representation.h"
 #include "commands.h"
 #include "progress.h"
 #include "scene_options.h"
@@ -253,6 +255,49 @@ void addBenchScene(CLI::App* bench) {
     o.progress = progressLine;
     const bench::SceneBenchResult r = bench::runSceneBench(o);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);
+  });
+}
+
+// `probecast bench motion`: probes, stream and raster client while geometry moves.
+void addBenchMotion(CLI::App* bench) {
+  CLI::App* cmd = bench->add_subcommand(
+      "motion", "an animated scene held, played and held again: error per scene time, lag, wire bytes, update and visibility ms");
+  auto mt = std::make_shared<TracingOptions>();
+  struct MotionCli {
+    std::string json, repr = "zh3";
+    int deadzone = 1;
+    NoiseRuleCli noise;
+    bench::MotionBenchOptions bench;
+  };
+  auto mo = std::make_shared<MotionCli>();
+  mt->add(cmd);
+  cmd->add_option("--step", mo->bench.step, "scene seconds per update while moving")->check(CLI::Range(1e-6, 1e6));
+  cmd->add_option("--still-before", mo->bench.stillBefore, "updates held at --time before the motion")
+      ->check(CLI::Range(2u, 10000u));
+  cmd->add_option("--moving", mo->bench.moving, "updates while moving")->check(CLI::Range(1u, 10000u));
+  cmd->add_option("--still-after", mo->bench.stillAfter, "updates held after the motion")->check(CLI::Range(1u, 10000u));
+  cmd->add_option("--reference-samples", mo->bench.referenceSamples,
+                  "paths per probe and update of each scene time's converged volume (4 updates)")
+      ->check(CLI::Range(32u, 1u << 20));
+  cmd->add_option("--repr", mo->repr, "stream representation (l1, zh3, l2)");
+  cmd->add_option("--deadzone", mo->deadzone, "as serve's")->check(CLI::Range(0, 127));
+  mo->noise.add(cmd);
+  addJsonOption(cmd, mo->json);
+  cmd->callback([=] {
+    bench::MotionBenchOptions& o = mo->bench;
+    o.sceneSpec = mt->scene.scene;
+    o.start = mt->scene.t;
+    const scene::Scene first = mt->scene.load();
+    o.grid = mt->grid.resolve(first);
+    o.updater = mt->updater(mt->scene.environment.load());
+    o.context = mt->device.context();
+    o.repr = session::parseRepresentationOrThrow(mo->repr);
+    o.encoder.deadzone = mo->deadzone;
+    mo->noise.apply(o.encoder, true);
+    o.command = commandLine();
+    o.progress = progressLine;
+    const bench::MotionBenchResult r = bench::runMotionBench(o);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", mo->json, "", "");
   });
 }
 
@@ -557,6 +602,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchStream(bench);
   addBenchEdge(bench);
   addBenchAdaptive(bench);
+  addBenchMotion(bench);
 }
 
 }  // namespace probecast::app
