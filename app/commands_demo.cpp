@@ -17,8 +17,13 @@ void addDemoCommand(CLI::App& app) {
   CLI::App* demo = app.add_subcommand("demo", "server + stereo and light-field viewers over loopback; writes out/");
   auto o = std::make_shared<DemoOptions>();
   demo->add_option("--out", o->out, "output folder");
-  demo->add_option("--scene", o->scene, "scene the server lights (built-in scenes animate their light)");
+  demo->add_option("--scene", o->scene, "scene the server lights: builtin:NAME or a glTF file (tests/data/scenes/cornell-animated/cornell-animated.gltf moves a cube and bends an arm)");
   demo->add_option("--seconds", o->seconds, "streaming time with the light moving")->check(CLI::Range(1.0, 3600.0));
+  demo->add_option("--animate", o->rate,
+                   "scene seconds per second while streaming (built-in scenes turn their light once per scene second; "
+                   "a glTF file plays its animation)")
+      ->check(CLI::Range(1e-6, 1000.0))
+      ->capture_default_str();
   addSppOption(demo, o->spp, "updater samples per probe per update");
   o->grid.add(demo, false, 2, 64);
   addRepresentationOption(demo, o->repr, "representation streamed");

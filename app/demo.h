@@ -29,7 +29,7 @@ struct DemoOptions {
   std::string out = "out";
   std::string scene = "builtin:cornell";
   double seconds = 24.0;        // streaming with the light moving
-  double turnsPerMinute = 1.5;  // light speed (builtin scenes move it once around per unit of t)
+  double rate = 0.025;  // scene seconds per second while streaming (built-ins turn their light once per scene second)
   uint32_t spp = 64;            // updater samples per probe per update
   GridOptions grid;  // --grid only (no --bounds), 2…64 per axis
   std::string repr = "zh3";

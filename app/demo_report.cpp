@@ -126,10 +126,12 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
         "outer face of the ceiling, which takes no probe light (every probe of its cells lies behind "
         "it), as in the reference.\n\n",
         nlohmann::json(viewsAboveScene).dump());
-  md += "## While the light moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
+  md += "## While the scene moves\n\n![bytes per second per viewer](bandwidth.svg)\n\n";
   for (const auto& m : report["moments"])
-    md += fmt::format("At {:.1f} s (t = {:.3f}): ![stereo]({}) ![quilt]({})\n\n", m["seconds"].get<double>(),
-                      m["t"].get<double>(), m.value("stereo", ""), m.value("quilt", ""));
+    md += fmt::format("At {:.1f} s (server scene time {:.3f} s; headset drawn at {:.3f} s, display at {:.3f} s): "
+                      "![stereo]({}) ![quilt]({})\n\n",
+                      m["seconds"].get<double>(), m["scene_time"].get<double>(), m.value("stereo_scene_time", 0.0),
+                      m.value("quilt_scene_time", 0.0), m.value("stereo", ""), m.value("quilt", ""));
   md += "## Against the reference\n\n![PSNR per view](psnr_per_view.svg)\n\n";
   md += "| | headset (stereo) | light-field quilt |\n|---|---|---|\n";
   md += "| probecast | ![](final_stereo.png) | ![](final_quilt.png) |\n";
@@ -313,7 +315,7 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
   report["stream_seconds"] = run.streamSeconds;
   report["updates"] = producer.updates;
   report["update_ms_median"] = session::median(producer.updateMs);
-  report["final_t"] = run.finalT;
+  report["final_scene_time"] = run.finalT;
   report["moments"] = run.moments;
   report["server_device"] = run.serverContext->deviceName();
   report["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";

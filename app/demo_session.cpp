@@ -53,7 +53,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
   uo.areaLights = o.areaLights.options();  // stated in the description: the viewers light the same emitters
   session::Animation animation;
   animation.mode = session::Animation::Mode::WallClock;
-  animation.ratePerSecond = o.turnsPerMinute / 60.0;
+  animation.ratePerSecond = o.rate;
   animation.reloadScene = session::sceneMoves(o.scene, run.scene0);  // built-ins and animated glTF files
   run.producer->traceScene(*run.serverContext, o.scene, run.scene0, run.grid, uo, animation);
   service::ServerConfig sc;
@@ -128,13 +128,15 @@ void stream(const DemoOptions& o, DemoRun& run) {
       lastSample = now;
     }
     if (nextMoment < 3 && now >= moment[nextMoment]) {
-      nlohmann::json m{{"seconds", now}, {"t", producer.t()}};
+      // Each viewer's images are of its own display time: the scene it drew was posed (or lit) then.
+      nlohmann::json m{{"seconds", now}, {"scene_time", producer.sceneTime()}};
       for (size_t k = 0; k < run.viewers.size(); ++k)
         if (!run.viewers[k].viewer->images().empty()) {
           const std::string tag = k == 0 ? "stereo" : "quilt";
           const std::string file = fmt::format("moment{}_{}", nextMoment + 1, tag);
           writeViewerImages(o.out + "/" + file, run.viewers[k], run.viewers[k].viewer->images());
           m[tag] = file + ".png";
+          m[tag + "_scene_time"] = run.viewers[k].viewer->displayTime();
         }
       run.moments.push_back(m);
       ++nextMoment;
@@ -159,12 +161,12 @@ void settle(const DemoOptions& o, DemoRun& run) {
   session::ProbeProducer& producer = *run.producer;
   // Where the light stands after exactly o.seconds, whatever the loop's timing: the same final
   // scene every run, so its references come from the cache.
-  producer.freeze(static_cast<float>(o.seconds * o.turnsPerMinute / 60.0));
+  producer.freeze(static_cast<float>(o.seconds * o.rate));
   run.finalT = static_cast<float>(producer.sceneTime());
   while (producer.running() && producer.stats().settledUpdates < o.settleUpdates) {
     const uint32_t settled = producer.stats().settledUpdates;
     progress.update(static_cast<double>(settled) / o.settleUpdates,
-                    fmt::format("light frozen at t = {:.3f}, settling {}/{} updates", run.finalT, settled,
+                    fmt::format("scene clock frozen at {:.3f} s, settling {}/{} updates", run.finalT, settled,
                                 o.settleUpdates));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }

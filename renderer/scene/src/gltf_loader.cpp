@@ -764,8 +764,12 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error, double 
   for (int root : roots)
     if (!visit(root, glm::mat4(1.0f))) return fail(nodeError);
   if (scene.triangleCount() == 0) return fail("no triangles");
+  const auto finite = [](const glm::vec3& a, const glm::vec3& b) {
+    return std::isfinite(a.x + a.y + a.z + b.x + b.y + b.z);
+  };
   if (rig->primitives.empty() && rig->lights.empty() && rig->cameras.empty()) {
     finalizeScene(scene);
+    if (!finite(scene.boundsMin, scene.boundsMax)) return fail("the node transforms take vertices to infinity or NaN");
     return true;
   }
   scene.rig = rig;
@@ -782,6 +786,7 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error, double 
       }
     }
   }
+  if (!finite(lo, hi)) return fail("the node transforms or the animation take vertices to infinity or NaN");
   scene.boundsMin = lo;
   scene.boundsMax = hi;
   poseScene(scene, seconds);
