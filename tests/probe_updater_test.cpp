@@ -697,6 +697,9 @@ TEST_F(Updater, ProbesNextToMovedGeometryFollowItWithinTwoUpdates) {
   EXPECT_TRUE(u.classifyStats().partial);
   EXPECT_GT(u.classifyStats().nearMoved, 0u);
   EXPECT_LT(u.classifyStats().nearMoved, g.count() / 2);  // not the whole volume
+  // The cube's and the arm's triangles were refitted in place; nothing was built from scratch again.
+  EXPECT_EQ(u.geometryStats().builds, 1u);
+  EXPECT_GE(u.geometryStats().refits, 1u);
   for (int k = 0; k < 2; ++k) u.update();
   o.seed = 9;
   ProbeUpdater fresh(*context_, at2, g, o);

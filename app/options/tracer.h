@@ -20,6 +20,7 @@ struct TracerOptions {
   float changeHistory = renderer::UpdaterOptions{}.changeHistory;
   float clamp = 16.0f;
   bool relocate = true;
+  bool refit = true;
   bool surfaceProbesOnly = true;
   uint64_t raysPerUpdate = 0;
   void add(CLI::App* cmd) {
@@ -46,6 +47,9 @@ struct TracerOptions {
     cmd->add_flag("--relocate,!--no-relocate", relocate,
                   "move probes inside or too close to geometry (up to 45 % of a cell per axis) instead of only "
                   "switching them off (default on)");
+    cmd->add_flag("--refit,!--no-refit", refit,
+                  "moving geometry (animated glTF): refit the acceleration structures of the moving triangles in "
+                  "place instead of building all of them anew on every move (default on)");
     cmd->add_flag("--surface-probes-only,!--all-probes", surfaceProbesOnly,
                   "trace and send only the probes that light some surface (a triangle passes through the cells "
                   "around them); the others light no pixel and stay off (default on)");
@@ -61,6 +65,7 @@ struct TracerOptions {
     o.changeHistory = changeHistory;
     o.indirectClamp = clamp;
     o.relocate = relocate;
+    o.refitMovingGeometry = refit;
     o.surfaceProbesOnly = surfaceProbesOnly;
     o.raysPerUpdate = raysPerUpdate;
     return o;

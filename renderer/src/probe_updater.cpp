@@ -146,6 +146,7 @@ struct ProbeUpdater::Impl {
   uint32_t samples = 0;
   std::vector<uint32_t> activeList;
   ClassifyStats classifyStats;
+  GeometryStats geometryStats;
   std::vector<ProbeHistory> history;  // per probe: blend count and noise statistics
   std::vector<uint32_t> restarted;    // probes restarted by the update being blended
   // Per probe, how the update being blended restarted it (all kNoRestart between updates).
@@ -374,8 +375,19 @@ struct ProbeUpdater::Impl {
   std::vector<scene::Light> lights;
   std::vector<scene::Material> materials;
   std::vector<uint32_t> triangleMaterial;
-  void setGeometry(const scene::Scene& s) {
-    uploadGpuScene(*d, s, gpu);
+  // `refit`: the same triangles, only moving ones moved: their acceleration structures are refitted
+  // (refitSceneAccel) instead of built anew, when that holds.
+  void setGeometry(const scene::Scene& s, bool refit = false) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (refit && refitSceneAccel(*d, s, geometryPositions, gpu.accel)) {
+      uploadGpuSurfaces(*d, s, gpu);  // the moved normals, and the shading
+    } else {
+      uploadGpuScene(*d, s, gpu);
+      ++geometryStats.builds;
+    }
+    geometryStats.refits = gpu.accel.refits;
+    geometryStats.refitRebuilds = gpu.accel.rebuilds;
+    geometryStats.lastMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     nearSurface = options.surfaceProbesOnly ? probesNearSurfaces(s, volume.grid) : std::vector<uint8_t>(volume.count(), 1);
     markClientLit(s);
     geometryPositions = s.positions;
@@ -450,7 +462,7 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
   if (geometryChanged && sameTriangles) {
     // Moved geometry: only the probes around it are classified again and restarted.
     const std::vector<uint32_t> near = probesNearMoved(s.volume.grid, s.geometryPositions, scene.positions, scene.indices);
-    s.setGeometry(scene);
+    s.setGeometry(scene, s.options.refitMovingGeometry);
     s.reclassify(near);
   } else if (geometryChanged) {
     s.setGeometry(scene);
@@ -636,6 +648,7 @@ uint32_t ProbeUpdater::updates() const { return impl_->volume.updates; }
 const ProbeVolume& ProbeUpdater::volume() const { return impl_->volume; }
 const ProbeGrid& ProbeUpdater::grid() const { return impl_->volume.grid; }
 const ClassifyStats& ProbeUpdater::classifyStats() const { return impl_->classifyStats; }
+const GeometryStats& ProbeUpdater::geometryStats() const { return impl_->geometryStats; }
 
 uint64_t ProbeUpdater::deviceBytes() const {
   const Impl& s = *impl_;
@@ -643,10 +656,9 @@ uint64_t ProbeUpdater::deviceBytes() const {
   for (const Buffer* b : {&s.directions, &s.classifyDirections, &s.probeList, &s.partials, &s.levelDirections, &s.gpu.triangleMaterial,
                           &s.gpu.materials, &s.gpu.lights, &s.gpu.emitters, &s.gpu.normals, &s.gpu.texcoords, &s.gpu.texels,
                           &s.gpu.textures, &s.gpu.environment, &s.gpu.environmentData, &s.gpu.accel.positions, &s.gpu.accel.indices,
-                          &s.gpu.accel.instances, &s.gpu.accel.blas.storage, &s.gpu.accel.blasNonOpaque.storage,
-                          &s.gpu.accel.tlas.storage, &s.pass.sbt})
+                          &s.pass.sbt})
     total += b->size;
-  return total;
+  return total + sceneAccelBytes(s.gpu.accel);
 }
 
 }  // namespace probecast::renderer

@@ -5,6 +5,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "probecast/scene/animation.h"
 #include "probecast/scene/scene.h"
 
 namespace probecast::scene {
@@ -27,6 +28,22 @@ uint32_t triangleClass(const Scene& s, uint32_t t) {
   if (m >= s.materials.size()) return 0;
   const Material& mat = s.materials[m];
   return mat.transmissive() ? 2u : (mat.opaqueToRays() ? 0u : 1u);
+}
+
+std::vector<uint8_t> movingVertices(const Scene& s) {
+  std::vector<uint8_t> out(s.positions.size(), 0);
+  if (!s.rig || !(s.rig->duration > 0.0f)) return out;  // posed once at load: nothing moves later
+  for (const RigPrimitive& p : s.rig->primitives)
+    for (uint32_t v = p.firstVertex; v < p.firstVertex + p.vertexCount && v < out.size(); ++v) out[v] = 1;
+  return out;
+}
+
+std::vector<uint8_t> movingTriangles(const Scene& s) {
+  const std::vector<uint8_t> vertex = movingVertices(s);
+  std::vector<uint8_t> out(s.triangleCount(), 0);
+  for (uint32_t t = 0; t < s.triangleCount(); ++t)
+    out[t] = vertex[s.indices[3 * t]] | vertex[s.indices[3 * t + 1]] | vertex[s.indices[3 * t + 2]];
+  return out;
 }
 
 uint32_t leadingTrianglesBelowClass(const Scene& s, uint32_t cls) {
@@ -72,15 +89,16 @@ void finalizeScene(Scene& s) {
   const uint32_t count = s.triangleCount();
   if (count == 0) return;
   const glm::vec3 extent = glm::max(s.boundsMax - s.boundsMin, glm::vec3(1e-6f));
-  std::vector<uint32_t> code(count);
+  const std::vector<uint8_t> moves = movingTriangles(s);
+  std::vector<uint64_t> code(count);
   for (uint32_t t = 0; t < count; ++t) {
     const glm::vec3 c =
         (s.positions[s.indices[3 * t]] + s.positions[s.indices[3 * t + 1]] + s.positions[s.indices[3 * t + 2]]) / 3.0f;
     const glm::vec3 u = glm::clamp((c - s.boundsMin) / extent, 0.0f, 1.0f) * 1023.0f;
-    // The class in bits 30-31 keeps each class one run; Morton order within it.
-    code[t] = (triangleClass(s, t) << 30) | spreadBits(static_cast<uint32_t>(u.x)) |
-              (spreadBits(static_cast<uint32_t>(u.y)) << 1) |
-              (spreadBits(static_cast<uint32_t>(u.z)) << 2);
+    // The class in bits 32-33 keeps each class one run; within it the triangles that never move
+    // come first, those that move after (bit 31), each in Morton order.
+    code[t] = (uint64_t{triangleClass(s, t)} << 32) | (uint64_t{moves[t]} << 31) | spreadBits(static_cast<uint32_t>(u.x)) |
+              (spreadBits(static_cast<uint32_t>(u.y)) << 1) | (spreadBits(static_cast<uint32_t>(u.z)) << 2);
   }
   std::vector<uint32_t> order(count);
   std::iota(order.begin(), order.end(), 0u);

@@ -69,6 +69,10 @@ struct UpdaterOptions {
   // axis. Only a probe still inside after that is inactive. Offsets are snapped to what viewers
   // reconstruct from the wire (probe_offsets.h), and probes are traced there.
   bool relocate = true;
+  // When only the vertices of moving triangles move (an animated glTF scene, setScene), refit their
+  // acceleration structures in place instead of building every one anew (vk_acceleration.h); off
+  // rebuilds them all on every move (to compare).
+  bool refitMovingGeometry = true;
   float relocateClearance = 0.2f;  // fraction of the smallest cell
   float relocateMaxShift = 0.45f;  // fraction of the cell on each axis
   uint32_t relocateRounds = 4;
@@ -115,6 +119,14 @@ struct ClassifyStats {
   bool partial = false;          // this classification was of the probes near moved geometry only
 };
 
+// How the updater's acceleration structures followed the geometry (setScene).
+struct GeometryStats {
+  uint32_t builds = 0;         // scenes built from scratch (the first one included)
+  uint32_t refits = 0;         // moving runs refitted in place (only moving vertices moved)
+  uint32_t refitRebuilds = 0;  // moving runs built again after kMaxRefits refits
+  double lastMs = 0.0;         // the last geometry change: structures, surfaces and shading uploaded
+};
+
 class ProbeUpdater {
  public:
   ProbeUpdater(VulkanContext& context, const scene::Scene& scene, const ProbeGrid& grid,
@@ -141,6 +153,7 @@ class ProbeUpdater {
   const ProbeVolume& volume() const;
   const ProbeGrid& grid() const;
   const ClassifyStats& classifyStats() const;
+  const GeometryStats& geometryStats() const;
   // Device memory this updater holds (buffers and acceleration structures), bytes: it grows with
   // the probe count, not with probes × samples.
   uint64_t deviceBytes() const;

@@ -115,6 +115,11 @@ struct Scene {
 
 // Material class of a triangle in finalizeScene's order: 0 opaque to rays, 1 cut-out, 2 transmissive.
 uint32_t triangleClass(const Scene& scene, uint32_t triangle);
+// Per vertex / per triangle: 1 where it moves with the scene clock (a primitive of the rig of a
+// scene that animates, animation.h), 0 elsewhere. finalizeScene puts the moving triangles of each
+// class after the still ones, so each is one run.
+std::vector<uint8_t> movingVertices(const Scene& scene);
+std::vector<uint8_t> movingTriangles(const Scene& scene);
 // Length of the leading run of triangles of class < `cls` (the whole scene when not finalized).
 uint32_t leadingTrianglesBelowClass(const Scene& scene, uint32_t cls);
 
@@ -135,7 +140,8 @@ bool loadScene(const std::string& spec, double seconds, Scene& scene, std::strin
 // Recomputes the bounds and reorders triangles by the Morton code of their centroids, so BVH
 // builders that split at the index midpoint get spatially coherent halves. Triangles come in three
 // runs, each in Morton order: opaque to rays, then cut-out (Mask without transmission), then
-// transmissive (trianglesOpaqueToRays, trianglesDrawnOpaque give the run ends).
+// transmissive (trianglesOpaqueToRays, trianglesDrawnOpaque give the run ends); within each, the
+// triangles that never move first, then those that move.
 void finalizeScene(Scene& scene);
 
 // Appends a quad (two triangles, counter-clockwise seen from the side `normal` points to).
