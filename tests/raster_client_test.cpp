@@ -94,23 +94,28 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
 }
 
 TEST(RasterClient, MovedGeometryIsDrawnWhereItIsNow) {
-  // The animated Cornell box posed at 2 s and given through setShading draws exactly what a
-  // renderer made at 2 s draws (vertices, shadow maps and the probes' visibility all moved with
-  // it), and differs from the picture at 0 s.
+  // The animated Cornell box posed at 1.9 s, then at 2 s, given through setShading draws exactly
+  // what a renderer made at 2 s draws (vertices, shadow maps and the probes' visibility all moved
+  // with it), and differs from the picture at 0 s. The second, small move draws again only the
+  // depth cubes of the probes within reach of what moved.
   VulkanContext context(test::validatedContext());
   const std::string path = std::string(PROBECAST_TEST_DATA) + "/scenes/cornell-animated/cornell-animated.gltf";
-  scene::Scene at0, at2;
+  scene::Scene at0, at19, at2;
   std::string error;
   ASSERT_TRUE(scene::loadScene(path, 0.0, at0, error)) << error;
+  ASSERT_TRUE(scene::loadScene(path, 1.9, at19, error)) << error;
   ASSERT_TRUE(scene::loadScene(path, 2.0, at2, error)) << error;
-  const ProbeVolume v = onceUpdatedProbes(context, at2, 4, 64);
+  const ProbeVolume v = onceUpdatedProbes(context, at2, 8, 32);
   const CameraView cam = CameraView::fromScene(at0);
   RasterRenderer moving(context, at0, 64, 48);
   moving.setProbes(v);
   const Image before = moving.render(moving.viewProjection(cam), cam.position);
   EXPECT_EQ(moving.timings().geometryMoves, 0u);
+  moving.setShading(at19);
   moving.setShading(at2);
-  EXPECT_EQ(moving.timings().geometryMoves, 1u);
+  EXPECT_EQ(moving.timings().geometryMoves, 2u);
+  EXPECT_GT(moving.timings().visibilityProbesRedrawn, 0u);
+  EXPECT_LT(moving.timings().visibilityProbesRedrawn, 512u * 3 / 4);  // 271 here: the movers fill much of the room
   const Image after = moving.render(moving.viewProjection(cam), cam.position);
   RasterRenderer direct(context, at2, 64, 48);
   direct.setProbes(v);

@@ -221,7 +221,8 @@ void faceRuns(const std::vector<VisibilityCluster>& clusters, const glm::vec3& p
 uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
                         const std::vector<float>& positions, size_t first, uint32_t n,
                         const std::vector<glm::mat4>& faces, float farDistance, float reach, bool cull,
-                        GpuImage& depth, Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances) {
+                        GpuImage& depth, Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances,
+                        const std::vector<uint8_t>* only = nullptr) {
   uint64_t drawn = 0;
   submitAndWait(d, [&](VkCommandBuffer cmd) {
     transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
@@ -244,6 +245,7 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
       if (clusters.empty()) continue;
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pass == 0 ? vis.pipeline : vis.cutoutPipeline);
       for (uint32_t k = 0; k < n; ++k) {
+        if (only && !(*only)[k]) continue;
         const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
         const glm::mat4 move = glm::translate(glm::mat4(1.0f), -probe);
         for (uint32_t f = 0; f < 6; ++f) {
@@ -368,12 +370,96 @@ void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, Pro
                 std::numeric_limits<float>::infinity(), out);
 }
 
-void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis) {
+void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis, bool keepBuilt) {
   // finalizeScene keeps each class one run, in Morton order within it: runs of it are compact.
   const uint32_t opaque = scene::leadingTrianglesBelowClass(scene, 1);
   vis.opaque = clustersOf(scene, 0, opaque);
   vis.cutouts = clustersOf(scene, opaque, scene::leadingTrianglesBelowClass(scene, 2));
-  vis.builtFor.clear();  // new geometry: the next build draws again
+  if (!keepBuilt) vis.builtFor.clear();  // new geometry: the next build draws again
+}
+
+std::vector<uint32_t> probesNearMovedGeometry(const ProbeVisibility& vis, const std::vector<glm::vec3>& before,
+                                              const std::vector<glm::vec3>& after,
+                                              const std::vector<uint32_t>& indices) {
+  const size_t count = vis.builtFor.size() / 3;
+  std::vector<uint8_t> near(count, 0);
+  const bool unlimited = !std::isfinite(vis.builtReach);
+  for (size_t t = 0; t + 2 < indices.size() && !unlimited; t += 3) {
+    const uint32_t v[3] = {indices[t], indices[t + 1], indices[t + 2]};
+    if (before[v[0]] == after[v[0]] && before[v[1]] == after[v[1]] && before[v[2]] == after[v[2]]) continue;
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (uint32_t i : v) {
+      lo = glm::min(lo, glm::min(before[i], after[i]));
+      hi = glm::max(hi, glm::max(before[i], after[i]));
+    }
+    for (size_t p = 0; p < count; ++p) {
+      if (near[p]) continue;
+      const glm::vec3 q(vis.builtFor[3 * p], vis.builtFor[3 * p + 1], vis.builtFor[3 * p + 2]);
+      near[p] = glm::length(glm::clamp(q, lo, hi) - q) <= vis.builtReach;
+    }
+  }
+  std::vector<uint32_t> out;
+  for (size_t p = 0; p < count; ++p)
+    if (near[p] || unlimited) out.push_back(static_cast<uint32_t>(p));
+  return out;
+}
+
+uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                               const std::vector<uint32_t>& which, float farDistance, bool cull, ProbeVisibility& vis) {
+  if (which.empty() || vis.builtFor.empty()) return 0;
+  const auto t0 = Clock::now();
+  const size_t count = vis.builtFor.size() / 3;
+  std::vector<uint8_t> listed(count, 0);
+  for (uint32_t p : which) {
+    if (p >= count) throw std::invalid_argument("redrawProbeVisibility: no such probe");
+    listed[p] = 1;
+  }
+  const std::vector<glm::mat4> faces = cubeFaceViews(farDistance);
+  std::vector<float> atlas = vis.atlas;
+  GpuImage depth = createImage(d, VK_FORMAT_D32_SFLOAT, {kAtlasW, kAtlasH, 1},
+                               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  Buffer readback;
+  double momentsMs = 0.0;
+  uint64_t drawn = 0;
+  try {
+    readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
+                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    std::vector<float> distances, tile(RS_VIS_TILE * RS_VIS_TILE * 2);
+    // The batches of a full build, each probe at its own place in the depth atlas (rasterisation
+    // at another place may round differently): only the listed probes are drawn.
+    for (size_t first = 0; first < count; first += kBatch) {
+      const auto n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
+      const std::vector<uint8_t> only(listed.begin() + static_cast<std::ptrdiff_t>(first),
+                                      listed.begin() + static_cast<std::ptrdiff_t>(first + n));
+      if (std::find(only.begin(), only.end(), 1) == only.end()) continue;
+      drawn += drawDepthCubes(d, gpu, materials, vis.builtFor, first, n, faces, farDistance, vis.builtReach, cull, depth,
+                              readback, vis, distances, &only);
+      const auto m0 = Clock::now();
+      for (uint32_t k = 0; k < n; ++k) {
+        if (!only[k]) continue;
+        octahedralMoments(distances.data() + static_cast<size_t>(k) * 6 * kCube * kCube, kCube, tile.data());
+        const size_t p = first + k;
+        const size_t x0 = (p % RS_VIS_TILES_PER_ROW) * RS_VIS_TILE, y0 = (p / RS_VIS_TILES_PER_ROW) * RS_VIS_TILE;
+        for (uint32_t ty = 0; ty < RS_VIS_TILE; ++ty)
+          std::copy_n(tile.data() + ty * RS_VIS_TILE * 2, RS_VIS_TILE * 2,
+                      atlas.data() + ((y0 + ty) * vis.atlasWidth + x0) * 2);
+      }
+      momentsMs += msSince(m0);
+    }
+  } catch (...) {
+    destroyImage(d, depth);
+    destroyBuffer(d, readback);
+    throw;
+  }
+  destroyImage(d, depth);
+  destroyBuffer(d, readback);
+  const auto u0 = Clock::now();
+  const std::vector<float> built = vis.builtFor;
+  uploadMoments(d, std::move(atlas), vis.atlasWidth, vis.atlasHeight, built, vis.builtReach, vis);
+  vis.momentsMs = momentsMs + msSince(u0);
+  vis.renderMs = msSince(t0) - vis.momentsMs;
+  vis.trianglesDrawn = drawn;
+  return static_cast<uint32_t>(which.size());
 }
 
 float probeVisibilityReach(const ProbeGrid& grid, const glm::vec3& sceneExtent) {

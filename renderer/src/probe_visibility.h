@@ -63,7 +63,9 @@ constexpr uint32_t kVisibilityClusterTriangles = 64;  // most triangles per clus
 void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, ProbeVisibility& out);
 // Cuts the opaque and cut-out triangles of `scene` (as uploaded to the GpuScene the builds draw)
 // into clusters.
-void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis);
+// `keepBuilt`: the same triangles moved, and redrawProbeVisibility follows; otherwise the next
+// build draws every probe again.
+void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis, bool keepBuilt = false);
 // How far a probe of `grid` needs to see: 1.5 cell diagonals (a probe moved by at most half its cell
 // per axis weighs points of the 8 cells around its grid point, each within one diagonal of it, so
 // within 1.5 of the probe) plus 0.25 of the smallest spacing (raster.frag moves the point 0.225 ×
@@ -79,6 +81,17 @@ float probeVisibilityReach(const ProbeGrid& grid, const glm::vec3& sceneExtent);
 bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
                           const std::vector<float>& positions, float farDistance, float reach, bool cull,
                           ProbeVisibility& vis);
+// After moved geometry (setProbeVisibilityScene with keepBuilt): the probes of the last build
+// within `reach` of the box around a moved triangle's old and new corners (`before`, `after`:
+// positions of the same triangles `indices`). Every probe when the reach is unlimited.
+std::vector<uint32_t> probesNearMovedGeometry(const ProbeVisibility& vis, const std::vector<glm::vec3>& before,
+                                              const std::vector<glm::vec3>& after,
+                                              const std::vector<uint32_t>& indices);
+// Draws the depth cubes of the probes `which` (indices into the last build's positions) again and
+// replaces their tiles of the moments, with the last build's reach; the other probes keep theirs
+// (nothing within their reach moved). Needs a build before; returns the number of probes drawn.
+uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                               const std::vector<uint32_t>& which, float farDistance, bool cull, ProbeVisibility& vis);
 void destroyProbeVisibility(VulkanDevice& d, ProbeVisibility& vis);
 
 // The moments of one probe from its depth cube (6 faces of `size`² distances, face order +x −x +y

@@ -143,9 +143,8 @@ struct RasterRenderer::Impl {
   SurfaceRecord surfaces;  // as uploaded last
   size_t vertexCount = 0;
   std::vector<glm::vec3> positions;  // as uploaded last (setShading moves them)
-  // The last visibility build's inputs, to draw it again when the geometry moves.
-  std::vector<float> visibilityProbes;
-  float visibilityFar = 0.0f, visibilityReach = 0.0f;
+  // The last visibility build's far distance, to draw probes again when the geometry moves.
+  float visibilityFar = 0.0f;
   bool visibilityBuilt = false;
   uint32_t width = 0, height = 0, chunk = 1;  // of the targets: samplesPerSide × the images' size
   GpuScene gpu;
@@ -583,9 +582,7 @@ void RasterRenderer::setProbes(const ProbeVolume& volume) {
     const float reach = s.options.visibilityReach > 0.0f
                             ? s.options.visibilityReach * probeVisibilityReach(volume.grid, hi - lo)
                             : std::numeric_limits<float>::infinity();
-    s.visibilityProbes = positions;
     s.visibilityFar = farDistance;
-    s.visibilityReach = reach;
     s.visibilityBuilt = true;
     if (buildProbeVisibility(*s.d, s.gpu, s.set, positions, farDistance, reach, s.options.visibilityCulling,
                              s.visibility)) {
@@ -617,21 +614,28 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
     throw std::invalid_argument("setShading needs the same geometry (" + scene.name + " differs)");
   vkDeviceWaitIdle(s.d->device);
   const bool moved = scene.positions != s.positions;
+  std::vector<uint32_t> redraw;  // probes whose depth cubes the moved triangles reach
   if (moved) {  // moving geometry: the vertex stream every pass draws from, in place
+    if (s.visibilityBuilt && s.push.visibility) redraw = probesNearMovedGeometry(s.visibility, s.positions, scene.positions, scene.indices);
     std::memcpy(s.gpu.accel.positions.mapped, scene.positions.data(), scene.positions.size() * sizeof(glm::vec3));
     s.positions = scene.positions;
   }
   if (s.surfaces.changedBy(scene)) uploadGpuSurfaces(*s.d, scene, s.gpu);  // and the shading
   else uploadGpuShading(*s.d, scene, s.gpu);
   if (moved) {
-    setProbeVisibilityScene(scene, s.visibility);  // new clusters; the probes' depth cubes are drawn again
+    // New clusters (their bounds moved); the depth cubes of the probes within reach of a moved
+    // triangle are drawn again, the others keep theirs.
+    setProbeVisibilityScene(scene, s.visibility, true);
     s.timings.geometryMoves += 1;
-    if (s.visibilityBuilt && s.push.visibility &&
-        buildProbeVisibility(*s.d, s.gpu, s.set, s.visibilityProbes, s.visibilityFar, s.visibilityReach,
-                             s.options.visibilityCulling, s.visibility)) {
+    s.timings.visibilityProbesRedrawn =
+        redrawProbeVisibility(*s.d, s.gpu, s.set, redraw, s.visibilityFar, s.options.visibilityCulling, s.visibility);
+    if (s.timings.visibilityProbesRedrawn > 0) {
       s.timings.visibilityRenderMs = s.visibility.renderMs;
       s.timings.visibilityMomentsMs = s.visibility.momentsMs;
       s.timings.visibilityTriangles = s.visibility.trianglesDrawn;
+    } else {
+      s.timings.visibilityRenderMs = s.timings.visibilityMomentsMs = 0.0;
+      s.timings.visibilityTriangles = 0;
     }
   }
   s.push.lightCount = s.gpu.lightCount;

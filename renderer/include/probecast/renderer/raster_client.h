@@ -71,7 +71,8 @@ struct RasterTimings {
   double visibilityRenderMs = 0.0;   // last visibility build: depth cubes drawn and read back
   double visibilityMomentsMs = 0.0;  // last visibility build: moments on the CPU and their upload
   uint64_t visibilityTriangles = 0;  // last visibility build: triangles drawn over all cube faces
-  uint64_t geometryMoves = 0;        // setShading calls that moved vertices (each redraws the visibility)
+  uint64_t geometryMoves = 0;        // setShading calls that moved vertices
+  uint32_t visibilityProbesRedrawn = 0;  // the last move: probes whose depth cubes were drawn again
 };
 
 // Throws std::invalid_argument unless views of width × height at options.samplesPerSide fit a
@@ -110,8 +111,8 @@ class RasterRenderer {
   // The host copy of a probe's moments (E[r], E[r²]) toward `dir`, metres (nearest texel).
   glm::vec2 probeMoments(uint32_t probe, const glm::vec3& dir) const;
   // The same triangles with new positions, lights, materials, normals, texture coordinates or
-  // textures (an animated scene): shadows are redrawn, and moved vertices redraw the probes'
-  // visibility at once.
+  // textures (an animated scene): shadows are redrawn, and the visibility of the probes within
+  // reach of a moved triangle is drawn again at once (the others keep theirs).
   void setShading(const scene::Scene& scene);
   // The same, with client area lights by other options (those a stream's probes were made with:
   // RasterOptions::areaLights from now on).
