@@ -78,7 +78,7 @@ MotionBenchResult runMotionBench(const MotionBenchOptions& o) {
   nlohmann::json perUpdate = nlohmann::json::array();
   std::vector<double> errors(total), sceneMs, updateStillMs, updateMovingMs, visibilityMs, bytesMoving, bytesAfter;
   std::vector<double> stillNoise;
-  std::vector<double> partialClassifyMs, accelMs;
+  std::vector<double> partialClassifyMs, accelMs, visibilityProbes;
   for (uint32_t k = 0; k < total; ++k) {
     const bool moved = k > 0 && times[k] != times[k - 1];
     double setMs = 0.0;
@@ -106,12 +106,16 @@ MotionBenchResult runMotionBench(const MotionBenchOptions& o) {
       }
     const double perProbe = static_cast<double>(bytes) / o.grid.count();
     double visMs = 0.0;
+    uint32_t visProbes = 0;
     if (moved) {
       const uint64_t before = raster.timings().geometryMoves;
       raster.setShading(current);
-      if (raster.timings().geometryMoves > before)
+      if (raster.timings().geometryMoves > before) {
         visMs = raster.timings().visibilityRenderMs + raster.timings().visibilityMomentsMs;
+        visProbes = raster.timings().visibilityProbesRedrawn;
+      }
       visibilityMs.push_back(visMs);
+      visibilityProbes.push_back(visProbes);
     }
     raster.setProbes(v);
     errors[k] = irradianceRmseRel(v.probes.data(), referenceAt(times[k]).data(), v.active.data(), o.grid.count());
@@ -138,7 +142,8 @@ MotionBenchResult runMotionBench(const MotionBenchOptions& o) {
                          {"set_scene_ms", setMs},
                          {"probes_classified_again", near},
                          {"wire_bytes_per_probe", perProbe},
-                         {"raster_visibility_ms", visMs}});
+                         {"raster_visibility_ms", visMs},
+                         {"raster_visibility_probes_redrawn", visProbes}});
     if (o.progress)
       o.progress(fmt::format("bench motion: update {}/{} at {:.3f} s: error {:.4f}, {:.1f} ms + {:.1f} ms scene, "
                              "{:.2f} bytes/probe",
@@ -185,6 +190,7 @@ MotionBenchResult runMotionBench(const MotionBenchOptions& o) {
             {"wire_bytes_per_probe_stopped_mean", mean(bytesAfter)},
             {"wire_bytes_per_probe_settled_mean", mean(settled)},
             {"raster_visibility_ms_median", median(visibilityMs)},
+            {"raster_visibility_probes_redrawn_median", median(visibilityProbes)},
             {"per_update", perUpdate}};
   r.table = fmt::format(
       "bench motion: {} on {}x{}x{} probes, {} spp, {:.3f} scene s per update\n"
@@ -192,11 +198,11 @@ MotionBenchResult runMotionBench(const MotionBenchOptions& o) {
       "  update ms: still {:.1f}, moving {:.1f} + setScene {:.1f} ({} {:.1f} ms; classify {:.1f} ms near moved vs {:.1f} "
       "ms all)\n"
       "  wire bytes per probe per update: moving {:.3f}, stopped {:.3f}, settled {:.3f}\n"
-      "  raster visibility rebuild: {:.1f} ms per move\n",
+      "  raster visibility rebuild: {:.1f} ms per move ({:.0f} of {} probes' depth cubes drawn again)\n",
       o.sceneSpec, o.grid.dims[0], o.grid.dims[1], o.grid.dims[2], o.updater.samplesPerProbe, o.step, noiseLevel,
       median(movingError), mean(movingLag), settle, median(updateStillMs), median(updateMovingMs), median(sceneMs),
       o.updater.refitMovingGeometry ? "refit" : "full rebuild", median(accelMs), median(partialClassifyMs), fullClassifyMs, mean(bytesMoving), mean(bytesAfter), mean(settled),
-      median(visibilityMs));
+      median(visibilityMs), median(visibilityProbes), o.grid.count());
   return r;
 }
 

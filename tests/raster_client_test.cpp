@@ -105,19 +105,31 @@ TEST(RasterClient, MovedGeometryIsDrawnWhereItIsNow) {
   ASSERT_TRUE(scene::loadScene(path, 0.0, at0, error)) << error;
   ASSERT_TRUE(scene::loadScene(path, 1.9, at19, error)) << error;
   ASSERT_TRUE(scene::loadScene(path, 2.0, at2, error)) << error;
+  for (scene::Scene* s : {&at0, &at19, &at2}) {  // a point light under the ceiling: six shadow layers
+    scene::Light bulb;
+    bulb.position = {0.0f, 1.8f, 0.0f};
+    bulb.intensity = 2.0f;
+    s->lights.push_back(bulb);
+  }
   const ProbeVolume v = onceUpdatedProbes(context, at2, 8, 32);
   const CameraView cam = CameraView::fromScene(at0);
-  RasterRenderer moving(context, at0, 64, 48);
+  RasterOptions ro;
+  ro.areaLights.enabled = true;  // the ceiling panel, with a shadow layer of its own
+  RasterRenderer moving(context, at0, 64, 48, ro);
   moving.setProbes(v);
   const Image before = moving.render(moving.viewProjection(cam), cam.position);
   EXPECT_EQ(moving.timings().geometryMoves, 0u);
   moving.setShading(at19);
+  (void)moving.render(moving.viewProjection(cam), cam.position);
   moving.setShading(at2);
   EXPECT_EQ(moving.timings().geometryMoves, 2u);
   EXPECT_GT(moving.timings().visibilityProbesRedrawn, 0u);
   EXPECT_LT(moving.timings().visibilityProbesRedrawn, 512u * 3 / 4);  // 271 here: the movers fill much of the room
   const Image after = moving.render(moving.viewProjection(cam), cam.position);
-  RasterRenderer direct(context, at2, 64, 48);
+  // Of the bulb's six layers, those that see neither the cube nor the arm kept their depth.
+  EXPECT_GT(moving.timings().shadowLayersDrawn, 0u);
+  EXPECT_LT(moving.timings().shadowLayersDrawn, 6u);
+  RasterRenderer direct(context, at2, 64, 48, ro);
   direct.setProbes(v);
   const Image want = direct.render(direct.viewProjection(cam), cam.position);
   EXPECT_EQ(after.rgb, want.rgb);

@@ -132,6 +132,16 @@ VkWriteDescriptorSet imageWrite(VkDescriptorSet set, uint32_t binding, const VkD
   return w;
 }
 
+// The same client area lights: the same emitters, corners and radiance (their shadow layers hold).
+bool sameAreaLights(const scene::AreaLightSet& a, const scene::AreaLightSet& b) {
+  if (a.lights.size() != b.lights.size() || a.clientLitMaterial != b.clientLitMaterial) return false;
+  for (size_t k = 0; k < a.lights.size(); ++k)
+    if (a.lights[k].material != b.lights[k].material || a.lights[k].corners != b.lights[k].corners ||
+        a.lights[k].radiance != b.lights[k].radiance)
+      return false;
+  return true;
+}
+
 }  // namespace
 
 struct RasterRenderer::Impl {
@@ -143,6 +153,9 @@ struct RasterRenderer::Impl {
   SurfaceRecord surfaces;  // as uploaded last
   size_t vertexCount = 0;
   std::vector<glm::vec3> positions;  // as uploaded last (setShading moves them)
+  std::vector<glm::vec3> shadowBefore;  // the positions before the last move
+  std::vector<scene::Light> shadedLights;     // of the last shadow plan
+  std::vector<scene::Material> shadedMaterials;
   // The last visibility build's far distance, to draw probes again when the geometry moves.
   float visibilityFar = 0.0f;
   bool visibilityBuilt = false;
@@ -538,6 +551,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   }
   planShadowMaps(d, scene, s.shadows);
   s.planAreaLights(scene);
+  s.shadedLights = scene.lights;
+  s.shadedMaterials = scene.materials;
   s.push.shadowMapSize = options.shadowMapSize;
   s.push.areaShadowMapSize = options.areaShadowMapSize;
   s.push.lightCount = s.gpu.lightCount;
@@ -615,6 +630,7 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   vkDeviceWaitIdle(s.d->device);
   const bool moved = scene.positions != s.positions;
   std::vector<uint32_t> redraw;  // probes whose depth cubes the moved triangles reach
+  if (moved) s.shadowBefore = s.positions;
   if (moved) {  // moving geometry: the vertex stream every pass draws from, in place
     if (s.visibilityBuilt && s.push.visibility) redraw = probesNearMovedGeometry(s.visibility, s.positions, scene.positions, scene.indices);
     std::memcpy(s.gpu.accel.positions.mapped, scene.positions.data(), scene.positions.size() * sizeof(glm::vec3));
@@ -639,8 +655,23 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
     }
   }
   s.push.lightCount = s.gpu.lightCount;
-  planShadowMaps(*s.d, scene, s.shadows);
-  s.planAreaLights(scene);
+  // Shadow maps: planned again when the lights or materials changed (or nothing moved, as a caller
+  // that sets the same scene asks for); when only vertices moved under the same lights, only the
+  // layers that see a moved triangle are drawn again.
+  const bool sameLights = moved && scene.lights == s.shadedLights && scene.materials == s.shadedMaterials;
+  if (sameLights) {
+    markLayersOfMovedGeometry(s.shadowBefore, scene.positions, scene.indices, s.shadows);
+  } else {
+    planShadowMaps(*s.d, scene, s.shadows);
+  }
+  scene::AreaLightSet areas = scene::extractAreaLights(scene, s.options.areaLights);
+  if (sameLights && sameAreaLights(areas, s.areaSet)) {
+    markLayersOfMovedGeometry(s.shadowBefore, scene.positions, scene.indices, s.areaShadows);
+  } else {
+    s.planAreaLights(scene);
+  }
+  s.shadedLights = scene.lights;
+  s.shadedMaterials = scene.materials;
   s.writeDescriptors();
 }
 
@@ -657,8 +688,10 @@ std::vector<Image> RasterRenderer::renderViews(const std::vector<ViewInfo>& view
   fitShadowCascades(views, s.shadows);
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.shadows);
   s.timings.shadowMs = s.shadows.lastDrawMs;
+  s.timings.shadowLayersDrawn = s.shadows.lastLayersDrawn;
   drawShadowMaps(*s.d, s.gpu, s.indexCount, s.set, s.areaShadows);
   s.timings.areaShadowMs = s.areaShadows.lastDrawMs;
+  s.timings.areaShadowLayersDrawn = s.areaShadows.lastLayersDrawn;
   const auto t0 = Clock::now();
   auto* dst = static_cast<shaders::RsView*>(s.views.mapped);
   s.inverseViewProj.resize(views.size());

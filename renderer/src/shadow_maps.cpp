@@ -210,6 +210,49 @@ void uploadShadowPlan(VulkanDevice& d, const std::vector<shaders::RsShadowLight>
   maps.layerDirty.assign(maps.matrices.size(), 1);
 }
 
+uint32_t markLayersOfMovedGeometry(const std::vector<glm::vec3>& before, const std::vector<glm::vec3>& after,
+                                   const std::vector<uint32_t>& indices, ShadowMaps& maps) {
+  std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const uint32_t v[3] = {indices[t], indices[t + 1], indices[t + 2]};
+    if (before[v[0]] == after[v[0]] && before[v[1]] == after[v[1]] && before[v[2]] == after[v[2]]) continue;
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (uint32_t i : v) {
+      lo = glm::min(lo, glm::min(before[i], after[i]));
+      hi = glm::max(hi, glm::max(before[i], after[i]));
+    }
+    boxes.emplace_back(lo, hi);
+  }
+  uint32_t marked = 0;
+  for (size_t k = 0; k < maps.matrices.size(); ++k) {
+    if (maps.layerDirty[k]) continue;
+    for (const auto& [lo, hi] : boxes) {
+      // Outside the layer's clip volume when all eight corners are beyond one of its planes (x, y
+      // in [-w, w], z ≤ w) or behind a perspective light (w ≤ 0); a box partly behind it counts as in.
+      int outside[5] = {0, 0, 0, 0, 0};
+      int behindCount = 0;
+      for (int c = 0; c < 8; ++c) {
+        const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        const glm::vec4 q = maps.matrices[k] * glm::vec4(p, 1.0f);
+        behindCount += !(q.w > 0.0f);
+        outside[0] += q.x < -q.w;
+        outside[1] += q.x > q.w;
+        outside[2] += q.y < -q.w;
+        outside[3] += q.y > q.w;
+        outside[4] += q.z > q.w;
+      }
+      const bool culled = behindCount == 8 || (behindCount == 0 && (outside[0] == 8 || outside[1] == 8 ||
+                                                                     outside[2] == 8 || outside[3] == 8 || outside[4] == 8));
+      if (!culled) {
+        maps.layerDirty[k] = 1;
+        ++marked;
+        break;
+      }
+    }
+  }
+  return marked;
+}
+
 void fitShadowCascades(const std::vector<ViewInfo>& views, ShadowMaps& maps) {
   if (maps.suns.empty() || views.empty()) return;
   std::vector<float> key;
@@ -296,7 +339,10 @@ void fitShadowCascades(const std::vector<ViewInfo>& views, ShadowMaps& maps) {
 
 void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, VkDescriptorSet materials,
                     ShadowMaps& maps) {
-  if (std::find(maps.layerDirty.begin(), maps.layerDirty.end(), 1) == maps.layerDirty.end()) return;
+  if (std::find(maps.layerDirty.begin(), maps.layerDirty.end(), 1) == maps.layerDirty.end()) {
+    maps.lastLayersDrawn = 0;
+    return;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const uint32_t n = maps.size;
   submitAndWait(d, [&](VkCommandBuffer cmd) {
@@ -366,6 +412,7 @@ void drawShadowMaps(VulkanDevice& d, const GpuScene& gpu, uint32_t indexCount, V
     transitionImage(cmd, maps.depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   });
+  maps.lastLayersDrawn = static_cast<uint32_t>(std::count(maps.layerDirty.begin(), maps.layerDirty.end(), 1));
   std::fill(maps.layerDirty.begin(), maps.layerDirty.end(), 0);
   maps.lastDrawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -48,7 +48,14 @@ struct ShadowMaps {
   VkPipeline cutoutPipeline = VK_NULL_HANDLE;   // cut-outs, through shadow.frag
   VkPipeline transmitPipeline = VK_NULL_HANDLE; // transmissive triangles into `transmit`
   double lastDrawMs = 0.0;
+  uint32_t lastLayersDrawn = 0;
 };
+
+// Moved geometry under the same lights: marks for drawing the layers whose light volume holds the
+// box around a moved triangle's old and new corners (`before`, `after`: positions of the same
+// triangles `indices`); the other layers keep their depth. Returns the layers marked.
+uint32_t markLayersOfMovedGeometry(const std::vector<glm::vec3>& before, const std::vector<glm::vec3>& after,
+                                   const std::vector<uint32_t>& indices, ShadowMaps& maps);
 
 // `materials`: a set layout with the raster client's material bindings (RS_BINDING_*).
 // `cascades`: layers per directional light (1..RS_MAX_CASCADES; 1 = one layer over the scene).

@@ -67,6 +67,7 @@ struct RasterOptions {
 struct RasterTimings {
   double shadowMs = 0.0;  // last shadow-map pass
   double areaShadowMs = 0.0;  // last area-light shadow-map pass
+  uint32_t shadowLayersDrawn = 0, areaShadowLayersDrawn = 0;  // by the last renderViews (0: all kept)
   double viewsMs = 0.0;   // last renderViews, shadows excluded, readback included
   double visibilityRenderMs = 0.0;   // last visibility build: depth cubes drawn and read back
   double visibilityMomentsMs = 0.0;  // last visibility build: moments on the CPU and their upload
