@@ -8,24 +8,27 @@ vec3 srgbToLinear(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
 }
 
-vec4 texel(PtTexture t, int x, int y) {
+// `srgb`: colour decoded from sRGB (base colour, emission); false: the stored values (data textures).
+vec4 texel(PtTexture t, int x, int y, bool srgb) {
   x = ((x % int(t.width)) + int(t.width)) % int(t.width);  // repeat
   y = ((y % int(t.height)) + int(t.height)) % int(t.height);
   uint v = texels[t.offset + uint(y) * t.width + uint(x)];
   vec4 c = vec4(float(v & 255u), float((v >> 8) & 255u), float((v >> 16) & 255u), float(v >> 24)) / 255.0;
-  return vec4(srgbToLinear(c.rgb), c.a);
+  return srgb ? vec4(srgbToLinear(c.rgb), c.a) : c;
 }
 
 // Bilinear, repeat; 1 without a texture.
-vec4 sampleTexture(int index, vec2 uv) {
+vec4 sampleTextureAs(int index, vec2 uv, bool srgb) {
   if (index < 0) return vec4(1.0);
   PtTexture t = textures[index];
   vec2 p = uv * vec2(t.width, t.height) - 0.5;
   ivec2 i = ivec2(floor(p));
   vec2 f = p - vec2(i);
-  return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x),
-             mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
+  return mix(mix(texel(t, i.x, i.y, srgb), texel(t, i.x + 1, i.y, srgb), f.x),
+             mix(texel(t, i.x, i.y + 1, srgb), texel(t, i.x + 1, i.y + 1, srgb), f.x), f.y);
 }
+
+vec4 sampleTexture(int index, vec2 uv) { return sampleTextureAs(index, uv, true); }
 
 // `uvs`: TEXCOORD_0 in xy, TEXCOORD_1 in zw.
 vec2 transformedUv(vec4 row0, vec4 row1, vec4 uvs) {
@@ -43,6 +46,23 @@ vec3 materialEmission(PtMaterial m, vec4 uvs) {
   if (m.textures.y < 0) return m.emissionRoughness.rgb;
   vec2 uv = transformedUv(m.emissiveTransform0, m.emissiveTransform1, uvs);
   return m.emissionRoughness.rgb * sampleTexture(m.textures.y, uv).rgb;
+}
+
+// (metallic, roughness): the factors times the metallic-roughness texture's blue and green.
+vec2 materialMetallicRoughness(PtMaterial m, vec4 uvs) {
+  vec2 f = vec2(m.baseColorMetallic.a, m.emissionRoughness.a);
+  if (m.dataTextures.x < 0) return f;
+  vec2 uv = transformedUv(m.metallicRoughnessTransform0, m.metallicRoughnessTransform1, uvs);
+  vec4 t = sampleTextureAs(m.dataTextures.x, uv, false);
+  return clamp(f * t.bg, 0.0, 1.0);
+}
+
+// The share of indirect light that reaches the point (occlusion texture; 1 without one).
+float materialOcclusion(PtMaterial m, vec4 uvs) {
+  if (m.dataTextures.y < 0) return 1.0;
+  vec2 uv = transformedUv(m.occlusionTransform0, m.occlusionTransform1, uvs);
+  float r = sampleTextureAs(m.dataTextures.y, uv, false).r;
+  return 1.0 + m.dataFactors.x * (r - 1.0);
 }
 
 // Mask: the point is not there (rays pass, raster discards).

@@ -347,8 +347,9 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     segment = 0.0;
     vec3 n = shadingNormal(vertexNormal(i0) * bary.x + vertexNormal(i1) * bary.y + vertexNormal(i2) * bary.z, ngf, -dir);
     vec3 wo = -dir;
-    float metallic = m.baseColorMetallic.a;
-    float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
+    vec2 metalRough = materialMetallicRoughness(m, uvs);
+    float metallic = metalRough.x;
+    float alpha = max(metalRough.y * metalRough.y, 1e-3);
     float specProb = mix(0.2, 0.9, metallic);
     radiance += clampIndirect(throughput * directLight(p, n, ngf, wo, base, metallic, alpha), bounce);
     if (bounce + 1u >= PATH_MAX_BOUNCES) {

@@ -76,6 +76,12 @@ struct PtMaterial {
   vec4 baseTransform1;
   vec4 emissiveTransform0;
   vec4 emissiveTransform1;
+  ivec4 dataTextures;       // x metallic-roughness texture (B metallic, G roughness), y occlusion (R); -1 = none; read linearly
+  vec4 dataFactors;         // x occlusion strength
+  vec4 metallicRoughnessTransform0;
+  vec4 metallicRoughnessTransform1;
+  vec4 occlusionTransform0;
+  vec4 occlusionTransform1;
 };
 
 struct PtTexture {
@@ -161,7 +167,7 @@ struct PtCameraPushConstants {
 #ifdef __cplusplus
 static_assert(sizeof(PtCameraPushConstants) == 112);
 static_assert(sizeof(PtEmitter) == 16);
-static_assert(sizeof(PtMaterial) == 128);
+static_assert(sizeof(PtMaterial) == 224);
 static_assert(sizeof(PtTexture) == 16);
 static_assert(sizeof(PtLight) == 64);
 static_assert(sizeof(PtPushConstants) == 112);

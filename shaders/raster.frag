@@ -275,8 +275,9 @@ void main() {
     outColor = vec4(tau * base, 1.0);
     return;
   }
-  float metallic = m.baseColorMetallic.a;
-  float alpha = max(m.emissionRoughness.a * m.emissionRoughness.a, 1e-3);
+  vec2 metalRough = materialMetallicRoughness(m, texcoord);
+  float metallic = metalRough.x, roughness = metalRough.y;
+  float alpha = max(roughness * roughness, 1e-3);
   vec3 emission = materialEmission(m, texcoord);
   vec3 n = shadingNormal(worldNormal, ngf, wo);
   vec3 direct = vec3(0.0);
@@ -300,15 +301,15 @@ void main() {
     float cosine = dot(n, wi);
     if (cosine > 0.0 && dot(ngf, wi) > 0.0) direct += evalBsdf(n, wo, wi, base, metallic, alpha) * cosine * e * shadowVisibility(i, worldPosition, n);
   }
-  direct += areaLightsDirect(worldPosition, n, ngf, wo, base, metallic, alpha, m.emissionRoughness.a);
+  direct += areaLightsDirect(worldPosition, n, ngf, wo, base, metallic, alpha, roughness);
   float c[28];
   vec3 indirect = vec3(0.0);
   if (pc.visibility != 0u ? probeCoefficientsVisible(worldPosition, ngf, wo, c) : probeCoefficients(worldPosition, c)) {
     if (pc.volumeDims.w != 0.0) hallucinateZh3(c);
-    float roughness = m.emissionRoughness.a;
     vec3 f0 = mix(vec3(0.04), base, metallic);
-    indirect = base * (1.0 - metallic) / PI * probeIrradiance(c, n) +
-               probeGlossy(c, reflect(-wo, n), roughness, clamp(dot(n, wo), 0.0, 1.0), f0);
+    indirect = materialOcclusion(m, texcoord) *
+               (base * (1.0 - metallic) / PI * probeIrradiance(c, n) +
+                probeGlossy(c, reflect(-wo, n), roughness, clamp(dot(n, wo), 0.0, 1.0), f0));
   }
   outColor = vec4(emission + (1.0 - tau) * (direct + indirect), 1.0);
 }

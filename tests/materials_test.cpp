@@ -326,5 +326,96 @@ TEST_F(Materials, ShadingNormalBelowTheViewIsBentTheSameWayInTracerAndRaster) {
     }
 }
 
+// One texel of linear data: the channels as stored (a metallic-roughness or occlusion texture).
+scene::Texture dataTexel(uint8_t r, uint8_t g, uint8_t b) {
+  scene::Texture t;
+  t.width = t.height = 1;
+  t.rgba = {r, g, b, 255};
+  return t;
+}
+
+// A grey square filling the front camera, lit by a point light beside the camera: its highlight
+// depends on metallic and roughness.
+Scene litSquare(const Material& m, const std::vector<scene::Texture>& textures) {
+  Scene s;
+  s.textures = textures;
+  addFacingSquare(s, -1.0f, 1.0f, addMaterial(s, m));
+  scene::Light bulb;
+  bulb.position = {0.3f, 0.3f, -0.2f};
+  bulb.intensity = 0.5f;
+  s.lights.push_back(bulb);
+  scene::finalizeScene(s);
+  return s;
+}
+
+double maxRelativeDifference(const Image& a, const Image& b) {
+  double worst = 0.0;
+  for (size_t i = 0; i < a.rgb.size(); ++i)
+    worst = std::max(worst, std::fabs(static_cast<double>(a.rgb[i]) - b.rgb[i]) / std::max(1e-3, std::fabs(static_cast<double>(b.rgb[i]))));
+  return worst;
+}
+
+TEST_F(Materials, MetallicRoughnessTextureScalesTheFactorsByItsBlueAndGreenAsStored) {
+  // glTF: metallic = metallicFactor × B, roughness = roughnessFactor × G, the texture's values as
+  // stored (linear, not sRGB). Factors 1 and 1 with a texel (255, 128, 0) must shade exactly as
+  // metallic 0, roughness 128/255 without a texture, in the raster client and the path tracer;
+  // reading G as sRGB (roughness 0.216) or B as metallic 1 shades otherwise.
+  Material grey;
+  grey.baseColor = glm::vec3(0.5f);
+  Material textured = grey;
+  textured.metallic = 1.0f;
+  textured.roughness = 1.0f;
+  textured.metallicRoughnessTexture = 0;
+  Material plain = grey;
+  plain.metallic = 0.0f;
+  plain.roughness = 128.0f / 255.0f;
+  Material asSrgb = plain;
+  asSrgb.roughness = 0.2158605f;  // the sRGB decoding of 128/255
+  Material metal = plain;
+  metal.metallic = 1.0f;
+  const Scene a = litSquare(textured, {dataTexel(255, 128, 0)}), b = litSquare(plain, {}), c = litSquare(asSrgb, {}),
+              d = litSquare(metal, {});
+  const CameraView cam = frontCamera();
+  const Image ra = rasterImage(*context_, a, cam, 32), rb = rasterImage(*context_, b, cam, 32);
+  EXPECT_LT(maxRelativeDifference(ra, rb), 1e-4);
+  EXPECT_GT(maxRelativeDifference(rasterImage(*context_, c, cam, 32), rb), 0.05);
+  EXPECT_GT(maxRelativeDifference(rasterImage(*context_, d, cam, 32), rb), 0.05);
+  const Image ta = referenceImage(*context_, a, cam, 16, 16), tb = referenceImage(*context_, b, cam, 16, 16);
+  EXPECT_LT(maxRelativeDifference(ta, tb), 1e-3);
+  EXPECT_GT(maxRelativeDifference(referenceImage(*context_, d, cam, 16, 16), tb), 0.05);
+}
+
+TEST_F(Materials, OcclusionTextureDimsOnlyTheRasterClientsProbeLightByItsStrength) {
+  // occlusion = 1 + strength × (R − 1): R = 0 at strength 0.5 halves the probe light the raster
+  // client shades with (no lights, no emission here); the path tracer ignores the texture.
+  Material white;
+  white.baseColor = glm::vec3(1.0f);
+  Material occluded = white;
+  occluded.occlusionTexture = 0;
+  occluded.occlusionStrength = 0.5f;
+  const auto unlit = [](const Material& m) {
+    Scene s;
+    s.textures = {dataTexel(0, 255, 255)};
+    addFacingSquare(s, -1.0f, 1.0f, addMaterial(s, m));
+    scene::finalizeScene(s);
+    return s;
+  };
+  const Scene open = unlit(white), dim = unlit(occluded);
+  ProbeVolume v = makeProbeVolume(ProbeGrid{{2, 2, 2}, {{-1, -1, -1.5f}, {1, 1, 0}}});
+  for (int p = 0; p < 8; ++p)
+    for (int c = 0; c < 3; ++c) v.probes[p * 27 + c] = 1.0f;
+  const CameraView cam = frontCamera();
+  const auto render = [&](const Scene& s) {
+    RasterOptions ro;
+    ro.visibility = false;
+    RasterRenderer raster(*context_, s, 16, 16, ro);
+    raster.setProbes(v);
+    return raster.render(raster.viewProjection(cam), cam.position);
+  };
+  const Image full = render(open), half = render(dim);
+  ASSERT_GT(channelMean(full, 0), 0.01);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(channelMean(half, c) / channelMean(full, c), 0.5, 1e-4);
+}
+
 }  // namespace
 }  // namespace probecast::renderer

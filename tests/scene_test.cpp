@@ -223,6 +223,33 @@ TEST(Scene, AlphaModesTransmissionAndTextureTransformsAreLoaded) {
   for (uint32_t t = 2; t < 6; ++t) EXPECT_EQ(triangleClass(s, t), 2u);
 }
 
+TEST(Scene, MetallicRoughnessAndOcclusionTexturesAreReadWithTheirTransformsAndStrength) {
+  const std::string dir = PROBECAST_TEST_TMP;
+  test::writeFile(dir + "/mr.png", test::pngFile(1, 1, 3, 8, {255, 128, 0}));
+  std::vector<test::GltfQuad> quads(1);
+  quads[0].corners[0] = {0, 0, 0}, quads[0].corners[1] = {1, 0, 0}, quads[0].corners[2] = {1, 1, 0};
+  quads[0].corners[3] = {0, 1, 0};
+  const std::string path = test::writeQuadGltf(
+      dir, "mr", quads,
+      R"({"pbrMetallicRoughness":{"metallicFactor":0.5,"roughnessFactor":0.25,)"
+      R"("metallicRoughnessTexture":{"index":0,"texCoord":1}},"occlusionTexture":{"index":0,"strength":0.7,)"
+      R"("extensions":{"KHR_texture_transform":{"offset":[0.5,0]}}}})",
+      R"({"source":0})", R"({"uri":"mr.png"})", R"("extensionsUsed":["KHR_texture_transform"],)");
+  Scene s;
+  std::string error;
+  ASSERT_TRUE(loadGltf(path, s, error)) << error;
+  const Material& m = s.materials[0];
+  EXPECT_FLOAT_EQ(m.metallic, 0.5f);
+  EXPECT_FLOAT_EQ(m.roughness, 0.25f);
+  ASSERT_GE(m.metallicRoughnessTexture, 0);
+  EXPECT_EQ(m.metallicRoughnessTransform.texCoord, 1u);
+  EXPECT_EQ(m.occlusionTexture, m.metallicRoughnessTexture);  // one image, converted once
+  EXPECT_FLOAT_EQ(m.occlusionStrength, 0.7f);
+  EXPECT_FLOAT_EQ(m.occlusionTransform.row0.z, 0.5f);
+  const Texture& t = s.textures[m.metallicRoughnessTexture];
+  EXPECT_EQ(std::vector<uint8_t>(t.rgba.begin(), t.rgba.end()), (std::vector<uint8_t>{255, 128, 0, 255}));
+}
+
 TEST(Scene, SixteenBitPngIsReadAsItsTopEightBitsRounded) {
   // RGBA16 texels: 0x8080 → 128, 0xffff → 255, 0x4000 → round(16384 · 255 / 65535) = 64, 0 → 0;
   // a 16-bit grey + alpha image expands grey to RGB.

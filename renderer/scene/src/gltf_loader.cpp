@@ -223,6 +223,14 @@ void convertMaterials(const tinygltf::Model& model, Scene& scene) {
     out.emissiveTexture = convertTexture(model, m.emissiveTexture.index, imageToTexture, scene);
     out.baseColorTransform = textureTransform(pbr.baseColorTexture.extensions, pbr.baseColorTexture.texCoord);
     out.emissiveTransform = textureTransform(m.emissiveTexture.extensions, m.emissiveTexture.texCoord);
+    out.metallicRoughnessTexture = convertTexture(model, pbr.metallicRoughnessTexture.index, imageToTexture, scene);
+    out.metallicRoughnessTransform =
+        textureTransform(pbr.metallicRoughnessTexture.extensions, pbr.metallicRoughnessTexture.texCoord);
+    out.occlusionTexture = convertTexture(model, m.occlusionTexture.index, imageToTexture, scene);
+    out.occlusionTransform = textureTransform(m.occlusionTexture.extensions, m.occlusionTexture.texCoord);
+    out.occlusionStrength = std::isfinite(m.occlusionTexture.strength)
+                                ? std::clamp(static_cast<float>(m.occlusionTexture.strength), 0.0f, 1.0f)
+                                : 1.0f;
     out.alpha = pbr.baseColorFactor.size() == 4 ? std::clamp(static_cast<float>(pbr.baseColorFactor[3]), 0.0f, 1.0f)
                                                 : 1.0f;
     out.alphaMode = m.alphaMode == "MASK"    ? AlphaMode::Mask

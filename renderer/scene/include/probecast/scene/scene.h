@@ -38,6 +38,15 @@ struct Material {
   int32_t emissiveTexture = -1;   // index into Scene::textures, multiplies emission
   TextureTransform baseColorTransform;
   TextureTransform emissiveTransform;
+  // Data textures, read linearly (no sRGB decoding): metallicRoughnessTexture's blue channel
+  // multiplies `metallic` and its green `roughness` (every renderer); occlusionTexture's red is the
+  // share of indirect light that reaches the point, 1 + occlusionStrength × (r − 1), which only
+  // the raster client applies to its probe light (the tracers find occlusion by tracing).
+  int32_t metallicRoughnessTexture = -1;
+  int32_t occlusionTexture = -1;
+  float occlusionStrength = 1.0f;
+  TextureTransform metallicRoughnessTransform;
+  TextureTransform occlusionTransform;
   // Coverage: a = alpha (baseColorFactor.a) × the base colour texture's alpha.
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alpha = 1.0f;
