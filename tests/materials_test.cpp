@@ -334,16 +334,18 @@ scene::Texture dataTexel(uint8_t r, uint8_t g, uint8_t b) {
   return t;
 }
 
-// A grey square filling the front camera, lit by a point light beside the camera: its highlight
-// depends on metallic and roughness.
-Scene litSquare(const Material& m, const std::vector<scene::Texture>& textures) {
+// A square of `m` filling the front camera, lit (`bulb`) by a point light beside the camera: its
+// highlight depends on metallic and roughness.
+Scene squareScene(const Material& m, const std::vector<scene::Texture>& textures, bool bulb = true) {
   Scene s;
   s.textures = textures;
   addFacingSquare(s, -1.0f, 1.0f, addMaterial(s, m));
-  scene::Light bulb;
-  bulb.position = {0.3f, 0.3f, -0.2f};
-  bulb.intensity = 0.5f;
-  s.lights.push_back(bulb);
+  if (bulb) {
+    scene::Light l;
+    l.position = {0.3f, 0.3f, -0.2f};
+    l.intensity = 0.5f;
+    s.lights.push_back(l);
+  }
   scene::finalizeScene(s);
   return s;
 }
@@ -373,8 +375,8 @@ TEST_F(Materials, MetallicRoughnessTextureScalesTheFactorsByItsBlueAndGreenAsSto
   asSrgb.roughness = 0.2158605f;  // the sRGB decoding of 128/255
   Material metal = plain;
   metal.metallic = 1.0f;
-  const Scene a = litSquare(textured, {dataTexel(255, 128, 0)}), b = litSquare(plain, {}), c = litSquare(asSrgb, {}),
-              d = litSquare(metal, {});
+  const Scene a = squareScene(textured, {dataTexel(255, 128, 0)}), b = squareScene(plain, {}),
+              c = squareScene(asSrgb, {}), d = squareScene(metal, {});
   const CameraView cam = frontCamera();
   const Image ra = rasterImage(*context_, a, cam, 32), rb = rasterImage(*context_, b, cam, 32);
   EXPECT_LT(maxRelativeDifference(ra, rb), 1e-4);
@@ -393,14 +395,8 @@ TEST_F(Materials, OcclusionTextureDimsOnlyTheRasterClientsProbeLightByItsStrengt
   Material occluded = white;
   occluded.occlusionTexture = 0;
   occluded.occlusionStrength = 0.5f;
-  const auto unlit = [](const Material& m) {
-    Scene s;
-    s.textures = {dataTexel(0, 255, 255)};
-    addFacingSquare(s, -1.0f, 1.0f, addMaterial(s, m));
-    scene::finalizeScene(s);
-    return s;
-  };
-  const Scene open = unlit(white), dim = unlit(occluded);
+  const Scene open = squareScene(white, {dataTexel(0, 255, 255)}, false),
+              dim = squareScene(occluded, {dataTexel(0, 255, 255)}, false);
   ProbeVolume v = makeProbeVolume(ProbeGrid{{2, 2, 2}, {{-1, -1, -1.5f}, {1, 1, 0}}});
   for (int p = 0; p < 8; ++p)
     for (int c = 0; c < 3; ++c) v.probes[p * 27 + c] = 1.0f;
