@@ -41,6 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (uint32_t i : x.indices) require(i < x.positions.size());
     for (uint32_t m : x.triangleMaterial) require(m < x.materials.size());
     require(x.normals.size() == x.positions.size());
+    for (const glm::vec3& p : x.positions) require(std::isfinite(p.x + p.y + p.z));
     require(std::isfinite(x.boundsMin.x + x.boundsMin.y + x.boundsMin.z + x.boundsMax.x + x.boundsMax.y + x.boundsMax.z));
   };
   check(s);

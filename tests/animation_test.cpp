@@ -132,7 +132,8 @@ struct TestRig {
   static constexpr float kSin45 = 0.70710678f;
 };
 
-TestRig writeTestRig(const std::string& name, bool badJoint = false, bool badTimes = false, bool nanValue = false) {
+TestRig writeTestRig(const std::string& name, bool badJoint = false, bool badTimes = false, bool nanValue = false,
+                     bool hugeCount = false) {
   RigFile f;
   const int tri = f.floats({0, 0, 0, 0.1f, 0, 0, 0, 0.1f, 0}, "VEC3", 3);
   // Skinned: v0 (0, 0.5, 0) on j0, v1 (0, 1.5, 0) on j1, v2 (0, 1.2, 0) half and half.
@@ -177,6 +178,10 @@ TestRig writeTestRig(const std::string& name, bool badJoint = false, bool badTim
       "{\"sampler\":1,\"target\":{\"node\":5,\"path\":\"weights\"}},"
       "{\"sampler\":2,\"target\":{\"node\":6,\"path\":\"translation\"}},"
       "{\"sampler\":3,\"target\":{\"node\":7,\"path\":\"translation\"}}]}]";
+  if (hugeCount) {  // the two key times' accessor claims 2^62 elements: a size that wraps if multiplied unchecked
+    const std::string two = "\"count\":2,\"type\":\"SCALAR\"";
+    f.accessors.replace(f.accessors.find(two), two.size(), "\"count\":4611686018427387904,\"type\":\"SCALAR\"");
+  }
   return {f.write(name, body)};
 }
 
@@ -270,6 +275,8 @@ TEST(GltfAnimation, MalformedAnimationsAreRefusedWithTheReason) {
   EXPECT_NE(error.find("key times must be finite, not negative and increasing"), std::string::npos) << error;
   EXPECT_FALSE(loadScene(writeTestRig("nan-value", false, false, true).path, 0.0, s, error));
   EXPECT_NE(error.find("output holds NaN or Inf"), std::string::npos) << error;
+  EXPECT_FALSE(loadScene(writeTestRig("huge-count", false, false, false, true).path, 0.0, s, error));
+  EXPECT_NE(error.find("reads past the end of its buffer"), std::string::npos) << error;
 }
 
 TEST(GltfAnimation, AnimatedCornellBoxMovesItsCubeAndBendsItsArm) {

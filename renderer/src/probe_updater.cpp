@@ -97,10 +97,11 @@ ProbeGrid sceneGrid(const scene::Scene& scene, const std::array<uint32_t, 3>& di
   return cellCentredGrid(dims.data(), &scene.boundsMin.x, &scene.boundsMax.x);
 }
 
-// The probes within one cell of a triangle that moved between `before` and `after` (positions of
-// the same triangles): the grid points in the box around its old and new corners, grown by a cell.
+// The probes near a triangle that moved between `before` and `after` (positions of the same
+// triangles): the grid points in the box around its old and new corners, grown by `margin` cells.
 std::vector<uint32_t> probesNearMoved(const ProbeGrid& grid, const std::vector<glm::vec3>& before,
-                                      const std::vector<glm::vec3>& after, const std::vector<uint32_t>& indices) {
+                                      const std::vector<glm::vec3>& after, const std::vector<uint32_t>& indices,
+                                      float margin) {
   std::vector<uint8_t> near(grid.count(), 0);
   glm::vec3 lo, cell;
   glm::ivec3 dims;
@@ -124,7 +125,13 @@ std::vector<uint32_t> probesNearMoved(const ProbeGrid& grid, const std::vector<g
         to[a] = dims[a] - 1;
         continue;
       }
-      const float f = std::ceil((bmin[a] - cell[a] - lo[a]) / cell[a]), c = std::floor((bmax[a] + cell[a] - lo[a]) / cell[a]);
+      const float f = std::ceil((bmin[a] - margin * cell[a] - lo[a]) / cell[a]),
+                  c = std::floor((bmax[a] + margin * cell[a] - lo[a]) / cell[a]);
+      if (!std::isfinite(f) || !std::isfinite(c)) {  // not expected (poses stay finite): every probe
+        from[a] = 0;
+        to[a] = dims[a] - 1;
+        continue;
+      }
       from[a] = static_cast<int>(std::clamp(f, 0.0f, static_cast<float>(dims[a] - 1)));
       to[a] = static_cast<int>(std::clamp(c, 0.0f, static_cast<float>(dims[a] - 1)));
     }
@@ -461,7 +468,10 @@ void ProbeUpdater::setScene(const scene::Scene& scene) {
   const bool shadingChanged = s.shadingChanged(scene);
   if (geometryChanged && sameTriangles) {
     // Moved geometry: only the probes around it are classified again and restarted.
-    const std::vector<uint32_t> near = probesNearMoved(s.volume.grid, s.geometryPositions, scene.positions, scene.indices);
+    // A relocated probe stands up to relocateMaxShift of a cell from its grid point: the margin grows by that.
+    const float margin = 1.0f + (s.volume.offsets.empty() ? 0.0f : std::clamp(s.options.relocateMaxShift, 0.0f, 0.5f));
+    const std::vector<uint32_t> near =
+        probesNearMoved(s.volume.grid, s.geometryPositions, scene.positions, scene.indices, margin);
     s.setGeometry(scene, s.options.refitMovingGeometry);
     s.reclassify(near);
   } else if (geometryChanged) {

@@ -641,7 +641,9 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   if (moved) {
     // New clusters (their bounds moved); the depth cubes of the probes within reach of a moved
     // triangle are drawn again, the others keep theirs.
-    setProbeVisibilityScene(scene, s.visibility, true);
+    // Without a visibility in use the next build draws every probe (nothing cached survives a move).
+    setProbeVisibilityScene(scene, s.visibility, s.visibilityBuilt && s.push.visibility);
+    s.writeDescriptors();  // the uploads above replaced buffers the cut-out depth pass reads
     s.timings.geometryMoves += 1;
     s.timings.visibilityProbesRedrawn =
         redrawProbeVisibility(*s.d, s.gpu, s.set, redraw, s.visibilityFar, s.options.visibilityCulling, s.visibility);

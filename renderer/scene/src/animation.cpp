@@ -122,7 +122,9 @@ void posePrimitive(const Rig& rig, const RigPrimitive& p, const std::vector<RigN
       }
       nm = glm::transpose(glm::inverse(glm::mat3(m)));
     }
-    scene.positions[p.firstVertex + v] = glm::vec3(m * glm::vec4(pos, 1.0f));
+    // A pose that overflows (huge scales, tangents) keeps the vertex where it was.
+    const glm::vec3 moved = glm::vec3(m * glm::vec4(pos, 1.0f));
+    if (std::isfinite(moved.x + moved.y + moved.z)) scene.positions[p.firstVertex + v] = moved;
     if (p.normalsGiven) scene.normals[p.firstVertex + v] = unitOr(nm * nrm, glm::vec3(0.0f));
   }
   if (p.normalsGiven) return;
@@ -203,12 +205,16 @@ void poseScene(Scene& scene, double seconds) {
   for (const RigPrimitive& p : rig.primitives) posePrimitive(rig, p, nodes, world, scene);
   for (const Rig::Attached& a : rig.lights) {
     Light& l = scene.lights[a.index];
-    l.position = glm::vec3(world[a.node][3]);
+    const glm::vec3 at(world[a.node][3]);
+    if (!std::isfinite(at.x + at.y + at.z)) continue;
+    l.position = at;
     l.direction = unitOr(glm::vec3(world[a.node] * glm::vec4(0, 0, -1, 0)), glm::vec3(0, -1, 0));
   }
   for (const Rig::Attached& a : rig.cameras) {
     Camera& c = scene.cameras[a.index];
-    c.position = glm::vec3(world[a.node][3]);
+    const glm::vec3 at(world[a.node][3]);
+    if (!std::isfinite(at.x + at.y + at.z)) continue;
+    c.position = at;
     c.forward = unitOr(glm::vec3(world[a.node] * glm::vec4(0, 0, -1, 0)), glm::vec3(0, 0, -1));
     c.up = unitOr(glm::vec3(world[a.node] * glm::vec4(0, 1, 0, 0)), glm::vec3(0, 1, 0));
   }

@@ -69,10 +69,16 @@ class AccessorReader {
       return;
     }
     stride_ = view.byteStride ? view.byteStride : static_cast<size_t>(components_ * componentSize_);
-    const size_t begin = view.byteOffset + acc_->byteOffset;
     const size_t elementBytes = static_cast<size_t>(components_ * componentSize_);
-    const size_t need = acc_->count == 0 ? 0 : (acc_->count - 1) * stride_ + elementBytes;
-    if (begin > buffer.data.size() || need > buffer.data.size() - begin || acc_->byteOffset + need > view.byteLength) {
+    // Every product and sum checked against the buffer before it is formed (a huge count must not wrap).
+    const size_t size = buffer.data.size();
+    const bool offsetsFit = view.byteOffset <= size && acc_->byteOffset <= size - view.byteOffset;
+    const size_t begin = offsetsFit ? view.byteOffset + acc_->byteOffset : 0;
+    const size_t room = offsetsFit ? size - begin : 0;
+    const bool countFits = acc_->count == 0 || (elementBytes <= room && stride_ > 0 &&
+                                                acc_->count - 1 <= (room - elementBytes) / stride_);
+    const size_t need = countFits && acc_->count ? (acc_->count - 1) * stride_ + elementBytes : 0;
+    if (!offsetsFit || !countFits || acc_->byteOffset > view.byteLength || need > view.byteLength - acc_->byteOffset) {
       error = "accessor " + std::to_string(index) + " reads past the end of its buffer";
       return;
     }
