@@ -76,6 +76,8 @@ case "$cmd" in
       echo "fuzz: running ${target}_fuzz for ${share}s"
       log=build-fuzz/fuzz-$target.log
       rc=0
+      # Undefined behaviour fails the run, as a crash does (UBSan only reports it otherwise).
+      UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       "./build-fuzz/fuzz/${target}_fuzz" -max_total_time="$share" -print_final_stats=1 -artifact_prefix=build-fuzz/ \
         "$corpus" "$seeds" >"$log" 2>&1 || rc=$?
       grep -E '^(Done|stat::(number_of_executed_units|new_units_added)|==[0-9]+==|SUMMARY|.*artifact)' "$log" || true

@@ -94,7 +94,9 @@ void finalizeScene(Scene& s) {
   for (uint32_t t = 0; t < count; ++t) {
     const glm::vec3 c =
         (s.positions[s.indices[3 * t]] + s.positions[s.indices[3 * t + 1]] + s.positions[s.indices[3 * t + 2]]) / 3.0f;
-    const glm::vec3 u = glm::clamp((c - s.boundsMin) / extent, 0.0f, 1.0f) * 1023.0f;
+    glm::vec3 u = glm::clamp((c - s.boundsMin) / extent, 0.0f, 1.0f) * 1023.0f;
+    for (int a = 0; a < 3; ++a)
+      if (!(u[a] >= 0.0f && u[a] <= 1023.0f)) u[a] = 0.0f;  // non-finite corners (the loader then refuses the scene)
     // The class in bits 32-33 keeps each class one run; within it the triangles that never move
     // come first, those that move after (bit 31), each in Morton order.
     code[t] = (uint64_t{triangleClass(s, t)} << 32) | (uint64_t{moves[t]} << 31) | spreadBits(static_cast<uint32_t>(u.x)) |
