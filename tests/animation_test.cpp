@@ -182,7 +182,8 @@ TestRig writeTestRig(const std::string& name, bool badJoint = false, bool badTim
     const std::string two = "\"count\":2,\"type\":\"SCALAR\"";
     f.accessors.replace(f.accessors.find(two), two.size(), "\"count\":4611686018427387904,\"type\":\"SCALAR\"");
   }
-  return {f.write(name, body)};
+  // ctest runs the tests of this file in parallel: each writes files of its own.
+  return {f.write(name + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name(), body)};
 }
 
 // The posed vertices of the primitive on `node`.
