@@ -1,10 +1,12 @@
 // `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "live_window.h"
 #include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/codec/probe_file.h"
@@ -30,6 +32,7 @@ struct ViewOptions {
   std::vector<uint32_t> size{320, 200};
   uint32_t updates = 4;
   uint32_t supersample = renderer::RasterOptions{}.samplesPerSide;  // raster samples per pixel side
+  uint32_t msaa = renderer::RasterOptions{}.msaaSamples;
   float exposure = 1.0f;
   bool exr = false;
   bool visibility = true;
@@ -37,6 +40,55 @@ struct ViewOptions {
   bool visibilityCulling = true;
   std::string sceneCache;             // --connect: where fetched scenes are kept (empty: the default)
   uint64_t sceneMaxBytes = uint64_t{4} << 30;
+  LiveWindowOptions window;
+};
+
+imaging::ToneMap toneMapOf(const ViewOptions& o) {
+  imaging::ToneMap toneMap = imaging::ToneMap::Filmic;
+  imaging::parseToneMap(o.toneMap, toneMap);
+  return toneMap;
+}
+
+// A stream's state for the status line: connection, stalls, bytes per second.
+class StreamStatus {
+ public:
+  explicit StreamStatus(const session::Viewer& viewer) : viewer_(viewer) {}
+  std::string line() {
+    const service::ClientStats st = viewer_.clientStats();
+    const auto now = std::chrono::steady_clock::now();
+    if (st.framesApplied != lastFrames_) {
+      lastFrames_ = st.framesApplied;
+      lastFrameAt_ = now;
+    }
+    const double window = std::chrono::duration<double>(now - rateFrom_).count();
+    if (window >= 1.0) {
+      rate_ = static_cast<double>(st.bytesReceived - rateBytes_) / window;
+      rateBytes_ = st.bytesReceived;
+      rateFrom_ = now;
+    }
+    std::string state;
+    if (st.fatal)
+      state = "refused: " + st.lastError;
+    else if (!st.connected)
+      state = "reconnecting" + (st.lastError.empty() ? std::string() : ": " + st.lastError);
+    else if (st.framesApplied == 0)
+      state = "connected, waiting for the first volume";
+    else if (const double quiet = std::chrono::duration<double>(now - lastFrameAt_).count(); quiet > 2.0)
+      state = fmt::format("connected to {}, no new lighting for {:.0f} s", st.address, quiet);
+    else
+      state = "connected to " + st.address;
+    if (st.framesApplied == 0) return state;
+    return fmt::format("t {:.2f} s | probes {:.2f} s old | {:.1f} kB/s | {}", viewer_.displayTime(),
+                       viewer_.probeAge(), rate_ / 1e3, state);
+  }
+
+ private:
+  const session::Viewer& viewer_;
+  uint32_t lastFrames_ = 0;
+  std::chrono::steady_clock::time_point lastFrameAt_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point rateFrom_ = std::chrono::steady_clock::now();
+  uint64_t rateBytes_ = 0;
+  double rate_ = 0.0;
 };
 
 struct Rendered {
@@ -52,11 +104,9 @@ void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set) 
     fmt::print("view: client area lights off (the probes hold every emitter)\n");
 }
 
-// A viewer of a server's stream: subscribe for --wait seconds, then render what it holds at its
-// display clock (`sceneSpec` shaded at the display time).
-Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
-                          const std::string& sceneSpec, const std::vector<renderer::ViewInfo>& views,
-                          const renderer::RasterOptions& ro) {
+// A viewer of the stream --connect names, drawing `sceneSpec` at its display clock.
+session::ViewerConfig streamViewerConfig(const ViewOptions& o, const std::string& sceneSpec,
+                                         const renderer::RasterOptions& ro) {
   session::ViewerConfig vc;
   vc.width = o.size[0];
   vc.height = o.size[1];
@@ -66,7 +116,15 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   if (o.repr != "float") vc.client.representation = session::parseRepresentationOrThrow(o.repr);  // transcoded
   if (o.areaLights.mode != "auto") vc.areaLights = o.areaLights.mode == "on";
   vc.sceneSpec = sceneSpec;  // direct light at the display clock, locked to the stream's
-  session::Viewer viewer(context, s, views, vc);
+  return vc;
+}
+
+// A viewer of a server's stream: subscribe for --wait seconds, then render what it holds at its
+// display clock (`sceneSpec` shaded at the display time).
+Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                          const std::string& sceneSpec, const std::vector<renderer::ViewInfo>& views,
+                          const renderer::RasterOptions& ro) {
+  session::Viewer viewer(context, s, views, streamViewerConfig(o, sceneSpec, ro));
   viewer.start();
   viewer.waitFor(o.waitSeconds);
   viewer.stop();
@@ -127,6 +185,83 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
   return r;
 }
 
+// A live window on a server's stream: every display frame drawn at the display clock from the
+// newest volume held, through stalls and reconnects.
+void windowFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                      const std::string& sceneSpec, const renderer::ViewSetSpec& spec,
+                      const renderer::ViewSetOptions& vso, const renderer::RasterOptions& ro) {
+  const renderer::CameraView start = renderer::CameraView::fromScene(s);
+  session::Viewer viewer(context, s, renderer::makeViewSet(start, spec, vso), streamViewerConfig(o, sceneSpec, ro));
+  viewer.start();
+  StreamStatus status(viewer);
+  FrameSource source;
+  auto lastTold = std::chrono::steady_clock::now();
+  bool untold = false;  // the server's priority has not seen the camera's latest views
+  source.render = [&](const std::vector<renderer::ViewInfo>& views, bool moved, std::vector<renderer::Image>& images) {
+    // The server ranks bricks by these views: told at most 4 times a second while the camera moves.
+    untold = untold || moved;
+    const bool tell = untold && std::chrono::steady_clock::now() - lastTold > std::chrono::milliseconds(250);
+    if (moved || tell) viewer.setViews(views, tell);
+    if (tell) {
+      lastTold = std::chrono::steady_clock::now();
+      untold = false;
+    }
+    if (!viewer.render()) return false;
+    images = viewer.images();
+    return true;
+  };
+  source.status = [&] { return status.line(); };
+  runLiveWindow(o.window, context, start, spec, vso, o.size[0], o.size[1],
+                glm::length(s.boundsMax - s.boundsMin), source, o.out, o.exposure, toneMapOf(o));
+  viewer.stop();
+  const service::ClientStats st = viewer.clientStats();
+  if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
+}
+
+// A live window on local probes: a file's, or traced one update per frame up to --updates.
+void windowLocal(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                 const renderer::ViewSetSpec& spec, const renderer::ViewSetOptions& vso, renderer::RasterOptions ro) {
+  std::unique_ptr<renderer::ProbeUpdater> updater;
+  ProbeVolume volume;
+  AreaLightRule rule;
+  if (o.probes == "live") {
+    renderer::UpdaterOptions uo = o.tracing.updater(ro.environment);
+    ro.areaLights = o.areaLights.options();
+    uo.areaLights = ro.areaLights;
+    updater = std::make_unique<renderer::ProbeUpdater>(context, s, o.tracing.grid.resolve(s), uo);
+    rule = session::areaLightRuleOf(uo.areaLights);
+  } else {
+    std::string error;
+    orThrow(readProbeFile(o.probes, volume, error), error);
+    ro.areaLights = o.areaLights.follow(volume.areaLights, o.probes);
+  }
+  renderer::RasterRenderer raster(context, s, o.size[0], o.size[1], ro);
+  auto upload = [&](ProbeVolume v) {
+    if (o.repr != "float") v = decodeAs(v, session::parseRepresentationOrThrow(o.repr), /*zh3PerPixel=*/true);
+    raster.setProbes(v);
+  };
+  if (!updater) upload(volume);
+  uint32_t done = 0;
+  FrameSource source;
+  source.render = [&](const std::vector<renderer::ViewInfo>& views, bool, std::vector<renderer::Image>& images) {
+    if (updater && done < o.updates) {  // the light converges on screen
+      updater->update();
+      ++done;
+      ProbeVolume v = updater->volume();
+      v.areaLights = rule;
+      upload(std::move(v));
+    }
+    images = raster.renderViews(views);
+    return true;
+  };
+  source.status = [&] {
+    return updater ? fmt::format("traced here: update {}/{}", done, o.updates) : "probes from " + o.probes;
+  };
+  const renderer::CameraView start = renderer::CameraView::fromScene(s);
+  runLiveWindow(o.window, context, start, spec, vso, o.size[0], o.size[1], glm::length(s.boundsMax - s.boundsMin),
+                source, o.out, o.exposure, toneMapOf(o));
+}
+
 // The scene a --connect viewer draws: the stream's (fetched, or its own --scene checked against it).
 session::ViewerScene streamScene(const ViewOptions& o) {
   const service::ClientConfig cc = o.connection.client("probecast-view");
@@ -182,6 +317,11 @@ void addViewCommand(CLI::App& app) {
                   "one sample at the pixel's centre, about N² times faster)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
+  cmd->add_option("--msaa", o->msaa,
+                  "multisample anti-aliasing: 1 (off), 2, 4 or 8 coverage samples per pixel, shaded once (with "
+                  "--supersample 1: smooth edges at about the cost of one sample)")
+      ->check(CLI::IsMember({1, 2, 4, 8}))
+      ->capture_default_str();
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
@@ -200,6 +340,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--visibility-culling", o->visibilityCulling,
                   "on: each depth-cube face draws only the triangles within reach; off: all (same result)");
   o->areaLights.add(cmd, /*follows=*/true);
+  o->window.add(cmd);
   cmd->add_option("--scene-cache", o->sceneCache,
                   "--connect: folder of scenes fetched from servers, by hash (default $PROBECAST_SCENE_CACHE, else "
                   "~/.cache/probecast/scenes)");
@@ -229,7 +370,11 @@ void addViewCommand(CLI::App& app) {
     const scene::Scene s = session::loadSceneOrThrow(sceneSpec, t);
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
         renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
-    renderer::VulkanContext context(o->tracing.device.context());
+    // Only live probes are traced here: every other viewer rasterises, on any Vulkan 1.3 device.
+    renderer::ContextOptions co =
+        o->tracing.device.context(/*rayTracing=*/o->connection.connect.empty() && o->probes == "live");
+    if (o->window.enabled) co = LiveWindowOptions::presenting(co);
+    renderer::VulkanContext context(co);
     renderer::RasterOptions ro;
     ro.passes = o->passes == "multiview" ? renderer::ViewPasses::Multiview : renderer::ViewPasses::PerView;
     ro.shadowMapSize = o->shadowMap;
@@ -239,7 +384,16 @@ void addViewCommand(CLI::App& app) {
     ro.visibilityCulling = o->visibilityCulling;
     ro.environment = environment;
     ro.samplesPerSide = o->supersample;
+    ro.msaaSamples = o->msaa;
     renderer::checkRasterSize(o->size[0], o->size[1], ro);  // before any tracing or connecting
+    if (o->window.enabled) {
+      const renderer::ViewSetOptions vso = session::viewSetOptions(s, o->size[0], o->size[1]);
+      if (o->connection.connect.empty())
+        windowLocal(*o, context, s, spec, vso, ro);
+      else
+        windowFromServer(*o, context, s, sceneSpec, spec, vso, ro);
+      return;
+    }
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, sceneSpec, views, ro);
     writeViews(*o, r, views, spec);

@@ -73,7 +73,7 @@ service::ServerConfig startServer(const DemoOptions& o, DemoRun& run) {
 
 // The viewers on a Vulkan device of their own (a headset and a display are other machines).
 void startViewers(const DemoOptions& o, const service::ServerConfig& server, DemoRun& run) {
-  run.viewerContext = std::make_unique<renderer::VulkanContext>(o.device.context());
+  run.viewerContext = std::make_unique<renderer::VulkanContext>(o.device.context(/*rayTracing=*/false));
   run.viewers.resize(2);
   run.viewers[0].name = "headset";
   run.viewers[0].viewSet = "stereo";

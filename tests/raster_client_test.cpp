@@ -93,6 +93,41 @@ TEST(RasterClient, CornellWithUpdatedProbesRendersLitAndDeterministic) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+TEST(RasterClient, RasterOnlyDeviceDrawsWhatARayTracingOneDraws) {
+  // A viewer's device asks for no ray-tracing extension (headset and mobile GPUs have none): the
+  // picture is the same bit for bit, and tracing on such a device is refused by name.
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
+  Image traced;
+  ProbeVolume v;
+  {
+    VulkanContext context(test::validatedContext());
+    ASSERT_TRUE(context.rayTracing());
+    v = onceUpdatedProbes(context, s, 4, 32);
+    RasterRenderer raster(context, s, 40, 30);
+    raster.setProbes(v);
+    const CameraView cam = CameraView::fromScene(s);
+    traced = raster.render(raster.viewProjection(cam), cam.position);
+  }
+  ContextOptions options = test::validatedContext();
+  options.rayTracing = false;
+  VulkanContext rasterOnly(options);
+  EXPECT_FALSE(rasterOnly.rayTracing());
+  RasterRenderer raster(rasterOnly, s, 40, 30);
+  raster.setProbes(v);
+  scene::Scene moved = s;  // a move too: shading and visibility redraws need no acceleration structure
+  raster.setShading(moved);
+  const CameraView cam = CameraView::fromScene(s);
+  const Image img = raster.render(raster.viewProjection(cam), cam.position);
+  EXPECT_EQ(img.rgb, traced.rgb);
+  EXPECT_EQ(rasterOnly.validationMessages(), 0u);
+  try {
+    ProbeUpdater updater(rasterOnly, s, ProbeGrid{{2, 2, 2}, {{0, 0, 0}, {1, 1, 1}}});
+    FAIL() << "an updater on a raster-only device";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the probe updater needs ray tracing"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RasterClient, MovedGeometryIsDrawnWhereItIsNow) {
   // The animated Cornell box posed at 1.9 s, then at 2 s, given through setShading draws exactly
   // what a renderer made at 2 s draws (vertices, shadow maps and the probes' visibility all moved

@@ -20,14 +20,17 @@ struct DeviceOptions {
              if (!renderer::parseDeviceChoice(text, device))
                throw CLI::ValidationError("--device", "'" + text + "' is not auto, gpu or cpu");
            },
-           "auto: a GPU with ray tracing when one is present, lavapipe otherwise; gpu or cpu: that kind or an error")
+           "auto: a GPU when one is present, lavapipe otherwise (ray tracing only where probes are traced here); gpu "
+           "or cpu: that kind or an error")
         ->default_str("auto");
     cmd->add_flag("--validation", validation, "enable the Vulkan validation layer");
   }
-  renderer::ContextOptions context() const {
+  // `rayTracing` off: for raster-only work (viewers), so devices without ray tracing qualify.
+  renderer::ContextOptions context(bool rayTracing = true) const {
     renderer::ContextOptions o;
     o.device = device;
     o.validation = validation;
+    o.rayTracing = rayTracing;
     return o;
   }
 };

@@ -149,14 +149,37 @@ bool parseToneMap(const std::string& name, ToneMap& out) {
   return true;
 }
 
+namespace {
+uint8_t toneMapped(float x, float exposure, ToneMap toneMap) {
+  float v = std::isfinite(x) ? std::max(0.0f, x * exposure) : 0.0f;
+  if (toneMap == ToneMap::Filmic) v = v * (2.51f * v + 0.03f) / (v * (2.43f * v + 0.59f) + 0.14f);
+  return static_cast<uint8_t>(std::lround(255.0f * std::min(1.0f, std::pow(v, 1.0f / 2.2f))));
+}
+}  // namespace
+
+std::vector<unsigned char> toneMapRgba8(const std::vector<float>& rgb, float exposure, ToneMap toneMap) {
+  std::vector<unsigned char> out(rgb.size() / 3 * 4, 255);
+  for (size_t p = 0; p < rgb.size() / 3; ++p)
+    for (size_t c = 0; c < 3; ++c) out[p * 4 + c] = toneMapped(rgb[p * 3 + c], exposure, toneMap);
+  return out;
+}
+
+bool writePngRgba(const std::string& path, const std::vector<unsigned char>& rgba, int width, int height,
+                  std::string& error) {
+  if (rgba.size() != static_cast<size_t>(width) * static_cast<size_t>(height) * 4)
+    return error = path + ": RGBA image of the wrong size", false;
+  std::vector<uint8_t> rgb(rgba.size() / 4 * 3);
+  for (size_t p = 0; p < rgba.size() / 4; ++p)
+    for (size_t c = 0; c < 3; ++c) rgb[p * 3 + c] = rgba[p * 4 + c];
+  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3))
+    return error = path + ": cannot write PNG", false;
+  return true;
+}
+
 bool writePngPreview(const std::string& path, const std::vector<float>& rgb, int width, int height, float exposure,
                      std::string& error, ToneMap toneMap) {
   std::vector<uint8_t> bytes(rgb.size());
-  for (size_t i = 0; i < rgb.size(); ++i) {
-    float v = std::isfinite(rgb[i]) ? std::max(0.0f, rgb[i] * exposure) : 0.0f;
-    if (toneMap == ToneMap::Filmic) v = v * (2.51f * v + 0.03f) / (v * (2.43f * v + 0.59f) + 0.14f);
-    bytes[i] = static_cast<uint8_t>(std::lround(255.0f * std::min(1.0f, std::pow(v, 1.0f / 2.2f))));
-  }
+  for (size_t i = 0; i < rgb.size(); ++i) bytes[i] = toneMapped(rgb[i], exposure, toneMap);
   if (!stbi_write_png(path.c_str(), width, height, 3, bytes.data(), width * 3))
     return error = path + ": cannot write PNG", false;
   return true;

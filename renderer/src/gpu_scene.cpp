@@ -120,7 +120,7 @@ bool SurfaceRecord::changedBy(const scene::Scene& s) {
 }
 
 void uploadGpuScene(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
-  if (g.accel.tlas.handle) destroySceneAccel(d, g.accel);
+  if (g.accel.positions.buffer) destroySceneAccel(d, g.accel);
   buildSceneAccel(d, s, g.accel);
   uploadGpuSurfaces(d, s, g);
   if (!g.environment.buffer) uploadGpuEnvironment(d, nullptr, false, g);

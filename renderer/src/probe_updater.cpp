@@ -416,6 +416,7 @@ struct ProbeUpdater::Impl {
 ProbeUpdater::ProbeUpdater(VulkanContext& context, const scene::Scene& scene, const ProbeGrid& grid,
                            const UpdaterOptions& options)
     : impl_(std::make_unique<Impl>()) {
+  requireRayTracing(context.device(), "the probe updater");
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   if (grid.count() == 0) throw std::invalid_argument("probe grid has no probes");
   Impl& s = *impl_;

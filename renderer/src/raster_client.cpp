@@ -74,6 +74,19 @@ void fillInactiveProbes(ProbeVolume& v) {
 namespace {
 using Clock = std::chrono::steady_clock;
 
+// Sample counts the device offers for both raster targets (RGBA32F colour, D32 depth).
+VkSampleCountFlags targetSampleCounts(const VulkanDevice& d) {
+  VkImageFormatProperties color{}, depth{};
+  if (vkGetPhysicalDeviceImageFormatProperties(d.physical, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_TYPE_2D,
+                                               VK_IMAGE_TILING_OPTIMAL, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, 0,
+                                               &color) != VK_SUCCESS ||
+      vkGetPhysicalDeviceImageFormatProperties(d.physical, VK_FORMAT_D32_SFLOAT, VK_IMAGE_TYPE_2D,
+                                               VK_IMAGE_TILING_OPTIMAL, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0,
+                                               &depth) != VK_SUCCESS)
+    return VK_SAMPLE_COUNT_1_BIT;
+  return color.sampleCounts & depth.sampleCounts;
+}
+
 // Where each probe was traced: its grid position plus its offset (ProbeVolume::offsets), xyz per
 // probe. Throws std::invalid_argument for offsets that are neither empty nor 3 finite floats per
 // probe, or that move a probe farther than the grid's size (+ 1 m): relocation stays inside a cell.
@@ -161,7 +174,9 @@ struct RasterRenderer::Impl {
   bool visibilityBuilt = false;
   uint32_t width = 0, height = 0, chunk = 1;  // of the targets: samplesPerSide × the images' size
   GpuScene gpu;
-  GpuImage color, depth;  // `chunk` layers each
+  GpuImage color, depth;  // `chunk` layers each; with MSAA, depth is multisampled and color the resolve target
+  GpuImage msColor;       // MSAA: the multisampled colour target
+  VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
   GpuImage probeTextures[RS_PROBE_TEXTURES];
   GpuImage envBrdf;
   ShadowMaps shadows;
@@ -353,6 +368,7 @@ struct RasterRenderer::Impl {
       desc.fragmentBytes = sizeof kRasterFrag;
       desc.viewMask = viewMask;
       desc.layout = layout;
+      desc.samples = samples;
       desc.blend = pass == RS_PASS_OPAQUE ? ColorBlend::None
                                           : (pass == RS_PASS_TRANSMIT ? ColorBlend::Multiply : ColorBlend::Add);
       it = pipelines.emplace(key, createGraphicsPipeline(*d, desc)).first;
@@ -363,12 +379,18 @@ struct RasterRenderer::Impl {
   // Renders views [first, first + count) into layers 0..count-1 and reads them back.
   void renderChunk(uint32_t first, uint32_t count, std::vector<Image>& out) {
     const size_t pixels = static_cast<size_t>(width) * height;
-    const bool background = hasBackground();
+    const bool msaa = samples != VK_SAMPLE_COUNT_1_BIT;
+    // Without MSAA the target starts as the environment; with it, the environment goes behind the
+    // resolved pixels afterwards, weighted by what their samples left uncovered (alpha).
+    const bool background = hasBackground() && !msaa;
     if (background)
       for (uint32_t v = 0; v < count; ++v)
         writeBackground(static_cast<float*>(readback.mapped) + v * pixels * 4, inverseViewProj[first + v]);
     submitAndWait(*d, [&](VkCommandBuffer cmd) {
-      if (background) {  // the colour target starts as the environment (alpha 0: no surface)
+      if (msaa) {
+        transitionImage(cmd, msColor, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+        transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+      } else if (background) {  // the colour target starts as the environment (alpha 0: no surface)
         transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, count};
@@ -387,6 +409,13 @@ struct RasterRenderer::Impl {
         VkRenderingAttachmentInfo colorInfo =
             clearedAttachment(colorView, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
         if (background) colorInfo.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+        if (msaa) {  // drawn into the samples, averaged into `color` at the end of the pass
+          colorInfo.imageView = multiview || chunk == 1 ? msColor.view : msColor.layerViews[p];
+          colorInfo.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+          colorInfo.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
+          colorInfo.resolveImageView = colorView;
+          colorInfo.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        }
         const VkRenderingAttachmentInfo depthInfo =
             clearedAttachment(depthView, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_DONT_CARE);
         VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
@@ -415,6 +444,17 @@ struct RasterRenderer::Impl {
       vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr,
                            0, nullptr);
     });
+    if (msaa && hasBackground()) {  // the environment behind what the samples left uncovered
+      std::vector<float> env(pixels * 4);
+      for (uint32_t v = 0; v < count; ++v) {
+        writeBackground(env.data(), inverseViewProj[first + v]);
+        float* layer = static_cast<float*>(readback.mapped) + v * pixels * 4;
+        for (size_t i = 0; i < pixels; ++i) {
+          const float uncovered = std::clamp(1.0f - layer[i * 4 + 3], 0.0f, 1.0f);
+          for (size_t c = 0; c < 3; ++c) layer[i * 4 + c] += uncovered * env[i * 4 + c];
+        }
+      }
+    }
     // Each image pixel is the mean of its samplesPerSide² target pixels (one: a plain copy).
     const float* src = static_cast<const float*>(readback.mapped);
     const uint32_t n = options.samplesPerSide;
@@ -439,6 +479,8 @@ void checkRasterSize(uint32_t width, uint32_t height, const RasterOptions& optio
   if (width == 0 || height == 0) throw std::invalid_argument("raster target needs a size");
   if (options.samplesPerSide < 1 || options.samplesPerSide > 16)
     throw std::invalid_argument("raster samples per pixel side must be 1..16");
+  if (options.msaaSamples != 1 && options.msaaSamples != 2 && options.msaaSamples != 4 && options.msaaSamples != 8)
+    throw std::invalid_argument("MSAA samples must be 1, 2, 4 or 8");
   if (std::max(width, height) > 16384u / options.samplesPerSide)
     throw std::invalid_argument("a " + std::to_string(width) + "x" + std::to_string(height) + " view at " +
                                 std::to_string(options.samplesPerSide) +
@@ -471,11 +513,26 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.positions = scene.positions;
   s.indexCount = static_cast<uint32_t>(scene.indices.size());
   s.drawnOpaque = scene::leadingTrianglesBelowClass(scene, 2);
+  s.samples = static_cast<VkSampleCountFlagBits>(options.msaaSamples);
+  if (s.samples != VK_SAMPLE_COUNT_1_BIT) {
+    const VkSampleCountFlags offered = targetSampleCounts(d);
+    if (!(offered & s.samples)) {
+      std::string counts;
+      for (uint32_t n = 1; n <= 64; n *= 2)
+        if (offered & n) counts += (counts.empty() ? "" : ", ") + std::to_string(n);
+      throw std::invalid_argument("MSAA " + std::to_string(options.msaaSamples) + ": the device " + d.name +
+                                  " offers " + counts + " samples for the raster targets");
+    }
+  }
   s.color = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {s.width, s.height}, s.chunk,
                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
                                  VK_IMAGE_USAGE_TRANSFER_DST_BIT);  // starts as the background
+  if (s.samples != VK_SAMPLE_COUNT_1_BIT)
+    s.msColor = createImageArray(d, VK_FORMAT_R32G32B32A32_SFLOAT, {s.width, s.height}, s.chunk,
+                                 VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+                                 s.samples);
   s.depth = createImageArray(d, VK_FORMAT_D32_SFLOAT, {s.width, s.height}, s.chunk,
-                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, s.samples);
   s.readback = createBuffer(d, static_cast<VkDeviceSize>(s.width) * s.height * 16 * s.chunk,
                             VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   s.views = createBuffer(d, sizeof(shaders::RsView) * Impl::kMaxViews, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -568,7 +625,7 @@ RasterRenderer::~RasterRenderer() {
   vkDeviceWaitIdle(d.device);
   for (GpuImage& img : s.probeTextures) destroyImage(d, img);
   destroyBuffer(d, s.staging);
-  for (GpuImage* img : {&s.envBrdf, &s.color, &s.depth}) destroyImage(d, *img);
+  for (GpuImage* img : {&s.envBrdf, &s.color, &s.msColor, &s.depth}) destroyImage(d, *img);
   for (Buffer* b : {&s.readback, &s.views}) destroyBuffer(d, *b);
   destroyShadowMaps(d, s.shadows);
   destroyProbeVisibility(d, s.visibility);

@@ -27,6 +27,7 @@ CameraView CameraView::fromScene(const scene::Scene& s) {
 
 Image renderReference(VulkanContext& context, const scene::Scene& scene, const CameraView& camera,
                       const ReferenceOptions& options, ReferenceStats* stats) {
+  requireRayTracing(context.device(), "the reference renderer");
   if (scene.triangleCount() == 0) throw std::invalid_argument("scene " + scene.name + " has no triangles");
   if (options.width == 0 || options.height == 0 || options.samplesPerPixel == 0)
     throw std::invalid_argument("reference image needs a size and samples");

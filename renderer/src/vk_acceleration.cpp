@@ -109,8 +109,13 @@ void buildTopLevel(VulkanDevice& d, SceneAccel& a) {
 void buildSceneAccel(VulkanDevice& d, const scene::Scene& scene, SceneAccel& out) {
   const uint32_t count = scene.triangleCount();
   if (count >= (1u << 24)) throw std::invalid_argument("scene " + scene.name + " has more than 2^24 triangles");
-  out.positions = createBufferWithData(d, scene.positions.data(), scene.positions.size() * sizeof(glm::vec3), kInputUsage);
-  out.indices = createBufferWithData(d, scene.indices.data(), scene.indices.size() * sizeof(uint32_t), kInputUsage);
+  // Without ray tracing (a raster-only device) the vertex and index buffers are all there is.
+  const VkBufferUsageFlags usage =
+      d.rayTracing ? kInputUsage
+                   : VkBufferUsageFlags{VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                        VK_BUFFER_USAGE_INDEX_BUFFER_BIT};
+  out.positions = createBufferWithData(d, scene.positions.data(), scene.positions.size() * sizeof(glm::vec3), usage);
+  out.indices = createBufferWithData(d, scene.indices.data(), scene.indices.size() * sizeof(uint32_t), usage);
   out.opaqueTriangles = scene::leadingTrianglesBelowClass(scene, 1);
   out.maxVertex = static_cast<uint32_t>(scene.positions.size()) - 1;
   // Runs of the same kind (finalizeScene keeps each one contiguous).
@@ -127,12 +132,14 @@ void buildSceneAccel(VulkanDevice& d, const scene::Scene& scene, SceneAccel& out
     }
     ++out.blases.back().count;
   }
+  if (!d.rayTracing) return;
   for (BlasRun& run : out.blases)
     build(d, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, triangles(out, run), run.count, run.moves, false, run.as);
   buildTopLevel(d, out);
 }
 
 bool refitSceneAccel(VulkanDevice& d, const scene::Scene& scene, const std::vector<glm::vec3>& before, SceneAccel& a) {
+  requireRayTracing(d, "refitting acceleration structures");
   if (scene.positions.size() != before.size() || scene.positions.size() != static_cast<size_t>(a.maxVertex) + 1 ||
       a.blases.empty())
     return false;

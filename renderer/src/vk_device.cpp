@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <iterator>
 #include <cstring>
 #include <vector>
 
@@ -10,11 +12,17 @@
 namespace probecast::renderer {
 namespace {
 
-const char* kDeviceExtensions[] = {
+const char* kRayTracingExtensions[] = {
     VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
     VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
     VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
 };
+
+// PROBECAST_VK_HIDE_RAY_TRACING=1: every device looks as if it had no ray tracing.
+bool rayTracingHidden() {
+  const char* v = std::getenv("PROBECAST_VK_HIDE_RAY_TRACING");
+  return v && std::strcmp(v, "") != 0 && std::strcmp(v, "0") != 0;
+}
 
 VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                    VkDebugUtilsMessageTypeFlagsEXT,
@@ -26,12 +34,12 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
   return VK_FALSE;
 }
 
-bool hasExtensions(VkPhysicalDevice physical) {
+bool hasExtensions(VkPhysicalDevice physical, const std::vector<const char*>& wanted) {
   uint32_t count = 0;
   vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr);
   std::vector<VkExtensionProperties> props(count);
   vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, props.data());
-  for (const char* want : kDeviceExtensions) {
+  for (const char* want : wanted) {
     bool found = false;
     for (const auto& p : props) found = found || std::strcmp(p.extensionName, want) == 0;
     if (!found) return false;
@@ -52,11 +60,21 @@ void vkFail(VkResult result, const char* call, const char* file, int line) {
                            " at " + file + ":" + std::to_string(line));
 }
 
-void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
+void requireRayTracing(const VulkanDevice& d, const char* what) {
+  if (!d.rayTracing)
+    throw std::runtime_error(std::string(what) + " needs ray tracing, and this Vulkan device (" + d.name +
+                             ") was opened without it (a raster-only viewer's device" +
+                             (rayTracingHidden() ? ", PROBECAST_VK_HIDE_RAY_TRACING is set" : "") + ")");
+}
+
+void createDevice(VulkanDevice& d, const ContextOptions& options) {
+  const bool validation = options.validation;
+  const DeviceChoice choice = options.device;
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "probecast";
   app.apiVersion = VK_API_VERSION_1_3;
   std::vector<const char*> layers, extensions;
+  for (const std::string& e : options.instanceExtensions) extensions.push_back(e.c_str());
   if (validation) {
     layers.push_back("VK_LAYER_KHRONOS_validation");
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
@@ -90,32 +108,43 @@ void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
   VK_CHECK(vkEnumeratePhysicalDevices(d.instance, &count, nullptr));
   std::vector<VkPhysicalDevice> devices(count);
   VK_CHECK(vkEnumeratePhysicalDevices(d.instance, &count, devices.data()));
+  std::vector<const char*> wanted;
+  if (options.rayTracing) wanted.assign(std::begin(kRayTracingExtensions), std::end(kRayTracingExtensions));
+  if (options.swapchain) wanted.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  const bool hidden = rayTracingHidden();
   int best = -1;
   bool bestIsCpu = false;
   std::string seen;  // every device, for the error when none fits
   for (uint32_t i = 0; i < count; ++i) {
     VkPhysicalDeviceProperties p;
     vkGetPhysicalDeviceProperties(devices[i], &p);
-    const bool rayTracing = hasExtensions(devices[i]);
+    const bool rayTracing =
+        !hidden && hasExtensions(devices[i], {std::begin(kRayTracingExtensions), std::end(kRayTracingExtensions)});
+    const bool fits = (rayTracing || !options.rayTracing) && hasExtensions(devices[i], wanted) &&
+                      p.apiVersion >= VK_API_VERSION_1_3;
     const bool isCpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     seen += std::string(seen.empty() ? "" : ", ") + p.deviceName + (isCpu ? " (CPU" : " (GPU") +
-            (rayTracing ? ")" : ", no ray tracing)");
-    if (!rayTracing || (choice == DeviceChoice::Gpu && isCpu) || (choice == DeviceChoice::Cpu && !isCpu)) continue;
+            (rayTracing ? "" : ", no ray tracing") + (p.apiVersion >= VK_API_VERSION_1_3 ? "" : ", Vulkan < 1.3") + ")";
+    if (!fits || (choice == DeviceChoice::Gpu && isCpu) || (choice == DeviceChoice::Cpu && !isCpu)) continue;
     if (best < 0 || (bestIsCpu && !isCpu)) {  // auto: the first GPU, else the first CPU
       best = static_cast<int>(i);
       bestIsCpu = isCpu;
     }
   }
+  const std::string need = std::string(options.rayTracing ? "ray tracing" : "Vulkan 1.3") +
+                           (options.swapchain ? " and a swapchain" : "");
   if (best < 0 && choice == DeviceChoice::Auto)
     throw std::runtime_error(
-        "no Vulkan device with ray tracing (VK_KHR_ray_tracing_pipeline); lavapipe needs Mesa >= 24 from "
-        "bookworm-backports (scripts/setup.sh installs it); devices found: " +
-        (seen.empty() ? std::string("none") : seen));
+        "no Vulkan device with " + need +
+        (options.rayTracing ? std::string(" (VK_KHR_ray_tracing_pipeline); lavapipe needs Mesa >= 24 from "
+                                          "bookworm-backports (scripts/setup.sh installs it)")
+                            : std::string()) +
+        "; devices found: " + (seen.empty() ? std::string("none") : seen));
   if (best < 0)
     throw std::runtime_error(std::string("--device ") + deviceChoiceName(choice) + ": no " +
-                             (choice == DeviceChoice::Gpu ? "GPU" : "CPU") +
-                             " Vulkan device with ray tracing; devices found: " +
-                             (seen.empty() ? std::string("none") : seen) + " (--device auto takes whichever there is)");
+                             (choice == DeviceChoice::Gpu ? "GPU" : "CPU") + " Vulkan device with " + need +
+                             "; devices found: " + (seen.empty() ? std::string("none") : seen) +
+                             " (--device auto takes whichever there is)");
   d.physical = devices[best];
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   d.rtProperties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
@@ -134,8 +163,10 @@ void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
   vkGetPhysicalDeviceQueueFamilyProperties(d.physical, &families, qf.data());
   d.queueFamily = UINT32_MAX;
   for (uint32_t i = 0; i < families; ++i)
-    if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && d.queueFamily == UINT32_MAX) d.queueFamily = i;
-  if (d.queueFamily == UINT32_MAX) throw std::runtime_error("no compute queue");
+    if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && (qf[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) &&
+        d.queueFamily == UINT32_MAX)
+      d.queueFamily = i;
+  if (d.queueFamily == UINT32_MAX) throw std::runtime_error("no Vulkan queue that does both graphics and compute");
 
   VkPhysicalDeviceRayTracingPipelineFeaturesKHR rt{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
   rt.rayTracingPipeline = VK_TRUE;
@@ -143,8 +174,8 @@ void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
   as.accelerationStructure = VK_TRUE;
   as.pNext = &rt;
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  v12.bufferDeviceAddress = VK_TRUE;
-  v12.pNext = &as;
+  v12.bufferDeviceAddress = options.rayTracing ? VK_TRUE : VK_FALSE;  // device addresses serve the tracer only
+  v12.pNext = options.rayTracing ? static_cast<void*>(&as) : nullptr;
   VkPhysicalDeviceVulkan11Features v11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
   v11.multiview = VK_TRUE;  // core since 1.1 and mandatory
   v11.pNext = &v12;
@@ -169,9 +200,11 @@ void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
   dci.pNext = &features;
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
-  dci.enabledExtensionCount = static_cast<uint32_t>(std::size(kDeviceExtensions));
-  dci.ppEnabledExtensionNames = kDeviceExtensions;
+  dci.enabledExtensionCount = static_cast<uint32_t>(wanted.size());
+  dci.ppEnabledExtensionNames = wanted.data();
   VK_CHECK(vkCreateDevice(d.physical, &dci, nullptr, &d.device));
+  d.rayTracing = options.rayTracing;
+  d.swapchain = options.swapchain;
   vkGetDeviceQueue(d.device, d.queueFamily, 0, &d.queue);
 
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -179,6 +212,7 @@ void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice) {
   pci.queueFamilyIndex = d.queueFamily;
   VK_CHECK(vkCreateCommandPool(d.device, &pci, nullptr, &d.commandPool));
 
+  if (!d.rayTracing) return;
   load(d.device, d.vkCreateAccelerationStructureKHR, "vkCreateAccelerationStructureKHR");
   load(d.device, d.vkDestroyAccelerationStructureKHR, "vkDestroyAccelerationStructureKHR");
   load(d.device, d.vkGetAccelerationStructureBuildSizesKHR, "vkGetAccelerationStructureBuildSizesKHR");
@@ -208,7 +242,7 @@ void destroyDevice(VulkanDevice& d) {
 
 VulkanContext::VulkanContext(const ContextOptions& options) : device_(std::make_unique<VulkanDevice>()) {
   try {
-    createDevice(*device_, options.validation, options.device);
+    createDevice(*device_, options);
   } catch (...) {
     destroyDevice(*device_);
     throw;
@@ -238,6 +272,7 @@ const char* deviceChoiceName(DeviceChoice choice) {
 }
 const std::string& VulkanContext::deviceName() const { return device_->name; }
 uint32_t VulkanContext::validationMessages() const { return device_->validationMessages.load(); }
+bool VulkanContext::rayTracing() const { return device_->rayTracing; }
 VulkanDevice& VulkanContext::device() { return *device_; }
 
 }  // namespace probecast::renderer

@@ -21,6 +21,8 @@ struct VulkanDevice {
   VkPhysicalDeviceMemoryProperties memory{};
   VkPhysicalDeviceRayTracingPipelinePropertiesKHR rtProperties{};
   uint32_t maxMultiviewViewCount = 1;
+  bool rayTracing = false;  // the ray-tracing extensions are enabled (the entry points below are loaded)
+  bool swapchain = false;   // VK_KHR_swapchain is enabled
   std::atomic<uint32_t> validationMessages{0};
 
   PFN_vkCreateAccelerationStructureKHR vkCreateAccelerationStructureKHR = nullptr;
@@ -33,7 +35,9 @@ struct VulkanDevice {
   PFN_vkCmdTraceRaysKHR vkCmdTraceRaysKHR = nullptr;
 };
 
-void createDevice(VulkanDevice& d, bool validation, DeviceChoice choice);
+void createDevice(VulkanDevice& d, const ContextOptions& options);
+// Throws std::runtime_error naming `what` unless the device was made with ray tracing.
+void requireRayTracing(const VulkanDevice& d, const char* what);
 void destroyDevice(VulkanDevice& d);
 
 }  // namespace probecast::renderer

@@ -39,7 +39,7 @@ VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& d
   rs.depthBiasConstantFactor = 1.0f;
   rs.depthBiasSlopeFactor = 1.5f;
   VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-  ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  ms.rasterizationSamples = desc.samples;
   VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
   ds.depthTestEnable = VK_TRUE;
   ds.depthWriteEnable = desc.blend == ColorBlend::None ? VK_TRUE : VK_FALSE;

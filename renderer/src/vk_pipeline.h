@@ -28,6 +28,7 @@ struct GraphicsPipelineDesc {
   VkFormat colorFormat = VK_FORMAT_R32G32B32A32_SFLOAT;  // UNDEFINED: no colour attachment
   VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
   VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;  // of the attachments (MSAA)
 };
 
 VkPipeline createGraphicsPipeline(VulkanDevice& d, const GraphicsPipelineDesc& desc);

@@ -55,7 +55,8 @@ Buffer createBufferWithData(VulkanDevice& d, const void* data, size_t bytes, VkB
 
 namespace {
 GpuImage createImageLayers(VulkanDevice& d, VkFormat format, VkExtent3D extent, uint32_t layers,
-                           VkImageUsageFlags usage, bool type3d) {
+                           VkImageUsageFlags usage, bool type3d,
+                           VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT) {
   GpuImage img;
   img.format = format;
   img.extent = extent;
@@ -66,7 +67,7 @@ GpuImage createImageLayers(VulkanDevice& d, VkFormat format, VkExtent3D extent, 
   ici.extent = extent;
   ici.mipLevels = 1;
   ici.arrayLayers = layers;
-  ici.samples = VK_SAMPLE_COUNT_1_BIT;
+  ici.samples = samples;
   ici.tiling = VK_IMAGE_TILING_OPTIMAL;
   ici.usage = usage;
   ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
@@ -106,8 +107,9 @@ GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImag
   return createImageLayers(d, format, extent, 1, usage, type3d);
 }
 
-GpuImage createImageArray(VulkanDevice& d, VkFormat format, VkExtent2D extent, uint32_t layers, VkImageUsageFlags usage) {
-  return createImageLayers(d, format, {extent.width, extent.height, 1}, layers, usage, false);
+GpuImage createImageArray(VulkanDevice& d, VkFormat format, VkExtent2D extent, uint32_t layers, VkImageUsageFlags usage,
+                          VkSampleCountFlagBits samples) {
+  return createImageLayers(d, format, {extent.width, extent.height, 1}, layers, usage, false, samples);
 }
 
 void destroyImage(VulkanDevice& d, GpuImage& img) {

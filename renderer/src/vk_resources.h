@@ -37,7 +37,9 @@ struct GpuImage {
 // A 2D or 3D image (depth > 1 or `type3d`) with one mip level and a view of all of it.
 GpuImage createImage(VulkanDevice& d, VkFormat format, VkExtent3D extent, VkImageUsageFlags usage, bool type3d = false);
 // A 2D array of `layers` layers: `view` sees them all (2D array), `layerViews[k]` layer k alone.
-GpuImage createImageArray(VulkanDevice& d, VkFormat format, VkExtent2D extent, uint32_t layers, VkImageUsageFlags usage);
+// `samples` > 1: a multisampled target (rendered into, then resolved).
+GpuImage createImageArray(VulkanDevice& d, VkFormat format, VkExtent2D extent, uint32_t layers, VkImageUsageFlags usage,
+                          VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT);
 void destroyImage(VulkanDevice& d, GpuImage& image);
 // A whole-image layout transition (synchronisation2, all commands): simple and correct, not fast.
 void transitionImage(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to);

@@ -39,6 +39,9 @@ Viewer::Viewer(renderer::VulkanContext& context, const scene::Scene& scene, std:
 
 void Viewer::shadeAt(double displayTime) {
   if (animates_) {
+    if (posed_ && displayTime == posedAt_) return;  // a still clock: the same pose, the same shadows
+    posed_ = true;
+    posedAt_ = displayTime;
     advanceScene(config_.sceneSpec, displayTime, scene_);
     raster_->setShading(scene_);
   } else if (!config_.sceneSpec.empty() && held_.hasState && !(held_.state.lights == shadedState_.lights)) {
@@ -56,6 +59,12 @@ void Viewer::followAreaLights(const AreaLightRule& rule) {
   lit_ = rule;
 }
 
+void Viewer::setViews(std::vector<renderer::ViewInfo> views, bool tellServer) {
+  if (views.empty()) throw std::invalid_argument("a viewer needs at least one view");
+  views_ = std::move(views);
+  if (tellServer) client_->setViews(priorityViews(views_));
+}
+
 void Viewer::start() { client_->start(); }
 void Viewer::stop() { client_->stop(); }
 
@@ -71,11 +80,19 @@ bool Viewer::renderIfNew() {
 }
 
 bool Viewer::render() {
-  if (!client_->snapshot(held_)) return false;  // into the storage of the last snapshot
-  followAreaLights(held_.volume.areaLights);
+  // A frame every display refresh: the volume is copied and uploaded only when frames arrived
+  // since the last upload; otherwise the one held is drawn again at the new display time.
+  const bool fresh = !uploaded_ || client_->stats().framesApplied != held_.framesApplied;
+  if (fresh) {
+    if (!client_->snapshot(held_)) return false;  // into the storage of the last snapshot
+    followAreaLights(held_.volume.areaLights);
+  }
   stats_.framesSeen = held_.framesApplied;
   shadeAt(clock_.at(held_, service::wallClockUs()));
-  raster_->setProbes(held_.volume);
+  if (fresh) {
+    raster_->setProbes(held_.volume);
+    uploaded_ = true;
+  }
   images_ = raster_->renderViews(views_);
   stats_.renderMsPerView.push_back(raster_->timings().viewsMs / static_cast<double>(views_.size()));
   ++stats_.renders;

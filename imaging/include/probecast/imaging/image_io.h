@@ -30,5 +30,15 @@ bool writePngPreview(const std::string& path, const std::vector<float>& rgb, int
                      std::string& error, ToneMap toneMap = ToneMap::Filmic);
 // "filmic" or "gamma".
 bool parseToneMap(const std::string& name, ToneMap& out);
+// The 8-bit pixels writePngPreview writes, as RGBA (alpha 255): what a window shows.
+std::vector<unsigned char> toneMapRgba8(const std::vector<float>& rgb, float exposure, ToneMap toneMap = ToneMap::Filmic);
+// An 8-bit RGBA image as a PNG (alpha dropped).
+bool writePngRgba(const std::string& path, const std::vector<unsigned char>& rgba, int width, int height,
+                  std::string& error);
+// One line of text drawn into an RGBA image at (x, y) (its top left, pixels) in `rgb` (each glyph
+// pixel `scale` × `scale`), on a dark band across the whole width behind it; clipped to the image.
+// Returns the band's height in pixels.
+int drawTextLine(std::vector<unsigned char>& rgba, int width, int height, int x, int y, const std::string& text,
+                 int scale = 2, const unsigned char rgb[3] = nullptr);
 
 }  // namespace probecast::imaging

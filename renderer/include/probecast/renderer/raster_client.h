@@ -62,6 +62,11 @@ struct RasterOptions {
   // about N² the shading time; the images keep the size the renderer was made with. 4 by default,
   // the measured best (docs/MEASUREMENTS.md, "Defaults"); 1 draws one sample per pixel.
   uint32_t samplesPerSide = 4;
+  // Multisample anti-aliasing: 1 (off), 2, 4 or 8 coverage samples per target pixel, shaded once
+  // per pixel and resolved by averaging (the device must offer the count for RGBA32F colour and
+  // D32 depth; std::invalid_argument otherwise). Edges smooth at about the cost of one sample;
+  // combines with samplesPerSide.
+  uint32_t msaaSamples = 1;
 };
 
 struct RasterTimings {
@@ -77,7 +82,8 @@ struct RasterTimings {
 };
 
 // Throws std::invalid_argument unless views of width × height at options.samplesPerSide fit a
-// raster target (1..16 samples per side, at most 16384 pixels a side): to refuse before slow work.
+// raster target (1..16 samples per side, at most 16384 pixels a side) and msaaSamples is 1, 2, 4
+// or 8: to refuse before slow work.
 void checkRasterSize(uint32_t width, uint32_t height, const RasterOptions& options);
 
 // Replaces inactive probes by the mean of their active neighbours, growing outwards until every

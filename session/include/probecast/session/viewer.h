@@ -57,8 +57,11 @@ class Viewer {
 
   // Renders when frames arrived since the last render; false otherwise.
   bool renderIfNew();
-  // Renders what it holds now; false while it holds nothing.
+  // Renders what it holds now at the display clock (a live window calls it every frame: the
+  // volume is uploaded again only when frames arrived); false while it holds nothing.
   bool render();
+  // Other views from now on (a camera that moved); `tellServer`: also for the server's priority.
+  void setViews(std::vector<renderer::ViewInfo> views, bool tellServer = true);
   void setShading(const scene::Scene& scene) { raster_->setShading(scene); }
 
   const std::vector<renderer::Image>& images() const { return images_; }
@@ -87,8 +90,11 @@ class Viewer {
   std::unique_ptr<renderer::RasterRenderer> raster_;
   AreaLightRule lit_;
   service::VolumeSnapshot held_;  // what it rendered last; its storage is reused
+  bool uploaded_ = false;         // held_ is in the raster renderer
   service::DisplayClock clock_;
   bool animates_ = false;         // sceneSpec moves with the scene time
+  bool posed_ = false;            // scene_ is posed at posedAt_ (animates_)
+  double posedAt_ = 0.0;
   bus::SceneState shadedState_;  // the state whose lights it shades with (scenes that do not animate)
   // Shades direct light for the display time (see ViewerConfig::sceneSpec).
   void shadeAt(double displayTime);

@@ -1,0 +1,174 @@
+#include "live_window.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <glm/gtc/quaternion.hpp>
+
+#include "probecast/renderer/window.h"
+
+namespace probecast::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// A camera the user flies: the mouse turns it about the starting up axis and its own right axis,
+// W/A/S/D/Q/E move it at a speed set by the scene's size.
+class FlyCamera {
+ public:
+  FlyCamera(const renderer::CameraView& start, float sceneSize) : start_(start), speed_(0.4f * sceneSize) {}
+
+  // True when it moved.
+  bool apply(const renderer::WindowInput& in, double dt) {
+    if (in.reset) {
+      yaw_ = pitch_ = 0.0f;
+      offset_ = glm::vec3(0.0f);
+      return true;
+    }
+    const bool turned = in.look != glm::vec2(0.0f), moved = in.move != glm::vec3(0.0f);
+    yaw_ -= 0.004f * in.look.x;
+    pitch_ = std::clamp(pitch_ - 0.004f * in.look.y, -1.5f, 1.5f);
+    const renderer::CameraView c = camera();
+    const glm::vec3 right = glm::normalize(glm::cross(c.forward, c.up));
+    const float step = speed_ * (in.fast ? 4.0f : 1.0f) * static_cast<float>(dt);
+    offset_ += step * (in.move.x * right + in.move.y * c.up + in.move.z * c.forward);
+    return turned || moved;
+  }
+
+  renderer::CameraView camera() const {
+    renderer::CameraView c = start_;
+    const glm::vec3 up0 = glm::normalize(start_.up);
+    const glm::vec3 f0 = glm::normalize(start_.forward);
+    const glm::quat yaw = glm::angleAxis(yaw_, up0);
+    const glm::vec3 f1 = yaw * f0;
+    const glm::vec3 right = glm::normalize(glm::cross(f1, up0));
+    const glm::quat pitch = glm::angleAxis(pitch_, right);
+    c.forward = glm::normalize(pitch * f1);
+    c.up = glm::normalize(glm::cross(right, c.forward));
+    c.position = start_.position + offset_;
+    return c;
+  }
+
+ private:
+  renderer::CameraView start_;
+  float speed_;
+  float yaw_ = 0.0f, pitch_ = 0.0f;
+  glm::vec3 offset_{0.0f};
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+void LiveWindowOptions::add(CLI::App* cmd) {
+  cmd->add_flag("--window", enabled,
+                "show the views live in a window (GLFW + Vulkan swapchain): drag to look, W/A/S/D/Q/E to move, "
+                "Shift faster, R resets, F12 or P writes a screenshot to --out, Escape closes");
+  cmd->add_flag("--fullscreen", fullscreen, "--window: full screen on the primary monitor");
+  cmd->add_option("--window-seconds", seconds, "--window: close after this many seconds (0: when closed)")
+      ->check(CLI::Range(0.0, 1e7));
+  cmd->add_option("--screenshot-after", screenshotAfter, "--window: write one screenshot this many seconds in")
+      ->check(CLI::Range(0.0, 1e7));
+  cmd->add_option("--overlay", overlay, "--window: the status line (frame ms, probe age, bytes/s, connection)")
+      ->capture_default_str();
+}
+
+renderer::ContextOptions LiveWindowOptions::presenting(renderer::ContextOptions options) {
+  options.instanceExtensions = renderer::Window::instanceExtensions();
+  options.swapchain = true;
+  return options;
+}
+
+LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanContext& context,
+                               const renderer::CameraView& start, const renderer::ViewSetSpec& spec,
+                               const renderer::ViewSetOptions& viewSetOptions, uint32_t viewWidth,
+                               uint32_t viewHeight, float sceneSize, FrameSource& source, const std::string& outDir,
+                               float exposure, imaging::ToneMap toneMap) {
+  renderer::WindowOptions wo;
+  wo.width = source.displayWidth ? source.displayWidth : viewWidth * static_cast<uint32_t>(spec.columns);
+  wo.height = source.displayHeight ? source.displayHeight : viewHeight * static_cast<uint32_t>(spec.rows);
+  wo.fullscreen = o.fullscreen;
+  renderer::Window window(context, wo);
+  fmt::print("window: {}x{} on {}, present mode {}\n", window.width(), window.height(), context.deviceName(),
+             window.presentMode());
+  std::fflush(stdout);
+
+  FlyCamera camera(start, sceneSize);
+  LiveWindowResult result;
+  const Clock::time_point begin = Clock::now();
+  Clock::time_point lastFrame = begin, lastReport = begin;
+  std::vector<double> frameMs, secondMs;  // all frames; frames since the last report
+  std::vector<renderer::Image> images;
+  std::vector<renderer::ViewInfo> views;
+  renderer::Image shown;
+  bool screenshotDone = false, first = true;
+  while (window.isOpen() && (o.seconds <= 0.0 || secondsSince(begin) < o.seconds)) {
+    const Clock::time_point frameStart = Clock::now();
+    const double dt = std::chrono::duration<double>(frameStart - lastFrame).count();
+    lastFrame = frameStart;
+    const renderer::WindowInput in = window.poll();
+    const bool moved = camera.apply(in, dt) || first;
+    first = false;
+    if (moved) views = renderer::makeViewSet(camera.camera(), spec, viewSetOptions);
+    const bool drawn = source.render(views, moved, images);
+    if (drawn) {
+      shown = source.compose ? source.compose(images, views)
+                             : renderer::composeQuilt(images, views, spec.columns, spec.rows);
+    } else {
+      shown.width = wo.width;
+      shown.height = wo.height;
+      shown.rgb.assign(size_t{wo.width} * wo.height * 3, 0.0f);
+    }
+    std::vector<unsigned char> rgba = imaging::toneMapRgba8(shown.rgb, exposure, toneMap);
+    const double lastMs = frameMs.empty() ? 0.0 : frameMs.back();
+    const std::string status = source.status();
+    if (o.overlay)
+      imaging::drawTextLine(rgba, static_cast<int>(shown.width), static_cast<int>(shown.height), 6, 0,
+                            fmt::format("{:.1f} ms | {}", lastMs, status), shown.width >= 640 ? 2 : 1);
+    const bool screenshot =
+        in.screenshot || (!screenshotDone && o.screenshotAfter >= 0.0 && secondsSince(begin) >= o.screenshotAfter);
+    std::vector<uint8_t> readback;
+    window.present(rgba.data(), shown.width, shown.height, screenshot ? &readback : nullptr);
+    if (screenshot) {
+      screenshotDone = true;
+      std::filesystem::create_directories(outDir);
+      const std::string base = fmt::format("{}/screenshot_{:03}", outDir, result.screenshots.size());
+      std::string error;
+      if (!imaging::writePngRgba(base + ".png", readback, static_cast<int>(window.width()),
+                                 static_cast<int>(window.height()), error) ||
+          !imaging::writeExr(base + ".exr", shown.rgb, static_cast<int>(shown.width), static_cast<int>(shown.height),
+                             error))
+        fmt::print(stderr, "window: screenshot not written: {}\n", error);
+      else
+        fmt::print("window: screenshot {}.png (as presented) and {}.exr (linear)\n", base, base);
+      result.screenshots.push_back(base);
+    }
+    const double ms = 1e3 * secondsSince(frameStart);
+    frameMs.push_back(ms);
+    secondMs.push_back(ms);
+    if (secondsSince(lastReport) >= 1.0) {
+      fmt::print("window: {:.1f} s, {} frames presented, {:.1f} ms a frame, {}\n", secondsSince(begin),
+                 window.framesPresented(), median(secondMs), status);
+      std::fflush(stdout);
+      secondMs.clear();
+      lastReport = Clock::now();
+    }
+  }
+  result.frames = window.framesPresented();
+  result.seconds = secondsSince(begin);
+  result.medianFrameMs = median(frameMs);
+  fmt::print("window: closed after {:.1f} s, {} frames presented, median {:.1f} ms a frame\n", result.seconds,
+             result.frames, result.medianFrameMs);
+  return result;
+}
+
+}  // namespace probecast::app

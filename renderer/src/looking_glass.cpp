@@ -1,0 +1,318 @@
+#include "probecast/renderer/looking_glass.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "looking_glass.comp.h"
+#include "vk_resources.h"
+
+namespace probecast::renderer {
+namespace {
+
+using nlohmann::json;
+
+constexpr int kMaxScreenSide = 16384;
+constexpr double kMinAbsSlope = 0.01;  // a lens sheet this flat would need a near-infinite tilt
+constexpr double kMaxAbsSlope = 1000.0;
+
+std::string show(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// A JSON value for an error message, cut short so a huge value cannot flood it.
+std::string showJson(const json& v) {
+  std::string text = v.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return text;
+}
+
+std::string quoted(const char* field) { return std::string("\"") + field + "\""; }
+
+// The field's value with an optional {"value": ...} wrapper taken off; null when absent.
+const json* fieldValue(const json& root, const char* field, const std::string& where) {
+  const auto it = root.find(field);
+  if (it == root.end()) return nullptr;
+  if (it->is_object()) {
+    const auto inner = it->find("value");
+    if (inner == it->end())
+      throw std::invalid_argument(where + "field " + quoted(field) + " is an object without \"value\"");
+    return &*inner;
+  }
+  return &*it;
+}
+
+// A finite number from the field, or `fallback` when it is absent and not required.
+double numberField(const json& root, const char* field, bool required, double fallback, const std::string& where) {
+  const json* v = fieldValue(root, field, where);
+  if (!v) {
+    if (required) throw std::invalid_argument(where + "missing required field " + quoted(field));
+    return fallback;
+  }
+  if (!v->is_number())
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be a number (got " + showJson(*v) + ")");
+  const double d = v->get<double>();
+  if (!std::isfinite(d))
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be finite (got " + show(d) + ")");
+  return d;
+}
+
+int pixelsField(const json& root, const char* field, const std::string& where) {
+  const double d = numberField(root, field, true, 0.0, where);
+  if (d != std::floor(d) || d < 1 || d > kMaxScreenSide)
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be a whole number of pixels in 1.." +
+                                std::to_string(kMaxScreenSide) + " (got " + show(d) + ")");
+  return static_cast<int>(d);
+}
+
+// Calibration files write flags as 0.0 / 1.0; JSON booleans are taken as well.
+bool flagField(const json& root, const char* field, bool fallback, const std::string& where) {
+  const json* v = fieldValue(root, field, where);
+  if (v && v->is_boolean()) return v->get<bool>();
+  const double d = numberField(root, field, false, fallback ? 1.0 : 0.0, where);
+  if (d != 0.0 && d != 1.0)
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be 0 or 1 (got " + show(d) + ")");
+  return d == 1.0;
+}
+
+std::string textField(const json& root, const char* field) {
+  const auto it = root.find(field);
+  if (it == root.end()) return {};
+  const json& v = it->is_object() && it->contains("value") ? (*it)["value"] : *it;
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+// The checks both the parser and the interleaver rely on, on the values as stored (floats).
+void checkCalibration(const LookingGlassCalibration& c, const std::string& where) {
+  const auto field = [&](const char* name, const std::string& rule, double got) {
+    throw std::invalid_argument(where + "field " + quoted(name) + " " + rule + " (got " + show(got) + ")");
+  };
+  if (c.screenW < 1 || c.screenW > kMaxScreenSide)
+    field("screenW", "must be in 1.." + std::to_string(kMaxScreenSide), c.screenW);
+  if (c.screenH < 1 || c.screenH > kMaxScreenSide)
+    field("screenH", "must be in 1.." + std::to_string(kMaxScreenSide), c.screenH);
+  if (!std::isfinite(c.dpi) || c.dpi <= 0) field("DPI", "must be a finite number > 0", c.dpi);
+  if (!std::isfinite(c.pitch) || c.pitch <= 0) field("pitch", "must be a finite number > 0", c.pitch);
+  if (!std::isfinite(c.slope) || std::fabs(c.slope) < kMinAbsSlope || std::fabs(c.slope) > kMaxAbsSlope)
+    field("slope", "must be finite with |slope| in [" + show(kMinAbsSlope) + ", " + show(kMaxAbsSlope) + "]",
+          c.slope);
+  if (!std::isfinite(c.center)) field("center", "must be finite", c.center);
+  if (!std::isfinite(c.viewCone) || c.viewCone <= 0 || c.viewCone >= 180)
+    field("viewCone", "must be in (0, 180) degrees", c.viewCone);
+  if (!std::isfinite(c.verticalAngle)) field("verticalAngle", "must be finite", c.verticalAngle);
+}
+
+// Mirrors the push-constant block of shaders/looking_glass.comp (std430: the uvec4 at offset 32).
+struct LookingGlassPush {
+  int32_t screen[2];
+  int32_t tile[2];
+  int32_t columns;
+  int32_t rows;
+  int32_t views;
+  uint32_t flags;
+  uint32_t phase[4];
+};
+static_assert(sizeof(LookingGlassPush) == 48 && offsetof(LookingGlassPush, phase) == 32);
+constexpr uint32_t kInvView = 1, kFlipX = 2, kFlipY = 4;
+
+// A phase in lenticules as an unsigned 0.32 fixed-point fraction (its integer part dropped).
+uint32_t fixedTurns(double turns) {
+  const double fraction = turns - std::floor(turns);
+  const double scaled = std::round(fraction * 4294967296.0);
+  return scaled >= 4294967296.0 ? 0u : static_cast<uint32_t>(scaled);
+}
+
+// Everything the interleaving dispatch creates, released in reverse order however it ends.
+struct InterleavePass {
+  VulkanDevice& d;
+  Buffer quilt, panel;
+  VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+
+  explicit InterleavePass(VulkanDevice& device) : d(device) {}
+  InterleavePass(const InterleavePass&) = delete;
+  InterleavePass& operator=(const InterleavePass&) = delete;
+  ~InterleavePass() {
+    if (pool) vkDestroyDescriptorPool(d.device, pool, nullptr);
+    if (pipeline) vkDestroyPipeline(d.device, pipeline, nullptr);
+    if (layout) vkDestroyPipelineLayout(d.device, layout, nullptr);
+    if (setLayout) vkDestroyDescriptorSetLayout(d.device, setLayout, nullptr);
+    destroyBuffer(d, panel);
+    destroyBuffer(d, quilt);
+  }
+};
+
+}  // namespace
+
+QuiltLayout defaultQuiltLayout(int screenW, int screenH) {
+  if (screenH > screenW) return {8, 6};  // portrait panels
+  if (screenW >= 3840) return {5, 9};    // the 4K/8K class
+  return {5, 9};                         // smaller landscape panels use the same layout
+}
+
+LookingGlassCalibration parseLookingGlassCalibration(const std::string& jsonText) {
+  const std::string where = "visual.json: ";
+  const json root = json::parse(jsonText, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded()) throw std::invalid_argument(where + "malformed JSON");
+  if (!root.is_object()) throw std::invalid_argument(where + "expected a JSON object, got " + showJson(root));
+
+  LookingGlassCalibration c;
+  c.pitch = static_cast<float>(numberField(root, "pitch", true, 0.0, where));
+  c.slope = static_cast<float>(numberField(root, "slope", true, 0.0, where));
+  c.center = static_cast<float>(numberField(root, "center", true, 0.0, where));
+  c.dpi = static_cast<float>(numberField(root, "DPI", true, 0.0, where));
+  c.screenW = pixelsField(root, "screenW", where);
+  c.screenH = pixelsField(root, "screenH", where);
+  c.viewCone = static_cast<float>(numberField(root, "viewCone", false, 40.0, where));
+  c.verticalAngle = static_cast<float>(numberField(root, "verticalAngle", false, 0.0, where));
+  c.invView = flagField(root, "invView", true, where);
+  c.flipImageX = flagField(root, "flipImageX", false, where);
+  c.flipImageY = flagField(root, "flipImageY", false, where);
+  c.flipSubp = flagField(root, "flipSubp", false, where);
+  c.serial = textField(root, "serial");
+  c.configVersion = textField(root, "configVersion");
+  checkCalibration(c, where);
+  const QuiltLayout layout = defaultQuiltLayout(c.screenW, c.screenH);
+  c.quiltColumns = layout.columns;
+  c.quiltRows = layout.rows;
+  return c;
+}
+
+LookingGlassCalibration loadLookingGlassCalibration(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open the Looking Glass calibration");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw std::runtime_error(path + ": cannot read the Looking Glass calibration");
+  try {
+    return parseLookingGlassCalibration(text.str());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(path + ": " + e.what());
+  }
+}
+
+Image interleaveQuilt(VulkanContext& context, const Image& quilt, int columns, int rows,
+                      const LookingGlassCalibration& cal) {
+  const std::string where = "interleaveQuilt: ";
+  if (columns < 1 || rows < 1)
+    throw std::invalid_argument(where + "the quilt layout must be at least 1 × 1 (got " + std::to_string(columns) +
+                                " × " + std::to_string(rows) + ")");
+  const uint32_t cols = static_cast<uint32_t>(columns), rws = static_cast<uint32_t>(rows);
+  if (quilt.width < cols || quilt.height < rws || quilt.width % cols != 0 || quilt.height % rws != 0)
+    throw std::invalid_argument(where + "a " + std::to_string(quilt.width) + " × " + std::to_string(quilt.height) +
+                                " quilt does not split into " + std::to_string(columns) + " × " +
+                                std::to_string(rows) + " equal tiles");
+  if (quilt.rgb.size() != static_cast<size_t>(quilt.width) * quilt.height * 3)
+    throw std::invalid_argument(where + "the quilt holds " + std::to_string(quilt.rgb.size()) + " floats, not " +
+                                std::to_string(static_cast<size_t>(quilt.width) * quilt.height * 3));
+  checkCalibration(cal, where + "calibration ");
+
+  VulkanDevice& d = context.device();
+  const VkDeviceSize quiltBytes = static_cast<VkDeviceSize>(quilt.rgb.size()) * sizeof(float);
+  const VkDeviceSize panelBytes = static_cast<VkDeviceSize>(cal.screenW) * cal.screenH * 3 * sizeof(float);
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(d.physical, &props);
+  const VkDeviceSize limit = props.limits.maxStorageBufferRange;
+  if (quiltBytes > limit || panelBytes > limit)
+    throw std::runtime_error(where + "the quilt (" + std::to_string(quiltBytes) + " bytes) or the panel image (" +
+                             std::to_string(panelBytes) + " bytes) exceeds the device's storage-buffer limit of " +
+                             std::to_string(limit) + " bytes");
+
+  // The lens phase per pixel step right, per pixel step up, per subpixel, and at pixel (0, 0)
+  // (its centre), in double precision before the shader's fixed-point arithmetic.
+  const double w = cal.screenW, h = cal.screenH, slope = cal.slope;
+  const double pitchEff = double(cal.pitch) * w / double(cal.dpi) * std::cos(std::atan(1.0 / slope));
+  const double tilt = h / (w * slope);
+  const double subp = (cal.flipSubp ? -1.0 : 1.0) / (3.0 * w);
+  const double perX = pitchEff / w, perY = pitchEff * tilt / h;
+
+  LookingGlassPush push{};
+  push.screen[0] = cal.screenW;
+  push.screen[1] = cal.screenH;
+  push.tile[0] = static_cast<int32_t>(quilt.width / cols);
+  push.tile[1] = static_cast<int32_t>(quilt.height / rws);
+  push.columns = columns;
+  push.rows = rows;
+  push.views = columns * rows;
+  push.flags = (cal.invView ? kInvView : 0u) | (cal.flipImageX ? kFlipX : 0u) | (cal.flipImageY ? kFlipY : 0u);
+  push.phase[0] = fixedTurns(perX);
+  push.phase[1] = fixedTurns(perY);
+  push.phase[2] = fixedTurns(subp * pitchEff);
+  push.phase[3] = fixedTurns(0.5 * perX + 0.5 * perY - double(cal.center));
+
+  InterleavePass pass(d);
+  pass.quilt = createBufferWithData(d, quilt.rgb.data(), quiltBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  pass.panel = createBuffer(d, panelBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+
+  VkDescriptorSetLayoutBinding bindings[2] = {};
+  for (uint32_t b = 0; b < 2; ++b) {
+    bindings[b].binding = b;
+    bindings[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[b].descriptorCount = 1;
+    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  lci.bindingCount = 2;
+  lci.pBindings = bindings;
+  VK_CHECK(vkCreateDescriptorSetLayout(d.device, &lci, nullptr, &pass.setLayout));
+  pass.layout = createPipelineLayout(d, pass.setLayout, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(LookingGlassPush));
+
+  VkComputePipelineCreateInfo pci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  pci.stage = VkPipelineShaderStageCreateInfo{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  pci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pci.stage.module = createShaderModule(d, kLookingGlassComp, sizeof kLookingGlassComp);
+  pci.stage.pName = "main";
+  pci.layout = pass.layout;
+  const VkResult created = vkCreateComputePipelines(d.device, VK_NULL_HANDLE, 1, &pci, nullptr, &pass.pipeline);
+  vkDestroyShaderModule(d.device, pci.stage.module, nullptr);
+  VK_CHECK(created);
+
+  const VkDescriptorPoolSize sizes[1] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
+  createSingleDescriptorSet(d, pass.setLayout, sizes, 1, pass.pool, pass.set);
+  const VkDescriptorBufferInfo infos[2] = {{pass.quilt.buffer, 0, VK_WHOLE_SIZE},
+                                           {pass.panel.buffer, 0, VK_WHOLE_SIZE}};
+  VkWriteDescriptorSet writes[2];
+  for (uint32_t b = 0; b < 2; ++b) {
+    writes[b] = VkWriteDescriptorSet{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = pass.set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(d.device, 2, writes, 0, nullptr);
+
+  submitAndWait(d, [&](VkCommandBuffer cmd) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pass.pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pass.layout, 0, 1, &pass.set, 0, nullptr);
+    vkCmdPushConstants(cmd, pass.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(cmd, (push.screen[0] + 7) / 8, (push.screen[1] + 7) / 8, 1);
+    // The fence alone does not make shader writes visible to the host: this barrier does.
+    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    toHost.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0,
+                         nullptr, 0, nullptr);
+  });
+
+  Image out;
+  out.width = static_cast<uint32_t>(cal.screenW);
+  out.height = static_cast<uint32_t>(cal.screenH);
+  out.rgb.resize(static_cast<size_t>(out.width) * out.height * 3);
+  std::memcpy(out.rgb.data(), pass.panel.mapped, out.rgb.size() * sizeof(float));
+  return out;
+}
+
+}  // namespace probecast::renderer
