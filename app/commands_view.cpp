@@ -317,11 +317,7 @@ void addViewCommand(CLI::App& app) {
                   "one sample at the pixel's centre, about N² times faster)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  cmd->add_option("--msaa", o->msaa,
-                  "multisample anti-aliasing: 1 (off), 2, 4 or 8 coverage samples per pixel, shaded once (with "
-                  "--supersample 1: smooth edges at about the cost of one sample)")
-      ->check(CLI::IsMember({1, 2, 4, 8}))
-      ->capture_default_str();
+  addMsaaOption(cmd, o->msaa);
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");

@@ -45,6 +45,7 @@ struct DemoOptions {
   std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
   uint32_t supersample = renderer::RasterOptions{}.samplesPerSide;  // the viewers' raster samples per pixel side
+  uint32_t msaa = renderer::RasterOptions{}.msaaSamples;            // and their MSAA samples
   AreaLightCli areaLights;               // the server's rule; the viewers follow what the stream says
   DeviceOptions device;                     // --device: the server's and the viewers' Vulkan device
 };

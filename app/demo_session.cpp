@@ -92,6 +92,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
     vc.height = v.height;
     vc.raster.visibility = o.visibility;
     vc.raster.samplesPerSide = o.supersample;
+    vc.raster.msaaSamples = o.msaa;
     vc.client.address = server.listen;
     vc.client.token = server.token;
     vc.client.name = v.name;

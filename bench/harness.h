@@ -104,10 +104,11 @@ class ReferenceCache {
 
 // Raster options for the benches that compare streams, representations or rules rather than
 // anti-aliasing: one raster sample per pixel, so their figures hold when the viewers' default
-// (RasterOptions::samplesPerSide) moves. bench scene and bench raster take --supersample.
+// (RasterOptions::samplesPerSide, msaaSamples) moves. bench scene and bench raster take --supersample.
 inline renderer::RasterOptions singleSampleRaster() {
   renderer::RasterOptions o;
   o.samplesPerSide = 1;
+  o.msaaSamples = 1;
   return o;
 }
 

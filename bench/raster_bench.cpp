@@ -198,6 +198,7 @@ nlohmann::json rasterJson(const RasterBenchOptions& o, const std::string& device
   json["shadow_map_size"] = o.raster.shadowMapSize;
   json["shadow_cascades"] = o.raster.shadowCascades;
   json["supersample"] = o.raster.samplesPerSide;  // ms per view are for the supersampled size
+  json["msaa_samples"] = o.raster.msaaSamples;
   json["area_lights"] = o.raster.areaLights.enabled;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
   if (!m.quality.empty()) json["shadow_ms"] = m.firstShadowMs;
@@ -231,8 +232,9 @@ nlohmann::json rasterJson(const RasterBenchOptions& o, const std::string& device
 // The table, up to the volume updates (timeVolumeUpdates adds their rows).
 std::string rasterTable(const RasterBenchOptions& o, const std::string& device, const Reference& ref,
                         const RasterMetrics& m) {
-  std::string table = fmt::format("raster bench: {} at {}x{} on {}; reference {} spp, {}\n", o.scene.name, o.width,
-                                  o.height, device, o.referenceSpp, describeFloor(ref));
+  std::string table = fmt::format("raster bench: {} at {}x{} ({}x{} supersampled, MSAA {}) on {}; reference {} spp, {}\n",
+                                  o.scene.name, o.width, o.height, o.raster.samplesPerSide, o.raster.samplesPerSide,
+                                  o.raster.msaaSamples, device, o.referenceSpp, describeFloor(ref));
   table += fmt::format("{:<6} {:>9} {:>7} {:>11}\n", "repr", "PSNR dB", "SSIM", "ms/view");
   for (const Quality& q : m.quality)
     table += fmt::format("{:<6} {:>9.2f} {:>7.4f} {:>11.2f}\n", q.r.name, q.metrics.psnrDb, q.metrics.ssim, q.msPerView);

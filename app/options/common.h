@@ -46,6 +46,16 @@ inline CLI::Option* addVisibilityOption(CLI::App* cmd, bool& visibility) {
       ->check(CLI::IsMember({"on", "off"}));
 }
 
+// --msaa 1|2|4|8: multisample anti-aliasing in the raster client (RasterOptions::msaaSamples).
+inline CLI::Option* addMsaaOption(CLI::App* cmd, uint32_t& samples) {
+  return cmd
+      ->add_option("--msaa", samples,
+                   "raster client: multisample anti-aliasing, 1 (off), 2, 4 or 8 coverage samples per pixel, shaded "
+                   "once per pixel")
+      ->check(CLI::IsMember({1, 2, 4, 8}))
+      ->capture_default_str();
+}
+
 // --json FILE, required by every benchmark.
 inline CLI::Option* addJsonOption(CLI::App* cmd, std::string& json) {
   return cmd->add_option("--json", json, "write the results as JSON here")->required();
