@@ -1,6 +1,8 @@
 // `probecast view`: render mono, stereo or light-field views of a scene lit by a probe volume.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <optional>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -10,6 +12,7 @@
 #include "progress.h"
 #include "probecast/imaging/image_io.h"
 #include "probecast/codec/probe_file.h"
+#include "probecast/renderer/looking_glass.h"
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/view_sets.h"
 #include "probecast/service/client.h"
@@ -41,7 +44,29 @@ struct ViewOptions {
   std::string sceneCache;             // --connect: where fetched scenes are kept (empty: the default)
   uint64_t sceneMaxBytes = uint64_t{4} << 30;
   LiveWindowOptions window;
+  std::string lookingGlass;  // a display's calibration (visual.json)
+  CLI::Option* viewsOption = nullptr;
+  CLI::Option* sizeOption = nullptr;
 };
+
+// The picture a Looking Glass shows: the quilt interleaved by its calibration.
+renderer::Image interleaved(renderer::VulkanContext& context, const std::vector<renderer::Image>& images,
+                            const std::vector<renderer::ViewInfo>& views, const renderer::LookingGlassCalibration& lg) {
+  return renderer::interleaveQuilt(context, renderer::composeQuilt(images, views, lg.quiltColumns, lg.quiltRows),
+                                   lg.quiltColumns, lg.quiltRows, lg);
+}
+
+// A window shows the interleaved image at the panel's native size.
+void showOnLookingGlass(FrameSource& source, renderer::VulkanContext& context,
+                        const renderer::LookingGlassCalibration* lg) {
+  if (!lg) return;
+  source.compose = [&context, lg](const std::vector<renderer::Image>& images,
+                                  const std::vector<renderer::ViewInfo>& views) {
+    return interleaved(context, images, views, *lg);
+  };
+  source.displayWidth = static_cast<uint32_t>(lg->screenW);
+  source.displayHeight = static_cast<uint32_t>(lg->screenH);
+}
 
 imaging::ToneMap toneMapOf(const ViewOptions& o) {
   imaging::ToneMap toneMap = imaging::ToneMap::Filmic;
@@ -189,7 +214,8 @@ Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, con
 // newest volume held, through stalls and reconnects.
 void windowFromServer(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
                       const std::string& sceneSpec, const renderer::ViewSetSpec& spec,
-                      const renderer::ViewSetOptions& vso, const renderer::RasterOptions& ro) {
+                      const renderer::ViewSetOptions& vso, const renderer::RasterOptions& ro,
+                      const renderer::LookingGlassCalibration* lg) {
   const renderer::CameraView start = renderer::CameraView::fromScene(s);
   session::Viewer viewer(context, s, renderer::makeViewSet(start, spec, vso), streamViewerConfig(o, sceneSpec, ro));
   viewer.start();
@@ -211,6 +237,7 @@ void windowFromServer(const ViewOptions& o, renderer::VulkanContext& context, co
     return true;
   };
   source.status = [&] { return status.line(); };
+  showOnLookingGlass(source, context, lg);
   runLiveWindow(o.window, context, start, spec, vso, o.size[0], o.size[1],
                 glm::length(s.boundsMax - s.boundsMin), source, o.out, o.exposure, toneMapOf(o));
   viewer.stop();
@@ -220,7 +247,8 @@ void windowFromServer(const ViewOptions& o, renderer::VulkanContext& context, co
 
 // A live window on local probes: a file's, or traced one update per frame up to --updates.
 void windowLocal(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
-                 const renderer::ViewSetSpec& spec, const renderer::ViewSetOptions& vso, renderer::RasterOptions ro) {
+                 const renderer::ViewSetSpec& spec, const renderer::ViewSetOptions& vso, renderer::RasterOptions ro,
+                 const renderer::LookingGlassCalibration* lg) {
   std::unique_ptr<renderer::ProbeUpdater> updater;
   ProbeVolume volume;
   AreaLightRule rule;
@@ -257,6 +285,7 @@ void windowLocal(const ViewOptions& o, renderer::VulkanContext& context, const s
   source.status = [&] {
     return updater ? fmt::format("traced here: update {}/{}", done, o.updates) : "probes from " + o.probes;
   };
+  showOnLookingGlass(source, context, lg);
   const renderer::CameraView start = renderer::CameraView::fromScene(s);
   runLiveWindow(o.window, context, start, spec, vso, o.size[0], o.size[1], glm::length(s.boundsMax - s.boundsMin),
                 source, o.out, o.exposure, toneMapOf(o));
@@ -310,8 +339,16 @@ void addViewCommand(CLI::App& app) {
   o->connection.add(cmd, "take the probes from a probecast server (host:port) instead", false, false);
   cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
       ->check(CLI::Range(0.1, 3600.0));
-  cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
-  addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
+  o->viewsOption =
+      cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
+  o->sizeOption = addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
+  cmd->add_option("--looking-glass", o->lookingGlass,
+                  "a Looking Glass display's calibration (visual.json): render its view set (8x6 on portrait "
+                  "displays, 5x9 on others, across its view cone; views 560 pixels high at its aspect unless --size) "
+                  "and interleave it for the panel: looking_glass.png/.exr beside the quilt, or the window (with "
+                  "--fullscreen on the display)")
+      ->check(CLI::ExistingFile)
+      ->excludes(o->viewsOption);
   cmd->add_option("--supersample", o->supersample,
                   "N × N raster samples per pixel, averaged (as a reference averages the pixel's footprint; 1: "
                   "one sample at the pixel's centre, about N² times faster)")
@@ -364,8 +401,20 @@ void addViewCommand(CLI::App& app) {
       environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     }
     const scene::Scene s = session::loadSceneOrThrow(sceneSpec, t);
-    const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(
-        renderer::CameraView::fromScene(s), spec, session::viewSetOptions(s, o->size[0], o->size[1]));
+    std::optional<renderer::LookingGlassCalibration> lg;
+    if (!o->lookingGlass.empty()) {
+      lg = renderer::loadLookingGlassCalibration(o->lookingGlass);
+      spec = {renderer::ViewSetSpec::Kind::HorizontalLightField, lg->quiltColumns, lg->quiltRows};
+      o->views = fmt::format("lfh:{}x{}", lg->quiltColumns, lg->quiltRows);
+      if (o->sizeOption->count() == 0)  // each view has the panel's aspect
+        o->size = {std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(560.0 * lg->screenW / lg->screenH))), 560};
+      fmt::print("view: Looking Glass {} ({}x{}): {} views ({}x{} quilt) of {}x{} across {} degrees\n",
+                 lg->serial.empty() ? std::string("display") : lg->serial, lg->screenW, lg->screenH,
+                 spec.count(), spec.columns, spec.rows, o->size[0], o->size[1], lg->viewCone);
+    }
+    renderer::ViewSetOptions vso = session::viewSetOptions(s, o->size[0], o->size[1]);
+    if (lg) vso.lfConeDeg = lg->viewCone;
+    const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, vso);
     // Only live probes are traced here: every other viewer rasterises, on any Vulkan 1.3 device.
     renderer::ContextOptions co =
         o->tracing.device.context(/*rayTracing=*/o->connection.connect.empty() && o->probes == "live");
@@ -383,16 +432,24 @@ void addViewCommand(CLI::App& app) {
     ro.msaaSamples = o->msaa;
     renderer::checkRasterSize(o->size[0], o->size[1], ro);  // before any tracing or connecting
     if (o->window.enabled) {
-      const renderer::ViewSetOptions vso = session::viewSetOptions(s, o->size[0], o->size[1]);
       if (o->connection.connect.empty())
-        windowLocal(*o, context, s, spec, vso, ro);
+        windowLocal(*o, context, s, spec, vso, ro, lg ? &*lg : nullptr);
       else
-        windowFromServer(*o, context, s, sceneSpec, spec, vso, ro);
+        windowFromServer(*o, context, s, sceneSpec, spec, vso, ro, lg ? &*lg : nullptr);
       return;
     }
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, sceneSpec, views, ro);
     writeViews(*o, r, views, spec);
+    if (lg) {
+      const renderer::Image panel = interleaved(context, r.images, views, *lg);
+      const auto w = static_cast<int>(panel.width), h = static_cast<int>(panel.height);
+      orThrow(imaging::writePngPreview(o->out + "/looking_glass.png", panel.rgb, w, h, o->exposure, error,
+                                       toneMapOf(*o)) &&
+                  imaging::writeExr(o->out + "/looking_glass.exr", panel.rgb, w, h, error),
+              error);
+      fmt::print("view: wrote {}/looking_glass.png and .exr ({}x{}, interleaved for the panel)\n", o->out, w, h);
+    }
     fmt::print("view: {} {} views of {}x{} ({}² samples per pixel) on {}: {:.1f} ms per view, shadow maps {:.1f} ms; "
                "wrote {}/quilt.png and quilt.exr\n",
                o->views, views.size(), o->size[0], o->size[1], o->supersample, context.deviceName(),

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# `view --looking-glass`: a display's calibration picks the view set (8x6 on a portrait panel) and
+# the views are interleaved into one panel-sized image; a broken calibration is refused by name,
+# with nothing written.
+set -euo pipefail
+probecast=$1
+work=$2
+cal=$3
+rm -rf "$work"
+mkdir -p "$work"
+"$probecast" bake --scene builtin:cornell --grid 4,4,4 --spp 16 --updates 1 --out "$work/p.pcpv" >/dev/null
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --looking-glass "$cal" --size 24x32 --supersample 1 \
+  --out "$work/lg" | tee "$work/lg.log"
+grep -q "Looking Glass example-portrait (1536x2048): 48 views (8x6 quilt) of 24x32 across 40 degrees" "$work/lg.log"
+/usr/bin/python3 - "$work/lg/looking_glass.png" "$work/lg/quilt.png" <<'PY'
+import sys
+import matplotlib.image as mpimg
+panel, quilt = mpimg.imread(sys.argv[1]), mpimg.imread(sys.argv[2])
+assert panel.shape[:2] == (2048, 1536), panel.shape
+assert quilt.shape[:2] == (6 * 32, 8 * 24), quilt.shape
+# Interleaved: neighbouring subpixels come from different views, so the panel is far from a
+# smooth picture; but every value comes from the quilt.
+assert panel[..., :3].std() > 0.01
+print("looking glass panel %dx%d from a %dx%d quilt" % (panel.shape[1], panel.shape[0], quilt.shape[1], quilt.shape[0]))
+PY
+# A calibration without its pitch.
+grep -v '"pitch"' "$cal" >"$work/broken.json"
+set +e
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --looking-glass "$work/broken.json" --out "$work/broken" \
+  >"$work/broken.log" 2>&1
+rc=$?
+set -e
+[ "$rc" -ne 0 ] || { echo "a calibration without pitch was taken"; exit 1; }
+grep -q "pitch" "$work/broken.log" || { cat "$work/broken.log"; exit 1; }
+[ ! -e "$work/broken/looking_glass.png" ]
+echo "looking glass ok"
