@@ -133,7 +133,7 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
     const std::string status = source.status();
     if (o.overlay)
       imaging::drawTextLine(rgba, static_cast<int>(shown.width), static_cast<int>(shown.height), 6, 0,
-                            fmt::format("{:.1f} ms | {}", lastMs, status), shown.width >= 640 ? 2 : 1);
+                            fmt::format("{:.1f} ms | {}", lastMs, status), shown.width >= 1280 ? 2 : 1);
     const bool screenshot =
         in.screenshot || (!screenshotDone && o.screenshotAfter >= 0.0 && secondsSince(begin) >= o.screenshotAfter);
     std::vector<uint8_t> readback;

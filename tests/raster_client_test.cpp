@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "probecast/renderer/glossy_sh.h"
 #include "probecast/renderer/probe_updater.h"
@@ -125,6 +126,65 @@ TEST(RasterClient, RasterOnlyDeviceDrawsWhatARayTracingOneDraws) {
     FAIL() << "an updater on a raster-only device";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("the probe updater needs ray tracing"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RasterClient, MsaaSmoothsEdgesTowardTheSupersampledPictureOverTheEnvironment) {
+  // A floating quad against a bright uniform sky: with MSAA the edge pixels blend quad and sky as
+  // the 4×4-supersampled picture does (the sky goes behind what the samples left uncovered);
+  // inside the quad and in open sky nothing changes.
+  VulkanContext context(test::validatedContext());
+  scene::Scene s;
+  scene::Material grey;
+  grey.baseColor = glm::vec3(0.5f);
+  grey.emission = glm::vec3(0.2f);
+  s.materials.push_back(grey);
+  scene::addQuad(s, {-0.7f, -0.45f, 0}, {0.6f, -0.55f, 0}, {0.55f, 0.5f, 0}, {-0.65f, 0.4f, 0}, 0);
+  scene::finalizeScene(s);
+  auto sky = std::make_shared<Environment>();
+  std::string error;
+  ASSERT_TRUE(makeUniformSky(glm::vec3(2.0f, 1.5f, 1.0f), *sky, error)) << error;
+  CameraView cam;
+  cam.position = {0, 0, 2.5f};
+  cam.forward = {0, 0, -1};
+  cam.up = {0, 1, 0};
+  cam.yfov = 0.7f;
+  auto draw = [&](uint32_t perSide, uint32_t msaa) {
+    RasterOptions o;
+    o.samplesPerSide = perSide;
+    o.msaaSamples = msaa;
+    o.environment = sky;
+    RasterRenderer raster(context, s, 48, 32, o);
+    raster.setProbes(makeProbeVolume(ProbeGrid{{2, 2, 2}, {{-1, -1, -1}, {1, 1, 1}}}));
+    return raster.render(raster.viewProjection(cam), cam.position);
+  };
+  const Image one = draw(1, 1), msaa = draw(1, 4), super = draw(4, 1);
+  double errOne = 0.0, errMsaa = 0.0;
+  size_t edges = 0, changed = 0;
+  for (size_t p = 0; p < one.rgb.size() / 3; ++p) {
+    double dOne = 0.0, dMsaa = 0.0, dEach = 0.0;
+    for (size_t c = 0; c < 3; ++c) {
+      dOne += std::abs(one.rgb[p * 3 + c] - super.rgb[p * 3 + c]);
+      dMsaa += std::abs(msaa.rgb[p * 3 + c] - super.rgb[p * 3 + c]);
+      dEach += std::abs(msaa.rgb[p * 3 + c] - one.rgb[p * 3 + c]);
+    }
+    errOne += dOne;
+    errMsaa += dMsaa;
+    edges += dOne > 0.05 ? 1 : 0;
+    changed += dEach > 1e-4 ? 1 : 0;
+  }
+  EXPECT_GT(edges, 20u);                   // the quad has edges to smooth
+  EXPECT_LT(errMsaa, 0.35 * errOne);       // and MSAA smooths them most of the way
+  EXPECT_LT(changed, one.rgb.size() / 6);  // only edge pixels change (well under half of them)
+  EXPECT_GT(changed, 10u);
+  EXPECT_EQ(context.validationMessages(), 0u);
+  try {
+    RasterOptions bad;
+    bad.msaaSamples = 3;
+    RasterRenderer raster(context, s, 8, 8, bad);
+    FAIL() << "3 MSAA samples taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "MSAA samples must be 1, 2, 4 or 8");
   }
 }
 
