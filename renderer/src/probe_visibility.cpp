@@ -224,6 +224,35 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
                         GpuImage& depth, Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances,
                         const std::vector<uint8_t>* only = nullptr) {
   uint64_t drawn = 0;
+  // The opaque triangles each face keeps, gathered into one index list per face and drawn with one
+  // call per face (depth only: nothing needs their numbers in the scene): small clusters cull
+  // tightly without a draw call each. The same triangles in the same order: the same depths.
+  struct FaceDraw {
+    uint32_t firstIndex = 0, indexCount = 0, probe = 0, face = 0;
+  };
+  std::vector<FaceDraw> faceDraws;
+  Buffer gathered;
+  if (!vis.opaque.empty()) {
+    std::vector<uint32_t> list;
+    std::vector<DrawRun> runs;
+    const auto* indices = static_cast<const uint32_t*>(gpu.accel.indices.mapped);
+    for (uint32_t k = 0; k < n; ++k) {
+      if (only && !(*only)[k]) continue;
+      const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
+      for (uint32_t f = 0; f < 6; ++f) {
+        faceRuns(vis.opaque, probe, f, reach, cull, runs);
+        FaceDraw fd{static_cast<uint32_t>(list.size()), 0, k, f};
+        for (const DrawRun& run : runs) {
+          list.insert(list.end(), indices + size_t{3} * run.firstTriangle,
+                      indices + size_t{3} * (run.firstTriangle + run.triangles));
+          drawn += run.triangles;
+        }
+        fd.indexCount = static_cast<uint32_t>(list.size()) - fd.firstIndex;
+        if (fd.indexCount > 0) faceDraws.push_back(fd);
+      }
+    }
+    gathered = createBufferWithData(d, list.data(), list.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  }
   submitAndWait(d, [&](VkCommandBuffer cmd) {
     transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
     const VkRenderingAttachmentInfo depthInfo =
@@ -238,28 +267,43 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
     vkCmdBindVertexBuffers(cmd, 0, 3, streams, offsets);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vis.layout, 0, 1, &materials, 0, nullptr);
     std::vector<DrawRun> runs;
+    auto placeFace = [&](uint32_t k, uint32_t f, const glm::vec3& probe) {
+      const auto x = static_cast<int32_t>(((k % kBatchColumns) * 6 + f) * kCube);
+      const auto y = static_cast<int32_t>((k / kBatchColumns) * kCube);
+      const VkViewport viewport{static_cast<float>(x), static_cast<float>(y), kCube, kCube, 0.0f, 1.0f};
+      const VkRect2D scissor{{x, y}, {kCube, kCube}};
+      vkCmdSetViewport(cmd, 0, 1, &viewport);
+      vkCmdSetScissor(cmd, 0, 1, &scissor);
+      shaders::RsShadowPush push{};
+      const glm::mat4 vp = faces[f] * glm::translate(glm::mat4(1.0f), -probe);
+      std::memcpy(&push.viewProj, &vp[0][0], sizeof push.viewProj);
+      return push;
+    };
+    auto probeAt = [&](uint32_t k) {
+      return glm::vec3(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
+    };
+    if (!faceDraws.empty()) {  // the opaque triangles, one draw per face
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vis.pipeline);
+      vkCmdBindIndexBuffer(cmd, gathered.buffer, 0, VK_INDEX_TYPE_UINT32);
+      for (const FaceDraw& fd : faceDraws) {
+        const shaders::RsShadowPush push = placeFace(fd.probe, fd.face, probeAt(fd.probe));
+        vkCmdPushConstants(cmd, vis.layout, kStages, 0, sizeof push, &push);
+        vkCmdDrawIndexed(cmd, fd.indexCount, 1, fd.firstIndex, 0, 0);
+      }
+    }
     vkCmdBindIndexBuffer(cmd, gpu.accel.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
-    // The opaque triangles, then the cut-outs (shadow.frag finds each one's material by number).
-    for (int pass = 0; pass < 2; ++pass) {
-      const std::vector<VisibilityCluster>& clusters = pass == 0 ? vis.opaque : vis.cutouts;
+    // The cut-outs, by runs of the scene's order (shadow.frag finds each one's material by number).
+    for (int pass = 1; pass < 2; ++pass) {
+      const std::vector<VisibilityCluster>& clusters = vis.cutouts;
       if (clusters.empty()) continue;
-      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pass == 0 ? vis.pipeline : vis.cutoutPipeline);
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vis.cutoutPipeline);
       for (uint32_t k = 0; k < n; ++k) {
         if (only && !(*only)[k]) continue;
-        const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
-        const glm::mat4 move = glm::translate(glm::mat4(1.0f), -probe);
+        const glm::vec3 probe = probeAt(k);
         for (uint32_t f = 0; f < 6; ++f) {
           faceRuns(clusters, probe, f, reach, cull, runs);
           if (runs.empty()) continue;
-          const auto x = static_cast<int32_t>(((k % kBatchColumns) * 6 + f) * kCube);
-          const auto y = static_cast<int32_t>((k / kBatchColumns) * kCube);
-          const VkViewport viewport{static_cast<float>(x), static_cast<float>(y), kCube, kCube, 0.0f, 1.0f};
-          const VkRect2D scissor{{x, y}, {kCube, kCube}};
-          vkCmdSetViewport(cmd, 0, 1, &viewport);
-          vkCmdSetScissor(cmd, 0, 1, &scissor);
-          shaders::RsShadowPush push{};
-          const glm::mat4 vp = faces[f] * move;
-          std::memcpy(&push.viewProj, &vp[0][0], sizeof push.viewProj);
+          shaders::RsShadowPush push = placeFace(k, f, probe);
           for (const DrawRun& run : runs) {
             push.primitiveBase = run.firstTriangle;
             vkCmdPushConstants(cmd, vis.layout, kStages, 0, sizeof push, &push);
@@ -281,6 +325,7 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0,
                          nullptr);
   });
+  destroyBuffer(d, gathered);
   // Depth → distance: unproject through the face's inverse (the probe at the origin).
   std::vector<glm::mat4> inverse;
   for (const glm::mat4& f : faces) inverse.push_back(glm::inverse(f));

@@ -56,7 +56,7 @@ struct ProbeVisibility {
   uint64_t trianglesDrawn = 0;             // last build: triangles drawn over every cube face
 };
 
-constexpr uint32_t kVisibilityClusterTriangles = 64;  // most triangles per cluster
+constexpr uint32_t kVisibilityClusterTriangles = 16;  // most triangles per cluster
 
 // `materials`: the raster client's set layout (the depth pass binds none of it, the layout is shared).
 // Starts with one probe at the origin and an empty map (every direction open), so descriptors are valid.
