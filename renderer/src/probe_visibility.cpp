@@ -236,17 +236,24 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
     std::vector<uint32_t> list;
     std::vector<DrawRun> runs;
     const auto* indices = static_cast<const uint32_t*>(gpu.accel.indices.mapped);
+    const auto* vertices = static_cast<const glm::vec3*>(gpu.accel.positions.mapped);
     for (uint32_t k = 0; k < n; ++k) {
       if (only && !(*only)[k]) continue;
       const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
       for (uint32_t f = 0; f < 6; ++f) {
         faceRuns(vis.opaque, probe, f, reach, cull, runs);
         FaceDraw fd{static_cast<uint32_t>(list.size()), 0, k, f};
-        for (const DrawRun& run : runs) {
-          list.insert(list.end(), indices + size_t{3} * run.firstTriangle,
-                      indices + size_t{3} * (run.firstTriangle + run.triangles));
-          drawn += run.triangles;
-        }
+        for (const DrawRun& run : runs)
+          for (uint32_t t = run.firstTriangle; t < run.firstTriangle + run.triangles; ++t) {
+            const uint32_t* tri = indices + size_t{3} * t;
+            if (cull) {  // each triangle's own box, as the clusters' were tested
+              const glm::vec3 a = vertices[tri[0]] - probe, b = vertices[tri[1]] - probe, c = vertices[tri[2]] - probe;
+              const glm::vec3 lo = glm::min(a, glm::min(b, c)), hi = glm::max(a, glm::max(b, c));
+              if (!(clusterInReach(lo, hi, reach) && clusterInFace(lo, hi, f))) continue;
+            }
+            list.insert(list.end(), tri, tri + 3);
+            ++drawn;
+          }
         fd.indexCount = static_cast<uint32_t>(list.size()) - fd.firstIndex;
         if (fd.indexCount > 0) faceDraws.push_back(fd);
       }
