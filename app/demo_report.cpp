@@ -110,13 +110,14 @@ std::string reportMarkdown(const DemoOptions& o, const nlohmann::json& report, c
         v["converged_to_server_volume"].get<bool>() ? "yes" : "no");
   md += fmt::format(
       "\nPSNR and SSIM are computed after the same plain gamma 2.2 on both images, without "
-      "clamping; the PNGs use a filmic tone map. Each viewer pixel is the mean of {}² raster samples, "
-      "as each reference pixel averages its area. The reference has noise of its own: its two "
+      "clamping; the PNGs use a filmic tone map. Viewer pixels are anti-aliased ({}² raster "
+      "samples per pixel, {}× MSAA), as each reference pixel averages its area. The reference has "
+      "noise of its own: its two "
       "halves ({} samples per pixel each, different seeds) of the headset's left eye differ by "
       "{:.2f} dB PSNR, SSIM {:.4f}, so the reference itself is about {:.1f} dB from converged — the "
       "ceiling these figures can reach. Light-field views compared: the corners and the centre ({} "
       "in quilt order).\n\n",
-      o.supersample, o.referenceSpp / 2, report["reference_noise_floor"]["psnr_db"].get<double>(),
+      o.supersample, o.msaa, o.referenceSpp / 2, report["reference_noise_floor"]["psnr_db"].get<double>(),
       report["reference_noise_floor"]["ssim"].get<double>(),
       report["reference_noise_floor"]["reference_accuracy_db"].get<double>(),
       report["viewers"][1]["reference_views"].dump());
@@ -246,7 +247,8 @@ void compareWithReferences(const DemoOptions& o, DemoRun& run, const scene::Scen
   }
   Progress progress("demo");
   const auto status = [&progress](const std::string& s) { progress.message(s); };
-  bench::ReferenceCache cache(*run.viewerContext, o.referenceCache, status);
+  // References are path-traced: on the server's device (the viewers' is raster-only).
+  bench::ReferenceCache cache(*run.serverContext, o.referenceCache, status);
   report["reference_cache"] = cache.dir();
   const auto done = [&] {
     ++referencesDone;

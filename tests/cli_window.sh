@@ -53,7 +53,7 @@ serve() {
 }
 serve 1
 "$probecast" view --connect "127.0.0.1:$port" --token t0k "${view[@]}" --exr --wait 1 --out "$work/remote-off" >/dev/null
-"$probecast" view --connect "127.0.0.1:$port" --token t0k "${view[@]}" --window --window-seconds 14 \
+"$probecast" view --connect "127.0.0.1:$port" --token t0k "${view[@]}" --window --window-seconds 90 \
   --out "$work/remote-window" >"$work/remote-window.log" 2>&1 &
 viewer=$!
 pids+=($viewer)
@@ -71,8 +71,14 @@ sleep 4
 before=$(grep -c "frames presented" "$work/remote-window.log")
 grep -q "reconnecting" "$work/remote-window.log"
 serve 2
-sleep 4
+# Connected again after the reconnecting lines; then Escape closes the window.
+for _ in $(seq 300); do
+  sed -n '/reconnecting/,$p' "$work/remote-window.log" | grep -q "frames presented.*connected to" && break
+  sleep 0.1
+done
+xdotool key --window "$id" Escape
 wait "$viewer"
+grep -q "window: closed after" "$work/remote-window.log"
 python3 - "$work/remote-window.log" <<'PY'
 import re, sys
 lines = [l for l in open(sys.argv[1]) if l.startswith("window: ") and "frames presented," in l]

@@ -186,8 +186,8 @@ TEST(ImageHarness, ComparisonRefusesNonFinitePixelsAndSizeMismatch) {
 }
 
 // At a small size the raster client's one sample per pixel aliases every edge, while the
-// reference averages each pixel's area: supersampling the raster (the same footprint) must score
-// clearly closer to the reference than one sample per pixel.
+// reference averages each pixel's area: supersampling the raster (the same footprint) or MSAA
+// (the default) must score clearly closer to the reference than one sample per pixel.
 TEST(SceneBench, SupersamplingMatchesThePixelFootprintOfTheReference) {
   const std::filesystem::path dir = std::filesystem::path(PROBECAST_TEST_TMP) / "scene_bench_supersample";
   std::filesystem::remove_all(dir);
@@ -204,14 +204,20 @@ TEST(SceneBench, SupersamplingMatchesThePixelFootprintOfTheReference) {
   o.referenceCache = dir.string();
   o.context = test::validatedContext();
   const auto floatPsnr = [](const SceneBenchResult& r) { return r.json["representations"][0]["psnr_db"].get<double>(); };
-  EXPECT_EQ(o.raster.samplesPerSide, 4u) << "the library's default is supersampled";
-  const SceneBenchResult four = runSceneBench(o);
-  o.raster.samplesPerSide = 1;
+  EXPECT_EQ(o.raster.samplesPerSide, 1u) << "the library's default anti-aliases by MSAA";
+  EXPECT_EQ(o.raster.msaaSamples, 4u);
+  const SceneBenchResult msaa = runSceneBench(o);
+  o.raster.msaaSamples = 1;
   const SceneBenchResult one = runSceneBench(o);  // the cached reference, the same probes
+  o.raster.samplesPerSide = 4;
+  const SceneBenchResult four = runSceneBench(o);
   EXPECT_EQ(four.json["supersample"].get<uint32_t>(), 4u);
   EXPECT_EQ(one.json["supersample"].get<uint32_t>(), 1u);
+  EXPECT_EQ(msaa.json["msaa_samples"].get<uint32_t>(), 4u);
   EXPECT_GT(floatPsnr(four), floatPsnr(one) + 2.0) << "1 sample per pixel " << floatPsnr(one) << " dB, 16: "
                                                    << floatPsnr(four) << " dB";
+  EXPECT_GT(floatPsnr(msaa), floatPsnr(one) + 2.0) << "1 sample per pixel " << floatPsnr(one) << " dB, MSAA 4: "
+                                                   << floatPsnr(msaa) << " dB";
   std::filesystem::remove_all(dir);
   o.raster.samplesPerSide = 0;
   EXPECT_THROW(checkSceneBenchOptions(o), std::invalid_argument);
