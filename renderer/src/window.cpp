@@ -176,7 +176,21 @@ Window::Window(VulkanContext& context, const WindowOptions& options) : impl_(std
     throw std::invalid_argument("a window needs 1..16384 pixels a side");
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
-  GLFWmonitor* monitor = options.fullscreen ? glfwGetPrimaryMonitor() : nullptr;
+  GLFWmonitor* monitor = nullptr;
+  if (options.fullscreen) {
+    monitor = glfwGetPrimaryMonitor();
+    int count = 0;
+    GLFWmonitor** monitors = glfwGetMonitors(&count);
+    for (int i = 0; i < count; ++i) {
+      const GLFWvidmode* mode = glfwGetVideoMode(monitors[i]);
+      if (mode && static_cast<uint32_t>(mode->width) == options.width &&
+          static_cast<uint32_t>(mode->height) == options.height) {
+        monitor = monitors[i];
+        break;
+      }
+    }
+    if (!monitor) throw std::runtime_error("--fullscreen: the window system reports no monitor");
+  }
   w.window = glfwCreateWindow(static_cast<int>(options.width), static_cast<int>(options.height), options.title.c_str(),
                               monitor, nullptr);
   if (!w.window) throw std::runtime_error("cannot open a window: " + gGlfwError);

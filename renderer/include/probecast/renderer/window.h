@@ -22,7 +22,9 @@ namespace probecast::renderer {
 struct WindowOptions {
   uint32_t width = 960, height = 600;  // of the drawable area, pixels
   std::string title = "probecast";
-  bool fullscreen = false;  // on the primary monitor, at its current mode
+  // Full screen at the monitor's current mode: the monitor whose mode is width × height when one
+  // is (a Looking Glass beside a desktop monitor), else the primary one.
+  bool fullscreen = false;
 };
 
 // What the user did since the last poll.
