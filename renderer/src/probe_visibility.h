@@ -11,9 +11,11 @@
 // at it, so the triangles wholly beyond it change nothing and are not drawn. The scene's triangles
 // are cut into clusters of consecutive ones (finalizeScene orders each material class by the Morton
 // code of the centroids, so a run is a compact piece of the scene), each with its bounds; each face
-// of each cube draws only the clusters whose bounds meet both the reach sphere and the face's 90°
-// pyramid. Cut-out (alphaMode Mask) triangles are drawn through shadow.frag, so what is cut away
-// does not block.
+// of each cube keeps the clusters whose bounds meet both the reach sphere and the face's 90°
+// pyramid, then, of the opaque ones, each triangle whose own box does, gathered into one index list
+// drawn with one call per face. Cut-out (alphaMode Mask) triangles are drawn by runs of clusters
+// through shadow.frag, which finds each one's material by its number, so what is cut away does
+// not block.
 #pragma once
 
 #include <cstdint>
