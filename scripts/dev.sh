@@ -60,15 +60,15 @@ case "$cmd" in
       ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L 'codec|bus' "$@"
     ;;
   fuzz)
-    # Four targets share the time: the codec's decoders (half), the probe bus decoder, scene
-    # manifests and glTF scenes (a sixth each).
+    # Five targets share the time: the codec's decoders (half), the probe bus decoder, scene
+    # manifests, glTF scenes and Looking Glass calibrations (an eighth each).
     secs=${1:-60}
     configure_and_build build-fuzz -DPROBECAST_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14
-    for target in codec bus manifest gltf; do
+    for target in codec bus manifest gltf calibration; do
       if [ "$target" = codec ]; then
         seeds=build-fuzz/seeds corpus=build-fuzz/corpus share=$(( (secs + 1) / 2 ))
       else
-        seeds=build-fuzz/seeds-$target corpus=build-fuzz/corpus-$target share=$(( secs / 6 ))
+        seeds=build-fuzz/seeds-$target corpus=build-fuzz/corpus-$target share=$(( secs / 8 ))
       fi
       [ "$share" -ge 1 ] || share=1
       mkdir -p "$seeds" "$corpus"

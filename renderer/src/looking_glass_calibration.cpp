@@ -1,0 +1,159 @@
+// Looking Glass calibration files (visual.json): parsed and checked without Vulkan, so the fuzz
+// build can take this file alone.
+#include "looking_glass_calibration.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace probecast::renderer {
+namespace {
+
+using nlohmann::json;
+
+constexpr int kMaxScreenSide = 16384;
+constexpr double kMinAbsSlope = 0.01;  // a lens sheet this flat would need a near-infinite tilt
+constexpr double kMaxAbsSlope = 1000.0;
+
+std::string show(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// A JSON value for an error message, cut short so a huge value cannot flood it.
+std::string showJson(const json& v) {
+  std::string text = v.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return text;
+}
+
+std::string quoted(const char* field) { return std::string("\"") + field + "\""; }
+
+// The field's value with an optional {"value": ...} wrapper taken off; null when absent.
+const json* fieldValue(const json& root, const char* field, const std::string& where) {
+  const auto it = root.find(field);
+  if (it == root.end()) return nullptr;
+  if (it->is_object()) {
+    const auto inner = it->find("value");
+    if (inner == it->end())
+      throw std::invalid_argument(where + "field " + quoted(field) + " is an object without \"value\"");
+    return &*inner;
+  }
+  return &*it;
+}
+
+// A finite number from the field, or `fallback` when it is absent and not required.
+double numberField(const json& root, const char* field, bool required, double fallback, const std::string& where) {
+  const json* v = fieldValue(root, field, where);
+  if (!v) {
+    if (required) throw std::invalid_argument(where + "missing required field " + quoted(field));
+    return fallback;
+  }
+  if (!v->is_number())
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be a number (got " + showJson(*v) + ")");
+  const double d = v->get<double>();
+  if (!std::isfinite(d))
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be finite (got " + show(d) + ")");
+  return d;
+}
+
+int pixelsField(const json& root, const char* field, const std::string& where) {
+  const double d = numberField(root, field, true, 0.0, where);
+  if (d != std::floor(d) || d < 1 || d > kMaxScreenSide)
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be a whole number of pixels in 1.." +
+                                std::to_string(kMaxScreenSide) + " (got " + show(d) + ")");
+  return static_cast<int>(d);
+}
+
+// Calibration files write flags as 0.0 / 1.0; JSON booleans are taken as well.
+bool flagField(const json& root, const char* field, bool fallback, const std::string& where) {
+  const json* v = fieldValue(root, field, where);
+  if (v && v->is_boolean()) return v->get<bool>();
+  const double d = numberField(root, field, false, fallback ? 1.0 : 0.0, where);
+  if (d != 0.0 && d != 1.0)
+    throw std::invalid_argument(where + "field " + quoted(field) + " must be 0 or 1 (got " + show(d) + ")");
+  return d == 1.0;
+}
+
+std::string textField(const json& root, const char* field) {
+  const auto it = root.find(field);
+  if (it == root.end()) return {};
+  const json& v = it->is_object() && it->contains("value") ? (*it)["value"] : *it;
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+}  // namespace
+
+// The checks both the parser and the interleaver rely on, on the values as stored (floats).
+void checkLookingGlassCalibration(const LookingGlassCalibration& c, const std::string& where) {
+  const auto field = [&](const char* name, const std::string& rule, double got) {
+    throw std::invalid_argument(where + "field " + quoted(name) + " " + rule + " (got " + show(got) + ")");
+  };
+  if (c.screenW < 1 || c.screenW > kMaxScreenSide)
+    field("screenW", "must be in 1.." + std::to_string(kMaxScreenSide), c.screenW);
+  if (c.screenH < 1 || c.screenH > kMaxScreenSide)
+    field("screenH", "must be in 1.." + std::to_string(kMaxScreenSide), c.screenH);
+  if (!std::isfinite(c.dpi) || c.dpi <= 0) field("DPI", "must be a finite number > 0", c.dpi);
+  if (!std::isfinite(c.pitch) || c.pitch <= 0) field("pitch", "must be a finite number > 0", c.pitch);
+  if (!std::isfinite(c.slope) || std::fabs(c.slope) < kMinAbsSlope || std::fabs(c.slope) > kMaxAbsSlope)
+    field("slope", "must be finite with |slope| in [" + show(kMinAbsSlope) + ", " + show(kMaxAbsSlope) + "]",
+          c.slope);
+  if (!std::isfinite(c.center)) field("center", "must be finite", c.center);
+  if (!std::isfinite(c.viewCone) || c.viewCone <= 0 || c.viewCone >= 180)
+    field("viewCone", "must be in (0, 180) degrees", c.viewCone);
+  if (!std::isfinite(c.verticalAngle)) field("verticalAngle", "must be finite", c.verticalAngle);
+}
+
+
+QuiltLayout defaultQuiltLayout(int screenW, int screenH) {
+  if (screenH > screenW) return {8, 6};  // portrait panels
+  if (screenW >= 3840) return {5, 9};    // the 4K/8K class
+  return {5, 9};                         // smaller landscape panels use the same layout
+}
+
+LookingGlassCalibration parseLookingGlassCalibration(const std::string& jsonText) {
+  const std::string where = "visual.json: ";
+  const json root = json::parse(jsonText, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded()) throw std::invalid_argument(where + "malformed JSON");
+  if (!root.is_object()) throw std::invalid_argument(where + "expected a JSON object, got " + showJson(root));
+
+  LookingGlassCalibration c;
+  c.pitch = static_cast<float>(numberField(root, "pitch", true, 0.0, where));
+  c.slope = static_cast<float>(numberField(root, "slope", true, 0.0, where));
+  c.center = static_cast<float>(numberField(root, "center", true, 0.0, where));
+  c.dpi = static_cast<float>(numberField(root, "DPI", true, 0.0, where));
+  c.screenW = pixelsField(root, "screenW", where);
+  c.screenH = pixelsField(root, "screenH", where);
+  c.viewCone = static_cast<float>(numberField(root, "viewCone", false, 40.0, where));
+  c.verticalAngle = static_cast<float>(numberField(root, "verticalAngle", false, 0.0, where));
+  c.invView = flagField(root, "invView", true, where);
+  c.flipImageX = flagField(root, "flipImageX", false, where);
+  c.flipImageY = flagField(root, "flipImageY", false, where);
+  c.flipSubp = flagField(root, "flipSubp", false, where);
+  c.serial = textField(root, "serial");
+  c.configVersion = textField(root, "configVersion");
+  checkLookingGlassCalibration(c, where);
+  const QuiltLayout layout = defaultQuiltLayout(c.screenW, c.screenH);
+  c.quiltColumns = layout.columns;
+  c.quiltRows = layout.rows;
+  return c;
+}
+
+LookingGlassCalibration loadLookingGlassCalibration(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open the Looking Glass calibration");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw std::runtime_error(path + ": cannot read the Looking Glass calibration");
+  try {
+    return parseLookingGlassCalibration(text.str());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(path + ": " + e.what());
+  }
+}
+
+}  // namespace probecast::renderer
