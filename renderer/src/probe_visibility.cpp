@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -233,30 +234,55 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
   std::vector<FaceDraw> faceDraws;
   Buffer gathered;
   if (!vis.opaque.empty()) {
-    std::vector<uint32_t> list;
-    std::vector<DrawRun> runs;
     const auto* indices = static_cast<const uint32_t*>(gpu.accel.indices.mapped);
     const auto* vertices = static_cast<const glm::vec3*>(gpu.accel.positions.mapped);
-    for (uint32_t k = 0; k < n; ++k) {
-      if (only && !(*only)[k]) continue;
-      const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
-      for (uint32_t f = 0; f < 6; ++f) {
-        faceRuns(vis.opaque, probe, f, reach, cull, runs);
-        FaceDraw fd{static_cast<uint32_t>(list.size()), 0, k, f};
-        for (const DrawRun& run : runs)
-          for (uint32_t t = run.firstTriangle; t < run.firstTriangle + run.triangles; ++t) {
-            const uint32_t* tri = indices + size_t{3} * t;
-            if (cull) {  // each triangle's own box, as the clusters' were tested
-              const glm::vec3 a = vertices[tri[0]] - probe, b = vertices[tri[1]] - probe, c = vertices[tri[2]] - probe;
-              const glm::vec3 lo = glm::min(a, glm::min(b, c)), hi = glm::max(a, glm::max(b, c));
-              if (!(clusterInReach(lo, hi, reach) && clusterInFace(lo, hi, f))) continue;
+    // Probes [from, to) of the batch into their own list (one per thread; joined in order below).
+    struct Part {
+      std::vector<uint32_t> list;
+      std::vector<FaceDraw> draws;
+      uint64_t triangles = 0;
+    };
+    auto gather = [&](uint32_t from, uint32_t to, Part& out) {
+      std::vector<DrawRun> runs;
+      for (uint32_t k = from; k < to; ++k) {
+        if (only && !(*only)[k]) continue;
+        const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
+        for (uint32_t f = 0; f < 6; ++f) {
+          faceRuns(vis.opaque, probe, f, reach, cull, runs);
+          FaceDraw fd{static_cast<uint32_t>(out.list.size()), 0, k, f};
+          for (const DrawRun& run : runs)
+            for (uint32_t t = run.firstTriangle; t < run.firstTriangle + run.triangles; ++t) {
+              const uint32_t* tri = indices + size_t{3} * t;
+              if (cull) {  // each triangle's own box, as the clusters' were tested
+                const glm::vec3 a = vertices[tri[0]] - probe, b = vertices[tri[1]] - probe, c = vertices[tri[2]] - probe;
+                const glm::vec3 lo = glm::min(a, glm::min(b, c)), hi = glm::max(a, glm::max(b, c));
+                if (!(clusterInReach(lo, hi, reach) && clusterInFace(lo, hi, f))) continue;
+              }
+              out.list.insert(out.list.end(), tri, tri + 3);
+              ++out.triangles;
             }
-            list.insert(list.end(), tri, tri + 3);
-            ++drawn;
-          }
-        fd.indexCount = static_cast<uint32_t>(list.size()) - fd.firstIndex;
-        if (fd.indexCount > 0) faceDraws.push_back(fd);
+          fd.indexCount = static_cast<uint32_t>(out.list.size()) - fd.firstIndex;
+          if (fd.indexCount > 0) out.draws.push_back(fd);
+        }
       }
+    };
+    // Culling is CPU work while the device waits: split over the cores (at most 8 parts).
+    const uint32_t parts = std::clamp<uint32_t>(std::thread::hardware_concurrency(), 1, std::min<uint32_t>(8, n));
+    std::vector<Part> part(parts);
+    std::vector<std::thread> workers;
+    for (uint32_t i = 1; i < parts; ++i)
+      workers.emplace_back(gather, n * i / parts, n * (i + 1) / parts, std::ref(part[i]));
+    gather(0, n / parts, part[0]);
+    for (std::thread& w : workers) w.join();
+    std::vector<uint32_t> list;
+    for (Part& pt : part) {
+      const auto offset = static_cast<uint32_t>(list.size());
+      for (FaceDraw fd : pt.draws) {
+        fd.firstIndex += offset;
+        faceDraws.push_back(fd);
+      }
+      list.insert(list.end(), pt.list.begin(), pt.list.end());
+      drawn += pt.triangles;
     }
     gathered = createBufferWithData(d, list.data(), list.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   }
