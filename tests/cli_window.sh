@@ -24,7 +24,7 @@ export PROBECAST_SCENE_CACHE="$work/cache"
 view=(--views mono --size 160x96 --supersample 1)
 
 # 1. Local probes.
-"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --window-seconds 3 \
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --window-seconds 5 \
   --screenshot-after 0.5 --out "$work/local-window" | tee "$work/local-window.log"
 grep -q "window: 160x96 on" "$work/local-window.log"
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --exr --out "$work/local-off" >/dev/null
@@ -38,7 +38,7 @@ band = 20  # the status line's band at scale 1 is about 16 rows
 assert (abs(shot[band:, :, :3] - off[band:, :, :3]) < 1e-6).all(), "presented pixels differ from the render"
 assert (abs(shot[:band, :, :3] - off[:band, :, :3]) > 1e-3).any(), "no status line"
 frames = int(re.search(r"closed after [0-9.]+ s, (\d+) frames presented", open(sys.argv[3]).read()).group(1))
-assert frames >= 3, frames
+assert frames >= 2, frames
 print("local window: %d frames, screenshot equals the offscreen render" % frames)
 PY
 
