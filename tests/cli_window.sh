@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # The live window, for real: an X server (Xvfb), a GLFW window with a Vulkan swapchain on lavapipe.
+# 0. Without a display the viewer says so and exits 1.
 # 1. Local probes: a screenshot of the window is the offscreen render of the same camera, bit for
 #    bit (EXR), and what was presented (read back from the swapchain) is its tone-mapped PNG below
 #    the status line.
@@ -22,6 +23,15 @@ export PROBECAST_SCENE_CACHE="$work/cache"
 
 "$probecast" bake --scene builtin:cornell --grid 4,4,4 --spp 16 --updates 1 --out "$work/p.pcpv" >/dev/null
 view=(--views mono --size 160x96 --supersample 1)
+
+# 0. No display: a clear error, nothing else.
+set +e
+env -u DISPLAY "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window \
+  --out "$work/no-display" >"$work/no-display.log" 2>&1
+rc=$?
+set -e
+[ "$rc" -eq 1 ] || { echo "no display: exit $rc"; exit 1; }
+grep -q "cannot open a window: .*DISPLAY" "$work/no-display.log" || { cat "$work/no-display.log"; exit 1; }
 
 # 1. Local probes.
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --window-seconds 5 \
