@@ -10,7 +10,7 @@ PACKAGES=(
   libvulkan-dev vulkan-tools glslang-tools spirv-tools vulkan-validationlayers
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   nats-server libnats-dev
-  libglfw3-dev xvfb xauth xdotool
+  libglfw3-dev xvfb xauth xdotool libmeshoptimizer-dev
   clang-14 libclang-rt-14-dev openssl libssl-dev
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev python3-venv
 )

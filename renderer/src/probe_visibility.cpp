@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <meshoptimizer.h>
 
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/renderer/view_sets.h"
@@ -56,6 +57,79 @@ std::vector<VisibilityCluster> clustersOf(const scene::Scene& s, uint32_t first,
   }
   return out;
 }
+
+// Clusters of consecutive triangles of `indices` (three vertex numbers each), up to
+// kVisibilityClusterTriangles each, bounded by `positions`.
+std::vector<VisibilityCluster> clustersOf(const std::vector<uint32_t>& indices, const std::vector<glm::vec3>& positions) {
+  std::vector<VisibilityCluster> out;
+  const auto end = static_cast<uint32_t>(indices.size() / 3);
+  for (uint32_t k = 0; k < end; k += kVisibilityClusterTriangles) {
+    VisibilityCluster c;
+    c.first = k;
+    c.count = std::min(kVisibilityClusterTriangles, end - k);
+    c.lo = glm::vec3(std::numeric_limits<float>::max());
+    c.hi = -c.lo;
+    for (size_t i = size_t{3} * k; i < size_t{3} * (k + c.count); ++i) {
+      c.lo = glm::min(c.lo, positions[indices[i]]);
+      c.hi = glm::max(c.hi, positions[indices[i]]);
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+// The still triangles of `still` (vertex numbers) simplified to `error` metres: coincident
+// vertices welded, meshoptimizer's edge collapses within the error, then back to scene numbers.
+// Unchanged when the error is 0 or the positions are not finite.
+std::vector<uint32_t> simplified(std::vector<uint32_t> still, const std::vector<glm::vec3>& positions, float error) {
+  if (!(error > 0.0f) || still.size() < 3) return still;
+  std::vector<uint32_t> remap(positions.size());
+  const size_t unique = meshopt_generateVertexRemap(remap.data(), still.data(), still.size(), positions.data(),
+                                                    positions.size(), sizeof(glm::vec3));
+  std::vector<glm::vec3> welded(unique);
+  meshopt_remapVertexBuffer(welded.data(), positions.data(), positions.size(), sizeof(glm::vec3), remap.data());
+  std::vector<uint32_t> weldedIndices(still.size());
+  meshopt_remapIndexBuffer(weldedIndices.data(), still.data(), still.size(), remap.data());
+  for (const glm::vec3& v : welded)
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return still;
+  const float scale = meshopt_simplifyScale(&welded[0].x, unique, sizeof(glm::vec3));
+  if (!(scale > 0.0f) || !std::isfinite(scale)) return still;
+  std::vector<uint32_t> original(unique, 0);
+  for (size_t v = 0; v < positions.size(); ++v)
+    if (remap[v] != ~0u) original[remap[v]] = static_cast<uint32_t>(v);
+  std::vector<uint32_t> out(weldedIndices.size());
+  out.resize(meshopt_simplify(out.data(), weldedIndices.data(), weldedIndices.size(), &welded[0].x, unique,
+                              sizeof(glm::vec3), 0, error / scale, 0, nullptr));
+  for (uint32_t& i : out) i = original[i];
+  return out;
+}
+
+// Makes vis.proxy for `error` (again only when the error or a still vertex changed) and its
+// clusters at the vertices' current places.
+void ensureProxy(ProbeVisibility& vis, float error) {
+  bool stillMoved = vis.proxyFrom.size() != vis.vertices.size();
+  if (!stillMoved && vis.proxyFrom != vis.vertices)
+    for (size_t t = 0; t < vis.opaqueMoving.size() && !stillMoved; ++t)
+      for (size_t c = 0; c < 3 && !vis.opaqueMoving[t]; ++c) {
+        const uint32_t v = vis.opaqueIndices[t * 3 + c];
+        stillMoved = stillMoved || vis.proxyFrom[v] != vis.vertices[v];
+      }
+  if (error != vis.proxyError || stillMoved) {
+    std::vector<uint32_t> still, moving;
+    for (size_t t = 0; t < vis.opaqueMoving.size(); ++t) {
+      std::vector<uint32_t>& to = vis.opaqueMoving[t] ? moving : still;
+      to.insert(to.end(), vis.opaqueIndices.begin() + static_cast<std::ptrdiff_t>(t * 3),
+                vis.opaqueIndices.begin() + static_cast<std::ptrdiff_t>(t * 3 + 3));
+    }
+    vis.proxy = simplified(std::move(still), vis.vertices, error);
+    vis.proxy.insert(vis.proxy.end(), moving.begin(), moving.end());
+    vis.proxyError = error;
+    vis.proxyFrom = vis.vertices;
+  }
+  vis.opaque = clustersOf(vis.proxy, vis.vertices);
+}
+
+float proxyErrorFor(float reach) { return std::isfinite(reach) ? kVisibilityProxyError * reach : 0.0f; }
 
 // Whether a box (relative to the probe) may meet face f's 90° pyramid (the points whose coordinate
 // on the face's axis, signed, is at least the absolute value of the other two): each bounding plane
@@ -234,7 +308,7 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
   std::vector<FaceDraw> faceDraws;
   Buffer gathered;
   if (!vis.opaque.empty()) {
-    const auto* indices = static_cast<const uint32_t*>(gpu.accel.indices.mapped);
+    const uint32_t* indices = vis.proxy.data();
     const auto* vertices = static_cast<const glm::vec3*>(gpu.accel.positions.mapped);
     // Probes [from, to) of the batch into their own list (one per thread; joined in order below).
     struct Part {
@@ -451,7 +525,11 @@ void createProbeVisibility(VulkanDevice& d, VkDescriptorSetLayout materials, Pro
 void setProbeVisibilityScene(const scene::Scene& scene, ProbeVisibility& vis, bool keepBuilt) {
   // finalizeScene keeps each class one run, in Morton order within it: runs of it are compact.
   const uint32_t opaque = scene::leadingTrianglesBelowClass(scene, 1);
-  vis.opaque = clustersOf(scene, 0, opaque);
+  vis.opaqueIndices.assign(scene.indices.begin(), scene.indices.begin() + static_cast<std::ptrdiff_t>(opaque) * 3);
+  vis.opaqueMoving = scene::movingTriangles(scene);
+  vis.opaqueMoving.resize(opaque);
+  vis.vertices = scene.positions;
+  vis.opaque.clear();  // made with the proxy, before the next drawing
   vis.cutouts = clustersOf(scene, opaque, scene::leadingTrianglesBelowClass(scene, 2));
   if (!keepBuilt) vis.builtFor.clear();  // new geometry: the next build draws again
 }
@@ -486,6 +564,7 @@ uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescripto
                                const std::vector<uint32_t>& which, float farDistance, bool cull, ProbeVisibility& vis) {
   if (which.empty() || vis.builtFor.empty()) return 0;
   const auto t0 = Clock::now();
+  ensureProxy(vis, proxyErrorFor(vis.builtReach));
   const size_t count = vis.builtFor.size() / 3;
   std::vector<uint8_t> listed(count, 0);
   for (uint32_t p : which) {
@@ -561,6 +640,7 @@ bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet 
     throw std::invalid_argument("probe visibility takes 1.." + std::to_string(kMaxVisibilityProbes) + " probes, not " +
                                 std::to_string(count));
   const auto t0 = Clock::now();
+  ensureProxy(vis, proxyErrorFor(reach));
   const std::vector<glm::mat4> faces = cubeFaceViews(farDistance);
   const auto columns = static_cast<uint32_t>(std::min<size_t>(count, RS_VIS_TILES_PER_ROW));
   const auto rows = static_cast<uint32_t>((count + RS_VIS_TILES_PER_ROW - 1) / RS_VIS_TILES_PER_ROW);
