@@ -317,15 +317,18 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
       uint64_t triangles = 0;
     };
     auto gather = [&](uint32_t from, uint32_t to, Part& out) {
-      std::vector<DrawRun> runs;
+      std::vector<const VisibilityCluster*> near;
       for (uint32_t k = from; k < to; ++k) {
         if (only && !(*only)[k]) continue;
         const glm::vec3 probe(positions[(first + k) * 3], positions[(first + k) * 3 + 1], positions[(first + k) * 3 + 2]);
+        near.clear();  // the clusters within reach, once per probe; then each face's pyramid
+        for (const VisibilityCluster& c : vis.opaque)
+          if (!cull || clusterInReach(c.lo - probe, c.hi - probe, reach)) near.push_back(&c);
         for (uint32_t f = 0; f < 6; ++f) {
-          faceRuns(vis.opaque, probe, f, reach, cull, runs);
           FaceDraw fd{static_cast<uint32_t>(out.list.size()), 0, k, f};
-          for (const DrawRun& run : runs)
-            for (uint32_t t = run.firstTriangle; t < run.firstTriangle + run.triangles; ++t) {
+          for (const VisibilityCluster* cl : near) {
+            if (cull && !clusterInFace(cl->lo - probe, cl->hi - probe, f)) continue;
+            for (uint32_t t = cl->first; t < cl->first + cl->count; ++t) {
               const uint32_t* tri = indices + size_t{3} * t;
               if (cull) {  // each triangle's own box, as the clusters' were tested
                 const glm::vec3 a = vertices[tri[0]] - probe, b = vertices[tri[1]] - probe, c = vertices[tri[2]] - probe;
@@ -335,6 +338,7 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
               out.list.insert(out.list.end(), tri, tri + 3);
               ++out.triangles;
             }
+          }
           fd.indexCount = static_cast<uint32_t>(out.list.size()) - fd.firstIndex;
           if (fd.indexCount > 0) out.draws.push_back(fd);
         }
