@@ -564,19 +564,19 @@ std::vector<uint32_t> probesNearMovedGeometry(const ProbeVisibility& vis, const 
   return out;
 }
 
-uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
-                               const std::vector<uint32_t>& which, float farDistance, bool cull, ProbeVisibility& vis) {
-  if (which.empty() || vis.builtFor.empty()) return 0;
+namespace {
+
+// Draws the depth cubes of the probes at `positions` (all, or those `listed` marks), filters their
+// moments into `atlas` (`atlasWidth` texels wide, tiles in probe order) and uploads it. Each batch
+// is the one a full build draws, so a probe is rasterised at its own place in the depth atlas
+// whichever probes are drawn with it (another place may round differently).
+void drawIntoAtlas(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials, const std::vector<float>& positions,
+                   const std::vector<uint8_t>* listed, float farDistance, float reach, bool cull,
+                   std::vector<float> atlas, uint32_t atlasWidth, uint32_t atlasHeight, ProbeVisibility& vis) {
   const auto t0 = Clock::now();
-  ensureProxy(vis, proxyErrorFor(vis.builtReach));
-  const size_t count = vis.builtFor.size() / 3;
-  std::vector<uint8_t> listed(count, 0);
-  for (uint32_t p : which) {
-    if (p >= count) throw std::invalid_argument("redrawProbeVisibility: no such probe");
-    listed[p] = 1;
-  }
+  ensureProxy(vis, proxyErrorFor(reach));
+  const size_t count = positions.size() / 3;
   const std::vector<glm::mat4> faces = cubeFaceViews(farDistance);
-  std::vector<float> atlas = vis.atlas;
   GpuImage depth = createImage(d, VK_FORMAT_D32_SFLOAT, {kAtlasW, kAtlasH, 1},
                                VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
   Buffer readback;
@@ -586,24 +586,25 @@ uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescripto
     readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
                             VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     std::vector<float> distances, tile(RS_VIS_TILE * RS_VIS_TILE * 2);
-    // The batches of a full build, each probe at its own place in the depth atlas (rasterisation
-    // at another place may round differently): only the listed probes are drawn.
     for (size_t first = 0; first < count; first += kBatch) {
       const auto n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
-      const std::vector<uint8_t> only(listed.begin() + static_cast<std::ptrdiff_t>(first),
-                                      listed.begin() + static_cast<std::ptrdiff_t>(first + n));
-      if (std::find(only.begin(), only.end(), 1) == only.end()) continue;
-      drawn += drawDepthCubes(d, gpu, materials, vis.builtFor, first, n, faces, farDistance, vis.builtReach, cull, depth,
-                              readback, vis, distances, &only);
+      std::vector<uint8_t> only;
+      if (listed) {
+        only.assign(listed->begin() + static_cast<std::ptrdiff_t>(first),
+                    listed->begin() + static_cast<std::ptrdiff_t>(first + n));
+        if (std::find(only.begin(), only.end(), 1) == only.end()) continue;
+      }
+      drawn += drawDepthCubes(d, gpu, materials, positions, first, n, faces, farDistance, reach, cull, depth, readback,
+                              vis, distances, listed ? &only : nullptr);
       const auto m0 = Clock::now();
       for (uint32_t k = 0; k < n; ++k) {
-        if (!only[k]) continue;
+        if (listed && !only[k]) continue;
         octahedralMoments(distances.data() + static_cast<size_t>(k) * 6 * kCube * kCube, kCube, tile.data());
         const size_t p = first + k;
         const size_t x0 = (p % RS_VIS_TILES_PER_ROW) * RS_VIS_TILE, y0 = (p / RS_VIS_TILES_PER_ROW) * RS_VIS_TILE;
         for (uint32_t ty = 0; ty < RS_VIS_TILE; ++ty)
           std::copy_n(tile.data() + ty * RS_VIS_TILE * 2, RS_VIS_TILE * 2,
-                      atlas.data() + ((y0 + ty) * vis.atlasWidth + x0) * 2);
+                      atlas.data() + ((y0 + ty) * atlasWidth + x0) * 2);
       }
       momentsMs += msSince(m0);
     }
@@ -615,11 +616,26 @@ uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescripto
   destroyImage(d, depth);
   destroyBuffer(d, readback);
   const auto u0 = Clock::now();
-  const std::vector<float> built = vis.builtFor;
-  uploadMoments(d, std::move(atlas), vis.atlasWidth, vis.atlasHeight, built, vis.builtReach, vis);
+  uploadMoments(d, std::move(atlas), atlasWidth, atlasHeight, positions, reach, vis);
   vis.momentsMs = momentsMs + msSince(u0);
   vis.renderMs = msSince(t0) - vis.momentsMs;
   vis.trianglesDrawn = drawn;
+}
+
+}  // namespace
+
+uint32_t redrawProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                               const std::vector<uint32_t>& which, float farDistance, bool cull, ProbeVisibility& vis) {
+  if (which.empty() || vis.builtFor.empty()) return 0;
+  const size_t count = vis.builtFor.size() / 3;
+  std::vector<uint8_t> listed(count, 0);
+  for (uint32_t p : which) {
+    if (p >= count) throw std::invalid_argument("redrawProbeVisibility: no such probe");
+    listed[p] = 1;
+  }
+  const std::vector<float> built = vis.builtFor;  // uploadMoments replaces vis's copy
+  drawIntoAtlas(d, gpu, materials, built, &listed, farDistance, vis.builtReach, cull, vis.atlas, vis.atlasWidth,
+                vis.atlasHeight, vis);
   return static_cast<uint32_t>(which.size());
 }
 
@@ -643,50 +659,13 @@ bool buildProbeVisibility(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet 
   if (count == 0 || count > kMaxVisibilityProbes)
     throw std::invalid_argument("probe visibility takes 1.." + std::to_string(kMaxVisibilityProbes) + " probes, not " +
                                 std::to_string(count));
-  const auto t0 = Clock::now();
-  ensureProxy(vis, proxyErrorFor(reach));
-  const std::vector<glm::mat4> faces = cubeFaceViews(farDistance);
   const auto columns = static_cast<uint32_t>(std::min<size_t>(count, RS_VIS_TILES_PER_ROW));
   const auto rows = static_cast<uint32_t>((count + RS_VIS_TILES_PER_ROW - 1) / RS_VIS_TILES_PER_ROW);
   const uint32_t width = columns * RS_VIS_TILE, height = rows * RS_VIS_TILE;
-  std::vector<float> atlas(static_cast<size_t>(width) * height * 2, 0.0f);
-  GpuImage depth = createImage(d, VK_FORMAT_D32_SFLOAT, {kAtlasW, kAtlasH, 1},
-                               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-  Buffer readback;
-  double momentsMs = 0.0;
-  uint64_t drawn = 0;
-  try {
-    readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
-                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    std::vector<float> distances, tile(RS_VIS_TILE * RS_VIS_TILE * 2);
-    for (size_t first = 0; first < count; first += kBatch) {
-      const auto n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
-      drawn += drawDepthCubes(d, gpu, materials, positions, first, n, faces, farDistance, reach, cull, depth, readback,
-                              vis, distances);
-      const auto m0 = Clock::now();
-      for (uint32_t k = 0; k < n; ++k) {
-        octahedralMoments(distances.data() + static_cast<size_t>(k) * 6 * kCube * kCube, kCube, tile.data());
-        const size_t p = first + k;
-        const size_t x0 = (p % RS_VIS_TILES_PER_ROW) * RS_VIS_TILE, y0 = (p / RS_VIS_TILES_PER_ROW) * RS_VIS_TILE;
-        for (uint32_t ty = 0; ty < RS_VIS_TILE; ++ty)
-          std::copy_n(tile.data() + ty * RS_VIS_TILE * 2, RS_VIS_TILE * 2, atlas.data() + ((y0 + ty) * width + x0) * 2);
-      }
-      momentsMs += msSince(m0);
-    }
-  } catch (...) {
-    destroyImage(d, depth);
-    destroyBuffer(d, readback);
-    throw;
-  }
-  destroyImage(d, depth);
-  destroyBuffer(d, readback);
-  const auto u0 = Clock::now();
-  uploadMoments(d, std::move(atlas), width, height, positions, reach, vis);
-  vis.momentsMs = momentsMs + msSince(u0);
-  vis.renderMs = msSince(t0) - vis.momentsMs;
+  drawIntoAtlas(d, gpu, materials, positions, nullptr, farDistance, reach, cull,
+                std::vector<float>(static_cast<size_t>(width) * height * 2, 0.0f), width, height, vis);
   vis.builtFor = positions;
   vis.builtReach = reach;
-  vis.trianglesDrawn = drawn;
   return true;
 }
 
