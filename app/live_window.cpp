@@ -70,18 +70,23 @@ double median(std::vector<double> v) {
 }  // namespace
 
 void LiveWindowOptions::add(CLI::App* cmd) {
-  cmd->add_flag("--window", enabled,
-                "show the views live in a window (GLFW + Vulkan swapchain): drag to look, W/A/S/D/Q/E to move, "
-                "Shift faster, R resets, F12 or P writes a screenshot to --out, Escape closes");
+  CLI::Option* window =
+      cmd->add_flag("--window", enabled,
+                    "show the views live in a window (GLFW + Vulkan swapchain): drag to look, W/A/S/D/Q/E to move, "
+                    "Shift faster, R resets, F12 or P writes a screenshot to --out, Escape closes");
   cmd->add_flag("--fullscreen", fullscreen,
                 "--window: full screen, on the monitor whose mode is the window's size (a Looking Glass panel's) "
-                "when there is one, else the primary");
+                "when there is one, else the primary")
+      ->needs(window);
   cmd->add_option("--window-seconds", seconds, "--window: close after this many seconds (0: when closed)")
-      ->check(CLI::Range(0.0, 1e7));
+      ->check(CLI::Range(0.0, 1e7))
+      ->needs(window);
   cmd->add_option("--screenshot-after", screenshotAfter, "--window: write one screenshot this many seconds in")
-      ->check(CLI::Range(0.0, 1e7));
+      ->check(CLI::Range(0.0, 1e7))
+      ->needs(window);
   cmd->add_option("--overlay", overlay, "--window: the status line (frame ms, probe age, bytes/s, connection)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(window);
 }
 
 renderer::ContextOptions LiveWindowOptions::presenting(renderer::ContextOptions options) {
