@@ -290,14 +290,39 @@ void faceRuns(const std::vector<VisibilityCluster>& clusters, const glm::vec3& p
   }
 }
 
-// Draws the depth cubes of probes [first, first + n) into `depth` (kAtlasW × kAtlasH) and reads
-// the distances back into `distances` (6 kCube² per probe, cubeTexels' order), clamped to `reach`
-// (an open direction reads farDistance, or reach if nearer). Returns the triangles drawn.
-uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
-                        const std::vector<float>& positions, size_t first, uint32_t n,
-                        const std::vector<glm::mat4>& faces, float farDistance, float reach, bool cull,
-                        GpuImage& depth, Buffer& readback, const ProbeVisibility& vis, std::vector<float>& distances,
-                        const std::vector<uint8_t>* only = nullptr) {
+// One batch of depth cubes: its own depth atlas, readback and gathered indices, so that the host
+// gathers the next batch and filters the last one while the device draws this one.
+struct DepthBatch {
+  GpuImage depth;
+  Buffer readback, gathered;
+  Submission submission;
+  size_t first = 0;
+  uint32_t n = 0;
+  bool listed = false;  // draw only the probes `only` marks
+  std::vector<uint8_t> only;
+  bool inFlight = false;
+};
+
+void destroyDepthBatch(VulkanDevice& d, DepthBatch& b) {
+  finishSubmission(d, b.submission);
+  destroyBuffer(d, b.gathered);
+  destroyBuffer(d, b.readback);
+  destroyImage(d, b.depth);
+  b = DepthBatch{};
+}
+
+// Starts drawing the depth cubes of probes [b.first, b.first + b.n) into b.depth (kAtlasW ×
+// kAtlasH) and copying them to b.readback; finishDepthCubes waits and reads them. Returns the
+// triangles drawn.
+uint64_t startDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materials,
+                         const std::vector<float>& positions, const std::vector<glm::mat4>& faces, float reach,
+                         bool cull, const ProbeVisibility& vis, DepthBatch& batch) {
+  const size_t first = batch.first;
+  const uint32_t n = batch.n;
+  const std::vector<uint8_t>* only = batch.listed ? &batch.only : nullptr;
+  GpuImage& depth = batch.depth;
+  Buffer& readback = batch.readback;
+  Buffer& gathered = batch.gathered;
   uint64_t drawn = 0;
   // The opaque triangles each face keeps, gathered into one index list per face and drawn with one
   // call per face (depth only: nothing needs their numbers in the scene): small clusters cull
@@ -306,7 +331,6 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
     uint32_t firstIndex = 0, indexCount = 0, probe = 0, face = 0;
   };
   std::vector<FaceDraw> faceDraws;
-  Buffer gathered;
   if (!vis.opaque.empty()) {
     const uint32_t* indices = vis.proxy.data();
     const auto* vertices = static_cast<const glm::vec3*>(gpu.accel.positions.mapped);
@@ -364,7 +388,7 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
     }
     gathered = createBufferWithData(d, list.data(), list.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   }
-  submitAndWait(d, [&](VkCommandBuffer cmd) {
+  batch.submission = submitAsync(d, [&](VkCommandBuffer cmd) {
     transitionImage(cmd, depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
     const VkRenderingAttachmentInfo depthInfo =
         clearedAttachment(depth.view, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_STORE);
@@ -436,11 +460,23 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0,
                          nullptr);
   });
-  destroyBuffer(d, gathered);
+  batch.inFlight = true;
+  return drawn;
+}
+
+// Waits for a batch startDepthCubes began and reads its distances into `distances` (6 kCube² per
+// probe, cubeTexels' order), clamped to `reach` (an open direction reads farDistance, or reach if
+// nearer).
+void finishDepthCubes(VulkanDevice& d, const std::vector<glm::mat4>& faces, float farDistance, float reach,
+                      DepthBatch& b, std::vector<float>& distances) {
+  finishSubmission(d, b.submission);
+  b.inFlight = false;
+  destroyBuffer(d, b.gathered);
+  const uint32_t n = b.n;
   // Depth → distance: unproject through the face's inverse (the probe at the origin).
   std::vector<glm::mat4> inverse;
   for (const glm::mat4& f : faces) inverse.push_back(glm::inverse(f));
-  const float* z = static_cast<const float*>(readback.mapped);
+  const float* z = static_cast<const float*>(b.readback.mapped);
   distances.resize(static_cast<size_t>(n) * 6 * kCube * kCube);
   for (uint32_t k = 0; k < n; ++k)
     for (uint32_t f = 0; f < 6; ++f)
@@ -456,7 +492,6 @@ uint64_t drawDepthCubes(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet ma
           }
           distances[((static_cast<size_t>(k) * 6 + f) * kCube + ty) * kCube + tx] = r;
         }
-  return drawn;
 }
 
 }  // namespace
@@ -577,44 +612,56 @@ void drawIntoAtlas(VulkanDevice& d, const GpuScene& gpu, VkDescriptorSet materia
   ensureProxy(vis, proxyErrorFor(reach));
   const size_t count = positions.size() / 3;
   const std::vector<glm::mat4> faces = cubeFaceViews(farDistance);
-  GpuImage depth = createImage(d, VK_FORMAT_D32_SFLOAT, {kAtlasW, kAtlasH, 1},
-                               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-  Buffer readback;
   double momentsMs = 0.0;
   uint64_t drawn = 0;
+  // Two batches in turn: while the device draws one, the host gathers the next and filters the
+  // one before.
+  DepthBatch slot[2];
   try {
-    readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
-                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    for (DepthBatch& b : slot) {
+      b.depth = createImage(d, VK_FORMAT_D32_SFLOAT, {kAtlasW, kAtlasH, 1},
+                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+      b.readback = createBuffer(d, static_cast<VkDeviceSize>(kAtlasW) * kAtlasH * sizeof(float),
+                                VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    }
     std::vector<float> distances, tile(RS_VIS_TILE * RS_VIS_TILE * 2);
-    for (size_t first = 0; first < count; first += kBatch) {
-      const auto n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
-      std::vector<uint8_t> only;
-      if (listed) {
-        only.assign(listed->begin() + static_cast<std::ptrdiff_t>(first),
-                    listed->begin() + static_cast<std::ptrdiff_t>(first + n));
-        if (std::find(only.begin(), only.end(), 1) == only.end()) continue;
-      }
-      drawn += drawDepthCubes(d, gpu, materials, positions, first, n, faces, farDistance, reach, cull, depth, readback,
-                              vis, distances, listed ? &only : nullptr);
+    auto finish = [&](DepthBatch& b) {
+      if (!b.inFlight) return;
+      finishDepthCubes(d, faces, farDistance, reach, b, distances);
       const auto m0 = Clock::now();
-      for (uint32_t k = 0; k < n; ++k) {
-        if (listed && !only[k]) continue;
+      for (uint32_t k = 0; k < b.n; ++k) {
+        if (b.listed && !b.only[k]) continue;
         octahedralMoments(distances.data() + static_cast<size_t>(k) * 6 * kCube * kCube, kCube, tile.data());
-        const size_t p = first + k;
+        const size_t p = b.first + k;
         const size_t x0 = (p % RS_VIS_TILES_PER_ROW) * RS_VIS_TILE, y0 = (p / RS_VIS_TILES_PER_ROW) * RS_VIS_TILE;
         for (uint32_t ty = 0; ty < RS_VIS_TILE; ++ty)
           std::copy_n(tile.data() + ty * RS_VIS_TILE * 2, RS_VIS_TILE * 2,
                       atlas.data() + ((y0 + ty) * atlasWidth + x0) * 2);
       }
       momentsMs += msSince(m0);
+    };
+    uint32_t turn = 0;
+    for (size_t first = 0; first < count; first += kBatch) {
+      DepthBatch& b = slot[turn];
+      b.first = first;
+      b.n = static_cast<uint32_t>(std::min<size_t>(kBatch, count - first));
+      b.listed = listed != nullptr;
+      if (listed) {
+        b.only.assign(listed->begin() + static_cast<std::ptrdiff_t>(first),
+                      listed->begin() + static_cast<std::ptrdiff_t>(first + b.n));
+        if (std::find(b.only.begin(), b.only.end(), 1) == b.only.end()) continue;
+      }
+      drawn += startDepthCubes(d, gpu, materials, positions, faces, reach, cull, vis, b);
+      turn ^= 1u;
+      finish(slot[turn]);  // the batch before, drawn while this one was gathered
     }
+    finish(slot[turn ^ 1u]);
+    finish(slot[turn]);
   } catch (...) {
-    destroyImage(d, depth);
-    destroyBuffer(d, readback);
+    for (DepthBatch& b : slot) destroyDepthBatch(d, b);
     throw;
   }
-  destroyImage(d, depth);
-  destroyBuffer(d, readback);
+  for (DepthBatch& b : slot) destroyDepthBatch(d, b);
   const auto u0 = Clock::now();
   uploadMoments(d, std::move(atlas), atlasWidth, atlasHeight, positions, reach, vis);
   vis.momentsMs = momentsMs + msSince(u0);

@@ -12,6 +12,7 @@
 #include "raster_shared.h"
 #include "shadow.frag.h"
 #include "shadow_transmit.frag.h"
+#include "depth.vert.h"
 #include "shadow.vert.h"
 #include "vk_pipeline.h"
 
@@ -90,11 +91,15 @@ void uploadLayers(const ShadowMaps& maps) {
 void createDepthPipelines(VulkanDevice& d, VkPipelineLayout layout, bool depthBias, VkPipeline& opaque,
                           VkPipeline& cutout) {
   GraphicsPipelineDesc desc;
-  desc.vertexCode = kShadowVert;
-  desc.vertexBytes = sizeof kShadowVert;
+  desc.vertexCode = kDepthVert;  // positions only
+  desc.vertexBytes = sizeof kDepthVert;
+  desc.vertexStreams = 1;
   desc.depthBias = depthBias;
   desc.layout = layout;
   opaque = createGraphicsPipeline(d, desc);
+  desc.vertexCode = kShadowVert;
+  desc.vertexBytes = sizeof kShadowVert;
+  desc.vertexStreams = 3;
   desc.fragmentCode = kShadowFrag;
   desc.fragmentBytes = sizeof kShadowFrag;
   desc.colorFormat = VK_FORMAT_UNDEFINED;  // depth only, with a fragment shader that may discard

@@ -175,28 +175,45 @@ VkShaderModule createShaderModule(VulkanDevice& d, const uint32_t* code, size_t 
   return m;
 }
 
-void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record) {
+Submission submitAsync(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record) {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = d.commandPool;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
-  VkCommandBuffer cmd;
-  VK_CHECK(vkAllocateCommandBuffers(d.device, &ai, &cmd));
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
-  record(cmd);
-  VK_CHECK(vkEndCommandBuffer(cmd));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence;
-  VK_CHECK(vkCreateFence(d.device, &fci, nullptr, &fence));
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  VK_CHECK(vkQueueSubmit(d.queue, 1, &si, fence));
-  VK_CHECK(vkWaitForFences(d.device, 1, &fence, VK_TRUE, UINT64_MAX));
-  vkDestroyFence(d.device, fence, nullptr);
-  vkFreeCommandBuffers(d.device, d.commandPool, 1, &cmd);
+  Submission s;
+  VK_CHECK(vkAllocateCommandBuffers(d.device, &ai, &s.cmd));
+  try {
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(s.cmd, &bi));
+    record(s.cmd);
+    VK_CHECK(vkEndCommandBuffer(s.cmd));
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_CHECK(vkCreateFence(d.device, &fci, nullptr, &s.fence));
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &s.cmd;
+    VK_CHECK(vkQueueSubmit(d.queue, 1, &si, s.fence));
+  } catch (...) {
+    if (s.fence) vkDestroyFence(d.device, s.fence, nullptr);
+    vkFreeCommandBuffers(d.device, d.commandPool, 1, &s.cmd);
+    throw;
+  }
+  return s;
+}
+
+void finishSubmission(VulkanDevice& d, Submission& s) {
+  if (!s.cmd) return;
+  const VkResult waited = s.fence ? vkWaitForFences(d.device, 1, &s.fence, VK_TRUE, UINT64_MAX) : VK_SUCCESS;
+  if (s.fence) vkDestroyFence(d.device, s.fence, nullptr);
+  vkFreeCommandBuffers(d.device, d.commandPool, 1, &s.cmd);
+  s = Submission{};
+  VK_CHECK(waited);
+}
+
+void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record) {
+  Submission s = submitAsync(d, record);
+  finishSubmission(d, s);
 }
 
 }  // namespace probecast::renderer

@@ -58,4 +58,13 @@ VkShaderModule createShaderModule(VulkanDevice& d, const uint32_t* code, size_t 
 // Records commands into a fresh command buffer, submits it and waits.
 void submitAndWait(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record);
 
+// Work submitted without waiting: the host goes on while the device runs it. finishSubmission
+// waits for it and frees it (a default one is nothing to wait for).
+struct Submission {
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+};
+Submission submitAsync(VulkanDevice& d, const std::function<void(VkCommandBuffer)>& record);
+void finishSubmission(VulkanDevice& d, Submission& s);
+
 }  // namespace probecast::renderer
