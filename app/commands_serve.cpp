@@ -245,6 +245,7 @@ void addSubscribeCommand(CLI::App& app) {
                    ? "scene " + named.describe()
                    : std::string("no scene named"),
                snap.volume.scene.time, static_cast<double>(snap.clockOffsetUs) / 1e3);
+    fmt::print("subscribe: volume checksum {:08x} ({} probes)\n", volumeChecksum(snap.volume), snap.volume.grid.count());
     if (!so->out.empty()) {
       std::string error;
       orThrow(writeProbeFile(so->out, snap.volume, error), error);

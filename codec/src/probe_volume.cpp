@@ -2,8 +2,10 @@
 #include "probecast/codec/probe_volume.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include "probecast/codec/internal/crc32c.h"
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/codec/stream.h"
 
@@ -102,6 +104,13 @@ ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3Per
     if (!decodeProbeRecord(repr, record, probe, out.zh3PerPixel)) std::fill(probe, probe + kProbeFloats, 0.0f);
   }
   return out;
+}
+
+uint32_t volumeChecksum(const ProbeVolume& volume) {
+  static_assert(std::endian::native == std::endian::little, "the checksum reads floats as little-endian bytes");
+  uint32_t crc = crc32c(reinterpret_cast<const uint8_t*>(volume.probes.data()), volume.probes.size() * sizeof(float));
+  crc = crc32c(volume.active.data(), volume.active.size(), crc);
+  return crc32c(reinterpret_cast<const uint8_t*>(volume.offsets.data()), volume.offsets.size() * sizeof(float), crc);
 }
 
 }  // namespace probecast

@@ -119,4 +119,10 @@ bool checkProbeVolume(const ProbeVolume& volume, std::string& error);
 // the per-probe result.
 ProbeVolume decodeAs(const ProbeVolume& volume, Representation repr, bool zh3PerPixel);
 
+// A fingerprint of what a viewer lights with: CRC-32C over the samples (27 floats per probe, as
+// little-endian bytes), the active bytes and the offsets (3 floats per probe, or none). Two decoders
+// of one stream (the native client, the browser's WebAssembly build) that hold the same versions
+// agree on it.
+uint32_t volumeChecksum(const ProbeVolume& volume);
+
 }  // namespace probecast

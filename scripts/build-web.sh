@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Builds the browser viewer: the probe codec and the bus format compiled to WebAssembly with
+# emscripten (zstd included, from Debian's own source package), and the page's JavaScript
+# dependencies from web/package-lock.json. Output: build/web/ (served as static files).
+#   scripts/build-web.sh [OUT]      (OUT defaults to build/web)
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+OUT=$(realpath -m "${1:-$ROOT/build/web}")
+mkdir -p "$OUT"
+
+command -v emcc >/dev/null || { echo "build-web: emcc not found (apt install emscripten)" >&2; exit 1; }
+# Debian's emscripten runs its JavaScript tools with the node on PATH; Debian's acorn lives here.
+export NODE_PATH=/usr/share/nodejs${NODE_PATH:+:$NODE_PATH}
+
+# zstd's sources: Debian's source package of the libzstd the native build links, fetched with
+# apt's own signature and hash checks into a private apt state (the machine's sources untouched).
+ZSTD="$OUT/zstd"
+if [ ! -f "$ZSTD/lib/zstd.h" ]; then
+  echo "build-web: fetching Debian's zstd source package"
+  APT="$OUT/apt"
+  rm -rf "$APT" "$ZSTD"
+  mkdir -p "$APT/sources" "$APT/lists/partial" "$APT/cache/archives/partial" "$APT/get"
+  uri="http://deb.debian.org/debian"
+  if [ -f /etc/apt/sources.list.d/debian.sources ]; then
+    u=$(awk '/^URIs:/ && $2 !~ /security/ {print $2; exit}' /etc/apt/sources.list.d/debian.sources)
+    [ -n "$u" ] && uri=$u
+  fi
+  cat > "$APT/sources/zstd.sources" <<SRC
+Types: deb-src
+URIs: $uri
+Suites: bookworm
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+SRC
+  opts=(-o "Dir::Etc::SourceList=/dev/null" -o "Dir::Etc::SourceParts=$APT/sources"
+        -o "Dir::State::Lists=$APT/lists" -o "Dir::Cache=$APT/cache" -o "APT::Sandbox::User=root" -qq)
+  apt-get "${opts[@]}" update
+  (cd "$APT/get" && apt-get "${opts[@]}" source --download-only libzstd)
+  mkdir -p "$ZSTD"
+  tar -xf "$(ls "$APT"/get/libzstd_*.orig.tar.* | grep -v "\.asc$" | head -1)" -C "$ZSTD" --strip-components=1 --wildcards '*/lib/*' '*/LICENSE'
+  rm -rf "$APT"
+fi
+
+# The codec's sources, as codec/CMakeLists.txt lists them (it is the one list).
+mapfile -t CODEC < <(sed -n '/^add_library(probecast_codec/,/^)/p' "$ROOT/codec/CMakeLists.txt" | grep -o 'src/[a-z0-9_]*\.cpp' | sed "s|^|$ROOT/codec/|")
+ZSRC=("$ZSTD"/lib/common/*.c "$ZSTD"/lib/compress/*.c "$ZSTD"/lib/decompress/*.c)
+
+echo "build-web: emcc ($(emcc --version | head -1))"
+OBJ="$OUT/obj"
+mkdir -p "$OBJ"
+objs=()
+compile() {  # SOURCE FLAGS...
+  local src=$1 obj
+  shift
+  obj="$OBJ/$(echo "$src" | sed "s|^$ROOT/||; s|^$OUT/||; s|/|_|g").o"
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ]; then
+    emcc -c "$src" -o "$obj" "$@"
+  fi
+  objs+=("$obj")
+}
+CXXFLAGS=(-std=c++20 -Oz -ffp-contract=off -fno-exceptions -DNDEBUG -I"$ROOT/codec/include" -I"$ROOT/service/bus/include" -I"$ZSTD/lib")
+CFLAGS=(-Oz -DNDEBUG -DZSTD_DISABLE_ASM -DZSTD_MULTITHREAD=0 -DZSTD_LEGACY_SUPPORT=0 -I"$ZSTD/lib" -I"$ZSTD/lib/common")
+for s in "${ZSRC[@]}"; do compile "$s" "${CFLAGS[@]}"; done
+for s in "${CODEC[@]}" "$ROOT/service/bus/bus_format.cpp" "$ROOT/web/wasm/probecast_web.cpp"; do
+  compile "$s" "${CXXFLAGS[@]/-fno-exceptions/-fexceptions}"
+done
+emcc "${objs[@]}" -Oz -fexceptions -o "$OUT/probecast_codec.mjs" \
+  -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createProbecastCodec -sENVIRONMENT=web,node \
+  -sALLOW_MEMORY_GROWTH=1 -sFILESYSTEM=0 \
+  -sEXPORTED_RUNTIME_METHODS='["UTF8ToString"]' \
+  -sEXPORTED_FUNCTIONS='["_malloc","_free"]'
+echo "build-web: $OUT/probecast_codec.mjs $(stat -c %s "$OUT/probecast_codec.mjs") B + .wasm $(stat -c %s "$OUT/probecast_codec.wasm") B"
+
+# The page and the JavaScript it imports (from web/package-lock.json).
+if [ ! -d "$ROOT/web/node_modules/three" ] || [ "$ROOT/web/package-lock.json" -nt "$ROOT/web/node_modules/.package-lock.json" ]; then
+  echo "build-web: npm ci (web/package-lock.json)"
+  (cd "$ROOT/web" && npm ci --no-audit --no-fund --loglevel=error)
+fi
+rm -rf "$OUT/src" "$OUT/vendor"
+mkdir -p "$OUT/vendor/three/build" "$OUT/vendor/three/examples/jsm/loaders" "$OUT/vendor/three/examples/jsm/utils" "$OUT/vendor/nats.ws"
+cp "$ROOT/web/index.html" "$OUT/"
+cp -r "$ROOT/web/src" "$OUT/src"
+NM="$ROOT/web/node_modules"
+cp "$NM/three/build/three.module.js" "$NM/three/build/three.core.js" "$OUT/vendor/three/build/"
+cp "$NM/three/examples/jsm/loaders/GLTFLoader.js" "$OUT/vendor/three/examples/jsm/loaders/"
+cp "$NM/three/examples/jsm/utils/BufferGeometryUtils.js" "$NM/three/examples/jsm/utils/SkeletonUtils.js" "$OUT/vendor/three/examples/jsm/utils/"
+cp "$NM/nats.ws/esm/nats.js" "$OUT/vendor/nats.ws/nats.js"
+cp "$NM/three/LICENSE" "$OUT/vendor/three/LICENSE"
+cp "$NM/nats.ws/LICENSE" "$OUT/vendor/nats.ws/LICENSE"
+echo "build-web: page in $OUT (index.html)"

@@ -1,0 +1,269 @@
+// probecast's browser viewer. Subscribes to a producer's probe stream on the bus (nats-server's
+// WebSocket listener: the newest message of every brick, then each new version), decodes it with
+// the codec compiled to WebAssembly, loads the scene the stream names (every file checked against
+// the stream's manifest) and lights it in WebGL2 with three.js: direct light from the scene's
+// lights, diffuse indirect light from the probes. It renders every display frame from the newest
+// volume it holds, whatever the stream does.
+//
+// URL: index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL-OF-THE-SCENE-FOLDER#token=TOKEN
+// (the token in the fragment: it never reaches a web server's logs). Optional: camera=px,py,pz,tx,ty,tz,fovDeg.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { connect, DeliverPolicy } from 'nats.ws';
+import { loadCodec } from './codec.js';
+import { ProbeLighting } from './probe_lighting.js';
+
+const params = new URLSearchParams(location.search);
+const fragment = new URLSearchParams(location.hash.slice(1));
+const config = {
+  nats: params.get('nats'),
+  stream: params.get('stream') || 'default',
+  scene: params.get('scene'),
+  token: fragment.get('token') || params.get('token') || '',
+  camera: params.get('camera'),
+};
+
+// What the page shows, and what a test reads (window.probecast).
+const state = {
+  connection: 'starting',
+  error: '',
+  checksum: '',
+  bricks: 0,
+  bricksHeld: 0,
+  messages: 0,
+  bytes: 0,
+  frames: 0,
+  frameMs: 0,
+  decodeMs: 0,
+  sceneHash: '',
+  sceneLoaded: false,
+  representation: '',
+  lastBrickAt: 0,
+  epochs: 0,
+};
+window.probecast = state;
+
+const statusEl = document.getElementById('status');
+const canvas = document.getElementById('view');
+
+function fail(message) {
+  state.error = message;
+  statusEl.classList.add('error');
+}
+
+if (!/^[A-Za-z0-9_-]+$/.test(config.stream)) fail(`stream name "${config.stream}" is not letters, digits, - and _`);
+if (!config.nats) fail('no bus given: open index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL#token=TOKEN');
+
+// ---- rendering -----------------------------------------------------------------------------
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(1);
+renderer.outputColorSpace = THREE.SRGBColorSpace;
+renderer.toneMapping = THREE.NoToneMapping;
+renderer.shadowMap.enabled = true;
+renderer.shadowMap.type = THREE.PCFSoftShadowMap;
+const scene = new THREE.Scene();
+let camera = new THREE.PerspectiveCamera(45, 1, 0.01, 1000);
+const lighting = new ProbeLighting();
+
+function resize() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== w || canvas.height !== h) renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+}
+
+let last = performance.now();
+const frameTimes = [];
+function frame(now) {
+  resize();
+  renderer.render(scene, camera);
+  frameTimes.push(now - last);
+  if (frameTimes.length > 60) frameTimes.shift();
+  last = now;
+  state.frames += 1;
+  state.frameMs = median(frameTimes);
+  requestAnimationFrame(frame);
+}
+requestAnimationFrame(frame);
+
+function median(values) {
+  if (!values.length) return 0;
+  const s = values.slice().sort((a, b) => a - b);
+  return s[Math.floor(s.length / 2)];
+}
+
+// ---- the scene the stream names ------------------------------------------------------------
+async function sha256Hex(bytes) {
+  const d = new Uint8Array(await crypto.subtle.digest('SHA-256', bytes));
+  return Array.from(d, (b) => b.toString(16).padStart(2, '0')).join('');
+}
+
+async function loadScene(manifestText, hash) {
+  const manifest = JSON.parse(manifestText);
+  if (!manifest.scene || !manifest.scene.gltf) throw new Error('the stream names a built-in scene, which the browser does not have: serve a glTF scene');
+  if (!config.scene) throw new Error('no scene folder given (scene=URL)');
+  // Every file the manifest lists, fetched and checked against its size and SHA-256.
+  const files = new Map();
+  for (const f of manifest.files) {
+    const folder = new URL(config.scene.endsWith('/') ? config.scene : config.scene + '/', location.href);
+    const r = await fetch(new URL(f.path, folder));
+    if (!r.ok) throw new Error(`scene file ${f.path}: HTTP ${r.status}`);
+    const bytes = new Uint8Array(await r.arrayBuffer());
+    if (bytes.length !== f.bytes || (await sha256Hex(bytes)) !== f.sha256)
+      throw new Error(`scene file ${f.path} is not the stream's (size or SHA-256 differs): the scene does not match the stream ${hash.slice(0, 12)}`);
+    files.set(f.path, URL.createObjectURL(new Blob([bytes])));
+  }
+  // The glTF reads its buffers and images from the checked copies only.
+  const manager = new THREE.LoadingManager();
+  manager.setURLModifier((url) => files.get(url) ?? 'data:,');
+  const text = await (await fetch(files.get(manifest.scene.gltf))).arrayBuffer();
+  const gltf = await new GLTFLoader(manager).parseAsync(text, '');
+  scene.clear();
+  scene.add(gltf.scene);
+  gltf.scene.traverse((o) => {
+    if (o.isMesh) {
+      o.castShadow = o.receiveShadow = true;
+      const mats = Array.isArray(o.material) ? o.material : [o.material];
+      for (const m of mats) {
+        m.side = THREE.DoubleSide;  // scenes are two-sided, as in the tracers
+        if (m.isMeshStandardMaterial) lighting.apply(m);
+      }
+    }
+    if (o.isLight) {
+      o.castShadow = true;
+      if (o.shadow) o.shadow.mapSize.set(1024, 1024);
+    }
+  });
+  camera = pickCamera(gltf);
+  state.sceneLoaded = true;
+}
+
+function pickCamera(gltf) {
+  if (config.camera) {
+    const v = config.camera.split(',').map(Number);
+    if (v.length === 7 && v.every(Number.isFinite)) {
+      const c = new THREE.PerspectiveCamera(v[6], 1, 0.01, 1000);
+      c.position.set(v[0], v[1], v[2]);
+      c.lookAt(v[3], v[4], v[5]);
+      return c;
+    }
+    fail('camera= takes 7 numbers: px,py,pz,tx,ty,tz,fovDeg');
+  }
+  if (gltf.cameras.length) {
+    const c = gltf.cameras[0];
+    c.updateMatrixWorld(true);
+    return c;
+  }
+  const box = new THREE.Box3().setFromObject(gltf.scene);
+  const c = new THREE.PerspectiveCamera(45, 1, 0.01, 1000);
+  const centre = box.getCenter(new THREE.Vector3());
+  c.position.copy(centre).add(new THREE.Vector3(0, 0, box.getSize(new THREE.Vector3()).length()));
+  c.lookAt(centre);
+  return c;
+}
+
+// ---- the stream ----------------------------------------------------------------------------
+let codec;
+let volumeDirty = false;
+let loadingScene = null;
+
+function onMessage(bytes) {
+  state.messages += 1;
+  state.bytes += bytes.length;
+  const r = codec.message(bytes);
+  if (r === 0) {
+    state.lastRefusal = codec.error();  // refused and counted; what the page holds stays
+    return;
+  }
+  if (r === 1) {
+    state.epochs += 1;
+    const hash = codec.sceneHash();
+    if (hash && hash !== state.sceneHash && !loadingScene) {
+      state.sceneHash = hash;
+      loadingScene = loadScene(codec.sceneManifest(), hash).catch((e) => fail(e.message)).finally(() => { loadingScene = null; });
+    }
+    state.representation = codec.representation();
+  }
+  if (r === 2) state.lastBrickAt = performance.now();
+  volumeDirty = true;
+}
+
+function refreshVolume() {
+  if (!volumeDirty || !codec.hasVolume()) return;
+  volumeDirty = false;
+  state.bricks = codec.bricks();
+  state.bricksHeld = codec.bricksHeld();
+  state.checksum = codec.checksum();
+  state.decodeMs = median(codec.decodeMs);
+  lighting.update(codec.dims(), codec.bounds(), codec.probes(), codec.active(), codec.offsets());
+}
+setInterval(refreshVolume, 100);
+
+async function subscribe() {
+  for (;;) {
+    let nc;
+    try {
+      state.connection = 'connecting';
+      nc = await connect({ servers: config.nats, token: config.token || undefined, reconnect: true,
+                           maxReconnectAttempts: -1, reconnectTimeWait: 500, pingInterval: 5000 });
+    } catch (e) {
+      const text = String(e && (e.code || e.message));
+      if (/AUTHORIZATION|Authorization|authorization/.test(text) || e.code === 'AUTHORIZATION_VIOLATION') {
+        state.connection = 'refused';
+        fail('not authorised: the bus refused the token (give it as #token=… in the address)');
+        return;
+      }
+      state.connection = 'unreachable';
+      await sleep(1000);
+      continue;
+    }
+    state.error = '';
+    statusEl.classList.remove('error');
+    (async () => {
+      for await (const s of nc.status()) {
+        if (s.type === 'disconnect' || s.type === 'reconnecting') state.connection = 'reconnecting';
+        else if (s.type === 'reconnect') state.connection = 'connected';
+      }
+    })();
+    try {
+      const js = nc.jetstream();
+      // The newest message of every subject (the volume and each brick), then everything new.
+      const consumer = await js.consumers.get(`PROBECAST_${config.stream}`, {
+        filterSubjects: `probecast.${config.stream}.>`,
+        deliver_policy: DeliverPolicy.LastPerSubject,
+      });
+      state.connection = 'connected';
+      const messages = await consumer.consume({ max_messages: 512 });
+      for await (const m of messages) onMessage(m.data);
+    } catch (e) {
+      state.lastStreamError = String(e && e.message);
+      state.connection = /stream not found/i.test(state.lastStreamError) ? 'waiting for the producer' : 'reconnecting';
+    }
+    await nc.close().catch(() => {});
+    await sleep(1000);
+  }
+}
+
+function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
+
+// ---- the status line -----------------------------------------------------------------------
+let bytesBefore = 0, rate = 0;
+setInterval(() => {
+  rate = state.bytes - bytesBefore;
+  bytesBefore = state.bytes;
+  state.bytesPerSecond = rate;
+}, 1000);
+setInterval(() => {
+  const age = state.lastBrickAt ? ((performance.now() - state.lastBrickAt) / 1000).toFixed(1) + ' s' : '–';
+  const lines = [
+    `${state.connection}  ${config.stream}  ${state.representation}  bricks ${state.bricksHeld}/${state.bricks}  checksum ${state.checksum || '–'}`,
+    `frame ${state.frameMs.toFixed(1)} ms  newest light ${age} ago  ${(rate / 1024).toFixed(1)} kB/s  decode ${state.decodeMs.toFixed(2)} ms/message`,
+  ];
+  if (state.error) lines.push(state.error);
+  statusEl.textContent = lines.join('\n');
+}, 250);
+
+loadCodec().then((c) => {
+  codec = c;
+  if (!state.error) subscribe();
+}).catch((e) => fail('the WebAssembly codec did not load: ' + e.message));

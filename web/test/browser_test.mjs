@@ -1,0 +1,168 @@
+// The browser viewer end to end, in headless Chromium against a real nats-server (WebSocket
+// listener, token) and a real `probecast serve` publishing to it:
+//   - the page connects, holds every brick, and its volume's checksum equals the native client's;
+//   - it renders (a screenshot), and reports its page weight, decode and frame times;
+//   - a wrong token gets a clear message;
+//   - the producer restarts (a new epoch): the page follows and holds the same volume again.
+// Usage: node browser_test.mjs PROBECAST WEB_DIR SCENE_GLTF WORK_DIR
+import { spawn, execFileSync } from 'node:child_process';
+import { createServer } from 'node:http';
+import { readFileSync, writeFileSync, mkdirSync, rmSync, statSync, existsSync } from 'node:fs';
+import { dirname, join, extname, resolve, basename, sep } from 'node:path';
+import { chromium } from 'playwright-core';
+
+const [probecast, webDir, sceneGltf, work] = process.argv.slice(2).map((p) => resolve(p));
+if (!work) throw new Error('usage: node browser_test.mjs PROBECAST WEB_DIR SCENE_GLTF WORK_DIR');
+rmSync(work, { recursive: true, force: true });
+mkdirSync(work, { recursive: true });
+const sceneDir = dirname(sceneGltf);
+const children = [];
+const deadline = setTimeout(() => { console.error('browser test: over 240 s'); cleanup(); process.exit(1); }, 240000);
+
+function cleanup() {
+  for (const c of children) try { c.kill('SIGTERM'); } catch {}
+}
+process.on('exit', cleanup);
+
+function start(cmd, args, log) {
+  const out = [];
+  const child = spawn(cmd, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  child.stdout.on('data', (d) => out.push(d));
+  child.stderr.on('data', (d) => out.push(d));
+  child.on('exit', () => writeFileSync(join(work, log), Buffer.concat(out)));
+  child.text = () => Buffer.concat(out).toString();
+  children.push(child);
+  return child;
+}
+
+async function until(what, test, seconds = 30) {
+  const end = Date.now() + seconds * 1000;
+  for (;;) {
+    const v = await test();
+    if (v) return v;
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    await new Promise((r) => setTimeout(r, 100));
+  }
+}
+
+function check(ok, message) {
+  if (!ok) { console.error('FAILED: ' + message); cleanup(); process.exit(1); }
+  console.log('ok: ' + message);
+}
+
+const base = 20000 + Math.floor(Math.random() * 20000);
+const ports = { nats: base, ws: base + 1, grpc: base + 2, http: base + 3 };
+const busToken = 'bus-' + Math.random().toString(36).slice(2);
+
+// nats-server: JetStream, a token, and a WebSocket listener on loopback (plain ws: loopback only).
+writeFileSync(join(work, 'bus-token'), busToken + '\n');
+writeFileSync(join(work, 'nats.conf'), `authorization { token: "${busToken}" }
+websocket { listen: "127.0.0.1:${ports.ws}", no_tls: true }
+`);
+const natsBin = ['/usr/sbin/nats-server', '/usr/bin/nats-server'].find(existsSync) || 'nats-server';
+start(natsBin, ['-c', join(work, 'nats.conf'), '-a', '127.0.0.1', '-p', String(ports.nats), '-js', '-sd', join(work, 'nats')], 'nats.log');
+
+execFileSync(probecast, ['bake', '--scene', sceneGltf, '--grid', '6,6,6', '--spp', '32', '--updates', '1', '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
+const serveArgs = ['serve', '--probes', join(work, 'served.pcpv'), '--scene', sceneGltf, '--listen', `127.0.0.1:${ports.grpc}`,
+  '--plaintext', '--token', 't0k', '--seconds', '200', '--publish', `nats://127.0.0.1:${ports.nats}`, '--stream', 'web',
+  '--nats-token-file', join(work, 'bus-token'), '--nats-plaintext'];
+let serve = start(probecast, serveArgs, 'serve.log');
+await until('serve to listen', () => /on port/.test(serve.text()));
+
+// The native client's checksum of the same stream.
+const sub = execFileSync(probecast, ['subscribe', '--connect', `127.0.0.1:${ports.grpc}`, '--token', 't0k', '--seconds', '2']).toString();
+const native = /volume checksum ([0-9a-f]{8})/.exec(sub)?.[1];
+check(!!native, `the native client reports a checksum (${native})`);
+
+// Static files: the page at /, the scene's folder at /scene/.
+const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.wasm': 'application/wasm',
+  '.gltf': 'model/gltf+json', '.bin': 'application/octet-stream', '.png': 'image/png', '.jpg': 'image/jpeg' };
+const served = new Map();
+const http = createServer((req, res) => {
+  const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+  const [root, rel] = path.startsWith('/scene/') ? [sceneDir, path.slice(7)] : [webDir, path === '/' ? 'index.html' : path.slice(1)];
+  const file = resolve(root, rel);
+  if (!file.startsWith(root + sep) || !existsSync(file) || !statSync(file).isFile()) { res.writeHead(404); res.end(); return; }
+  const body = readFileSync(file);
+  if (root === webDir) served.set(rel, body.length);
+  res.writeHead(200, { 'content-type': types[extname(file)] || 'application/octet-stream' });
+  res.end(body);
+}).listen(ports.http, '127.0.0.1');
+
+const browser = await chromium.launch({
+  executablePath: process.env.PROBECAST_CHROMIUM || '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
+});
+const page = await browser.newPage({ viewport: { width: 320, height: 240 } });
+const consoleLines = [];
+page.on('console', (m) => consoleLines.push(m.text()));
+page.on('pageerror', (e) => consoleLines.push('page error: ' + e.message));
+const url = (token) => `http://127.0.0.1:${ports.http}/index.html?nats=ws://127.0.0.1:${ports.ws}&stream=web&scene=/scene/#token=${token}`;
+const probe = () => page.evaluate(() => ({ ...window.probecast }));
+
+try {
+  const t0 = Date.now();
+  await page.goto(url(busToken));
+  const s = await until('the page to hold the whole volume', async () => {
+    const v = await probe();
+    return v.bricks > 0 && v.bricksHeld === v.bricks && v.checksum && v.sceneLoaded && v.frames > 10 ? v : null;
+  }, 60);
+  const firstVolumeMs = Date.now() - t0;
+  check(s.checksum === native, `the page's decoded volume equals the native client's (checksum ${s.checksum} vs ${native})`);
+  check(!s.error, `no error on the page (${s.error || 'none'})`);
+  await page.screenshot({ path: join(work, 'page.png') });
+  const f0 = (await probe()).frames;
+  await new Promise((r) => setTimeout(r, 1000));
+  const f1 = (await probe()).frames;
+  check(f1 > f0, `the page keeps rendering (${f1 - f0} frames in 1 s)`);
+
+  // The producer restarts: a new epoch; the page follows and ends with the same volume.
+  serve.kill('SIGTERM');
+  await until('serve to stop', () => serve.exitCode !== null || serve.signalCode !== null, 10);
+  const epochsBefore = (await probe()).epochs;
+  await new Promise((r) => setTimeout(r, 1000));
+  const stalled = await probe();
+  check(stalled.frames > f1, 'frames go on while the producer is away');
+  serve = start(probecast, serveArgs, 'serve2.log');
+  const after = await until('the page to take the new epoch', async () => {
+    const v = await probe();
+    return v.epochs > epochsBefore && v.bricksHeld === v.bricks && v.checksum === native ? v : null;
+  }, 60);
+  check(after.checksum === native, `after the producer's restart the page holds the same volume (epochs ${after.epochs})`);
+
+  // A wrong token: a clear message, no volume.
+  const bad = await browser.newPage({ viewport: { width: 320, height: 240 } });
+  await bad.goto(url('wrong-token'));
+  const refused = await until('the refusal', async () => {
+    const v = await bad.evaluate(() => ({ ...window.probecast, text: document.getElementById('status').textContent }));
+    return v.connection === 'refused' && /not authorised/.test(v.text) ? v : null;
+  }, 30);
+  check(/not authorised/.test(refused.text), `a wrong token is refused with a message: "${refused.error}"`);
+
+  const weight = [...served].filter(([f]) => /\.(js|mjs|wasm|html)$/.test(f)).reduce((a, [, b]) => a + b, 0);
+  const report = {
+    command: process.argv.join(' '),
+    checksum: s.checksum,
+    probes: s.bricks,
+    page_bytes: weight,
+    page_files: Object.fromEntries(served),
+    first_volume_ms: firstVolumeMs,
+    decode_ms_per_message_median: s.decodeMs,
+    frame_ms_median: s.frameMs,
+    bytes_received: after.bytes,
+  };
+  writeFileSync(join(work, 'report.json'), JSON.stringify(report, null, 2) + '\n');
+  console.log(JSON.stringify(report));
+} catch (e) {
+  console.error('FAILED: ' + e.message);
+  console.error('page console:\n' + consoleLines.slice(-20).join('\n'));
+  console.error('page state: ' + JSON.stringify(await probe().catch(() => ({}))));
+  cleanup();
+  process.exit(1);
+} finally {
+  await browser.close().catch(() => {});
+  http.close();
+  clearTimeout(deadline);
+  cleanup();
+}
