@@ -13,7 +13,10 @@ PACKAGES=(
   libglfw3-dev xvfb xauth xdotool libmeshoptimizer-dev
   clang-14 libclang-rt-14-dev openssl libssl-dev
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev python3-venv
+  emscripten node-acorn nodejs chromium
 )
+# npm comes with nodejs where nodejs is not Debian's (NodeSource's): Debian's npm only without one.
+command -v npm >/dev/null 2>&1 || PACKAGES+=(npm)
 # From bookworm-backports (bookworm has none): scikit-build-core, for `pip install ./python`.
 BACKPORTS_PACKAGES=(python3-scikit-build-core)
 # Mesa >= 24 from bookworm-backports: lavapipe with ray tracing (see docs/PLATFORM.md).
