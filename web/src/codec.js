@@ -58,6 +58,7 @@ export class Decoder {
   checksum() { return (this.M._pc_viewer_checksum(this.handle) >>> 0).toString(16).padStart(8, '0'); }
   sceneHash() { return this.M.UTF8ToString(this.M._pc_viewer_scene_hash(this.handle)); }
   sceneManifest() { return this.M.UTF8ToString(this.M._pc_viewer_scene_manifest(this.handle)); }
+  areaLightRule() { return this.M._pc_viewer_area_light_rule(this.handle); }
   representation() { return this.M.UTF8ToString(this.M._pc_viewer_representation(this.handle)); }
   sceneTime() { return this.M._pc_viewer_scene_time(this.handle); }
   publishedUs() { return this.M._pc_viewer_published_us(this.handle); }

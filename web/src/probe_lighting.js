@@ -1,8 +1,10 @@
-// Diffuse indirect light from the probe volume in three.js's physical material: the 8 probes of a
-// point's cell weighted by trilinear × backface × activity, as the native raster client weighs
-// them (shaders/raster.frag, probeCoefficientsVisible), without its per-probe depth moments (the
-// browser has no visibility maps yet: docs/WEB.md). The probes hold L2 SH of incident radiance
-// (sh.h): irradiance E(n) = Σ Â_l c_lm Y_lm(n), which three's Lambert BRDF divides by π.
+// Indirect light from the probe volume in three.js's physical material, as the native raster
+// client computes it (shaders/raster.frag): the 8 probes of a point's cell weighted by trilinear ×
+// backface × activity (probeCoefficientsVisible, without its per-probe depth moments: the browser
+// has no visibility maps yet, docs/WEB.md); diffuse base (1 − metallic) / π · E(n) with
+// E(n) = Σ Â_l c_lm Y_lm(n) (sh.h: L2 SH of incident radiance), and glossy by the split sum,
+// Σ_l g_l(roughness) c_lm Y_lm(R) · (F0·A + B) (glossy_sh.h). Both are added to three's reflected
+// light directly, so that three's own energy split does not scale them.
 import * as THREE from 'three';
 
 const kTexels = 7;  // 27 coefficients and a pad per probe: 7 RGBA texels along x
@@ -76,8 +78,18 @@ export class ProbeLighting {
   vPcNormal = mat3(modelMatrix) * objectNormal;`);
       shader.fragmentShader = shader.fragmentShader
         .replace('#include <common>', `#include <common>\n${kIrradianceGlsl}`)
-        .replace('#include <lights_fragment_maps>', `#include <lights_fragment_maps>
-  if (pcOn > 0.5) irradiance += pcIrradiance(vPcWorld, normalize(vPcNormal) * faceDirection);`);
+        .replace('#include <lights_fragment_end>', `#include <lights_fragment_end>
+  if (pcOn > 0.5) {
+    vec3 pcN = normalize(vPcNormal) * faceDirection;
+    vec3 pcV = normalize(cameraPosition - vPcWorld);
+    float pcC[28];
+    if (pcCoefficients(vPcWorld, pcN, pcC)) {
+      reflectedLight.indirectDiffuse += diffuseColor.rgb * (1.0 - metalnessFactor) * RECIPROCAL_PI * pcIrradiance(pcC, pcN);
+      vec3 pcF0 = mix(vec3(0.04), diffuseColor.rgb, metalnessFactor);
+      vec2 pcAB = texture2D(dfgLUT, vec2(roughnessFactor, saturate(dot(pcN, pcV)))).rg;
+      reflectedLight.indirectSpecular += pcGlossy(pcC, reflect(-pcV, pcN), roughnessFactor) * (pcF0 * pcAB.x + pcAB.y);
+    }
+  }`);
     };
     material.customProgramCacheKey = () => 'probecast-probes';
     material.needsUpdate = true;
@@ -95,14 +107,17 @@ uniform float pcOn;
 varying vec3 vPcWorld;
 varying vec3 vPcNormal;
 
-vec3 pcIrradiance(vec3 p, vec3 n) {
+// The 27 coefficients at p (normal n) from the 8 probes of its cell; false where no probe lights it.
+bool pcCoefficients(vec3 p, vec3 n, out float s[28]) {
+  for (int i = 0; i < 28; ++i) s[i] = 0.0;
   vec3 dims = pcDims;
   ivec3 last = ivec3(dims) - 1;
   vec3 extent = max(pcMax - pcMin, vec3(1e-6));
   vec3 g = clamp((p - pcMin) / extent * (dims - 1.0), vec3(0.0), dims - 1.0);
   ivec3 base = ivec3(min(floor(g), max(dims - 2.0, vec3(0.0))));
   vec3 a = clamp(g - vec3(base), vec3(0.0), vec3(1.0));
-  float spacing = length(extent / max(dims - 1.0, vec3(1.0)));
+  vec3 cell = extent / max(dims - 1.0, vec3(1.0));
+  float spacing = min(dims.x > 1.0 ? cell.x : 1e9, min(dims.y > 1.0 ? cell.y : 1e9, dims.z > 1.0 ? cell.z : 1e9));
   vec4 c[7];
   for (int t = 0; t < 7; ++t) c[t] = vec4(0.0);
   float total = 0.0;
@@ -122,27 +137,42 @@ vec3 pcIrradiance(vec3 p, vec3 n) {
     for (int t = 0; t < 7; ++t) c[t] += w * texelFetch(pcProbes, ivec3(idx.x * 7 + t, idx.y, idx.z), 0);
     total += w;
   }
-  if (!anyInFront || total <= 1e-10) return vec3(0.0);
-  float s[28];
+  if (!anyInFront || total <= 1e-10) return false;
   for (int t = 0; t < 7; ++t) {
     s[4 * t] = c[t].x / total;
     s[4 * t + 1] = c[t].y / total;
     s[4 * t + 2] = c[t].z / total;
     s[4 * t + 3] = c[t].w / total;
   }
-  // Basis at n (sh_basis.cpp), times the clamped-cosine band weights (π, 2π/3, π/4).
+  return true;
+}
+
+// Σ_i k_i Y_i(d) c_i with band weights k (sh_basis.cpp's basis).
+vec3 pcEval(float s[28], vec3 d, float k0, float k1, float k2) {
   float y[9];
-  y[0] = 0.282094792 * 3.14159265;
-  y[1] = 0.488602512 * n.y * 2.09439510;
-  y[2] = 0.488602512 * n.z * 2.09439510;
-  y[3] = 0.488602512 * n.x * 2.09439510;
-  y[4] = 1.092548431 * n.x * n.y * 0.78539816;
-  y[5] = 1.092548431 * n.y * n.z * 0.78539816;
-  y[6] = 0.315391565 * (3.0 * n.z * n.z - 1.0) * 0.78539816;
-  y[7] = 1.092548431 * n.x * n.z * 0.78539816;
-  y[8] = 0.546274215 * (n.x * n.x - n.y * n.y) * 0.78539816;
+  y[0] = 0.282094792 * k0;
+  y[1] = 0.488602512 * d.y * k1;
+  y[2] = 0.488602512 * d.z * k1;
+  y[3] = 0.488602512 * d.x * k1;
+  y[4] = 1.092548431 * d.x * d.y * k2;
+  y[5] = 1.092548431 * d.y * d.z * k2;
+  y[6] = 0.315391565 * (3.0 * d.z * d.z - 1.0) * k2;
+  y[7] = 1.092548431 * d.x * d.z * k2;
+  y[8] = 0.546274215 * (d.x * d.x - d.y * d.y) * k2;
   vec3 e = vec3(0.0);
   for (int i = 0; i < 9; ++i) e += y[i] * vec3(s[3 * i], s[3 * i + 1], s[3 * i + 2]);
   return max(e, vec3(0.0));
+}
+
+// Irradiance: the clamped-cosine band weights (π, 2π/3, π/4).
+vec3 pcIrradiance(float s[28], vec3 n) { return pcEval(s, n, 3.14159265, 2.09439510, 0.78539816); }
+
+// The GGX lobe's zonal scales g_l, rational in α = roughness² (glossy_sh.h; the coefficients are
+// ggxLobeFit()'s).
+float pcLobe(float a, vec4 f) { return (1.0 + f.x * a + f.y * a * a) / (1.0 + f.z * a + f.w * a * a); }
+vec3 pcGlossy(float s[28], vec3 r, float roughness) {
+  float a = roughness * roughness;
+  return pcEval(s, r, 1.0, pcLobe(a, vec4(2.1795214, 3.78937271, 2.46112562, 6.99579005)),
+                pcLobe(a, vec4(1.79515323, 0.378824571, 2.5905287, 9.12932987)));
 }
 `;

@@ -6,7 +6,8 @@
 // volume it holds, whatever the stream does.
 //
 // URL: index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL-OF-THE-SCENE-FOLDER#token=TOKEN
-// (the token in the fragment: it never reaches a web server's logs). Optional: camera=px,py,pz,tx,ty,tz,fovDeg.
+// (the token in the fragment: it never reaches a web server's logs). Optional: camera=px,py,pz,tx,ty,tz,fovDeg,
+// exposure=X (as the native viewer's --exposure).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { connect, DeliverPolicy } from 'nats.ws';
@@ -55,10 +56,20 @@ if (!/^[A-Za-z0-9_-]+$/.test(config.stream)) fail(`stream name "${config.stream}
 if (!config.nats) fail('no bus given: open index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL#token=TOKEN');
 
 // ---- rendering -----------------------------------------------------------------------------
+// The native viewer's picture: linear light times the exposure, the filmic curve
+// (imaging/image_io.cpp: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)), then gamma 2.2.
+THREE.ShaderChunk.tonemapping_pars_fragment = THREE.ShaderChunk.tonemapping_pars_fragment.replace(
+  'vec3 CustomToneMapping( vec3 color ) { return color; }',
+  `vec3 CustomToneMapping( vec3 color ) {
+  vec3 v = max( color * toneMappingExposure, vec3( 0.0 ) );
+  v = v * ( 2.51 * v + 0.03 ) / ( v * ( 2.43 * v + 0.59 ) + 0.14 );
+  return pow( min( v, vec3( 1.0 ) ), vec3( 1.0 / 2.2 ) );
+}`);
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
-renderer.outputColorSpace = THREE.SRGBColorSpace;
-renderer.toneMapping = THREE.NoToneMapping;
+renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // the curve above ends in gamma 2.2
+renderer.toneMapping = THREE.CustomToneMapping;
+renderer.toneMappingExposure = Number(params.get('exposure') || 1);
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 const scene = new THREE.Scene();
@@ -183,6 +194,10 @@ function onMessage(bytes) {
       loadingScene = loadScene(codec.sceneManifest(), hash).catch((e) => fail(e.message)).finally(() => { loadingScene = null; });
     }
     state.representation = codec.representation();
+    // The page does not draw client area lights yet: say so rather than show a darker room silently.
+    state.warning = codec.areaLightRule() !== 0
+      ? 'this stream leaves its area lights to the viewer, and this page does not draw them yet: their direct light is missing'
+      : '';
   }
   if (r === 2) state.lastBrickAt = performance.now();
   volumeDirty = true;
@@ -259,6 +274,7 @@ setInterval(() => {
     `${state.connection}  ${config.stream}  ${state.representation}  bricks ${state.bricksHeld}/${state.bricks}  checksum ${state.checksum || '–'}`,
     `frame ${state.frameMs.toFixed(1)} ms  newest light ${age} ago  ${(rate / 1024).toFixed(1)} kB/s  decode ${state.decodeMs.toFixed(2)} ms/message`,
   ];
+  if (state.warning) lines.push(state.warning);
   if (state.error) lines.push(state.error);
   statusEl.textContent = lines.join('\n');
 }, 250);

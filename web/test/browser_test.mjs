@@ -62,7 +62,10 @@ websocket { listen: "127.0.0.1:${ports.ws}", no_tls: true }
 const natsBin = ['/usr/sbin/nats-server', '/usr/bin/nats-server'].find(existsSync) || 'nats-server';
 start(natsBin, ['-c', join(work, 'nats.conf'), '-a', '127.0.0.1', '-p', String(ports.nats), '-js', '-sd', join(work, 'nats')], 'nats.log');
 
-execFileSync(probecast, ['bake', '--scene', sceneGltf, '--grid', '6,6,6', '--spp', '32', '--updates', '1', '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
+// The probes hold every emitter (--area-lights off): the page does not draw client area lights yet.
+// PROBECAST_WEB_SPP: paths per probe (the README's screenshot takes 512).
+execFileSync(probecast, ['bake', '--scene', sceneGltf, '--area-lights', 'off', '--grid', '6,6,6', '--spp', process.env.PROBECAST_WEB_SPP || '32', '--updates', '1',
+  '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
 const serveArgs = ['serve', '--probes', join(work, 'served.pcpv'), '--scene', sceneGltf, '--listen', `127.0.0.1:${ports.grpc}`,
   '--plaintext', '--token', 't0k', '--seconds', '200', '--publish', `nats://127.0.0.1:${ports.nats}`, '--stream', 'web',
   '--nats-token-file', join(work, 'bus-token'), '--nats-plaintext'];
@@ -94,7 +97,9 @@ const browser = await chromium.launch({
   args: ['--no-sandbox', '--disable-gpu-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--disable-background-networking',
     '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
 });
-const page = await browser.newPage({ viewport: { width: 320, height: 240 } });
+// PROBECAST_WEB_VIEWPORT=WxH: another size (the README's screenshot is 640x480).
+const [vw, vh] = (process.env.PROBECAST_WEB_VIEWPORT || '320x240').split('x').map(Number);
+const page = await browser.newPage({ viewport: { width: vw || 320, height: vh || 240 } });
 const consoleLines = [];
 page.on('console', (m) => consoleLines.push(m.text()));
 page.on('pageerror', (e) => consoleLines.push('page error: ' + e.message));
@@ -111,7 +116,39 @@ try {
   const firstVolumeMs = Date.now() - t0;
   check(s.checksum === native, `the page's decoded volume equals the native client's (checksum ${s.checksum} vs ${native})`);
   check(!s.error, `no error on the page (${s.error || 'none'})`);
+  check(!s.warning, `no warning on the page (${s.warning || 'none'})`);
+  await new Promise((r) => setTimeout(r, 500));  // the status line's next refresh
   await page.screenshot({ path: join(work, 'page.png') });
+  // The same camera rendered by the native raster client from the same probes: PSNR of the page's
+  // canvas against it, both 8-bit pictures through the same curve.
+  execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation,
+    '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native')], { stdio: 'ignore' });
+  const nativePng = 'data:image/png;base64,' + readFileSync(join(work, 'native', 'quilt.png')).toString('base64');
+  const compared = await page.evaluate(async (url) => {
+    const img = new Image();
+    img.src = url;
+    await img.decode();
+    const view = document.getElementById('view');
+    const pixels = (source) => {
+      const c = document.createElement('canvas');
+      c.width = view.width;
+      c.height = view.height;
+      const g = c.getContext('2d');
+      g.drawImage(source, 0, 0);
+      return g.getImageData(0, 0, c.width, c.height).data;
+    };
+    const a = pixels(view), b = pixels(img);
+    let se = 0;
+    for (let i = 0; i < a.length; i += 4) for (let k = 0; k < 3; ++k) se += (a[i + k] - b[i + k]) ** 2;
+    const mse = se / (3 * (a.length / 4));
+    return { psnr: 10 * Math.log10((255 * 255) / Math.max(mse, 1e-12)), canvas: view.toDataURL('image/png'),
+             size: [view.width, view.height], nativeSize: [img.naturalWidth, img.naturalHeight] };
+  }, nativePng);
+  writeFileSync(join(work, 'canvas.png'), Buffer.from(compared.canvas.split(',')[1], 'base64'));
+  check(compared.size.join('x') === compared.nativeSize.join('x'), `the native render has the page's size (${compared.nativeSize.join('x')})`);
+  console.log(`page against the native raster client, same camera and probes: ${compared.psnr.toFixed(2)} dB PSNR`);
+  const minPsnr = Number(process.env.PROBECAST_WEB_MIN_PSNR || 0);
+  check(compared.psnr >= minPsnr, `the page's picture is within ${minPsnr} dB of the native client's (${compared.psnr.toFixed(2)} dB)`);
   const f0 = (await probe()).frames;
   await new Promise((r) => setTimeout(r, 1000));
   const f1 = (await probe()).frames;
@@ -144,6 +181,7 @@ try {
   const report = {
     command: process.argv.join(' '),
     checksum: s.checksum,
+    psnr_against_native_db: Number(compared.psnr.toFixed(2)),
     probes: s.bricks,
     page_bytes: weight,
     page_files: Object.fromEntries(served),

@@ -214,6 +214,12 @@ EMSCRIPTEN_KEEPALIVE const char* pc_viewer_scene_hash(void* handle) {
 EMSCRIPTEN_KEEPALIVE const char* pc_viewer_scene_manifest(void* handle) {
   return of(handle)->volume.sceneManifest.c_str();
 }
+// The stream's client area light rule (probe_volume.h AreaLightRule): 0 when the probes hold every
+// emitter, else the rule's version (the viewer must draw those emitters' direct light itself).
+EMSCRIPTEN_KEEPALIVE uint32_t pc_viewer_area_light_rule(void* handle) {
+  return of(handle)->haveVolume ? of(handle)->volume.areaLights.version : 0;
+}
+
 // The representation's name as the CLI spells it (l1, zh3h, zh3, l2, fp16, float).
 EMSCRIPTEN_KEEPALIVE const char* pc_viewer_representation(void* handle) {
   const Viewer& v = *of(handle);
