@@ -78,7 +78,8 @@ if [ ! -d "$ROOT/web/node_modules/three" ] || [ "$ROOT/web/package-lock.json" -n
   (cd "$ROOT/web" && npm ci --no-audit --no-fund --loglevel=error)
 fi
 rm -rf "$OUT/src" "$OUT/vendor"
-mkdir -p "$OUT/vendor/three/build" "$OUT/vendor/three/examples/jsm/loaders" "$OUT/vendor/three/examples/jsm/utils" "$OUT/vendor/nats.ws"
+mkdir -p "$OUT/vendor/three/build" "$OUT/vendor/three/examples/jsm/loaders" "$OUT/vendor/three/examples/jsm/utils" "$OUT/vendor/nats.ws" \
+  "$OUT/vendor/iwer"
 cp "$ROOT/web/index.html" "$OUT/"
 cp -r "$ROOT/web/src" "$OUT/src"
 NM="$ROOT/web/node_modules"
@@ -88,4 +89,5 @@ cp "$NM/three/examples/jsm/utils/BufferGeometryUtils.js" "$NM/three/examples/jsm
 cp "$NM/nats.ws/esm/nats.js" "$OUT/vendor/nats.ws/nats.js"
 cp "$NM/three/LICENSE" "$OUT/vendor/three/LICENSE"
 cp "$NM/nats.ws/LICENSE" "$OUT/vendor/nats.ws/LICENSE"
+cp "$NM/iwer/build/iwer.module.js" "$NM/iwer/LICENSE" "$OUT/vendor/iwer/"  # loaded only with xr=emulate
 echo "build-web: page in $OUT (index.html)"

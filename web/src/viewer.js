@@ -7,7 +7,9 @@
 //
 // URL: index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL-OF-THE-SCENE-FOLDER#token=TOKEN
 // (the token in the fragment: it never reaches a web server's logs). Optional: camera=px,py,pz,tx,ty,tz,fovDeg,
-// exposure=X (as the native viewer's --exposure).
+// exposure=X (as the native viewer's --exposure), xr=emulate (a headset emulated in the page, for
+// trying WebXR without one). Where the browser offers immersive VR, an "Enter VR" button opens a
+// session that renders each eye from the same probes, starting where the page's camera stands.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { connect, DeliverPolicy } from 'nats.ws';
@@ -85,17 +87,79 @@ function resize() {
 
 let last = performance.now();
 const frameTimes = [];
-function frame(now) {
-  resize();
-  renderer.render(scene, camera);
+function frame(now, xrFrame) {
+  if (!renderer.xr.isPresenting) resize();
+  renderer.render(scene, renderer.xr.isPresenting ? xrCamera : camera);
   frameTimes.push(now - last);
   if (frameTimes.length > 60) frameTimes.shift();
   last = now;
   state.frames += 1;
+  if (xrFrame) {
+    if (xrPlace) placeViewer(xrFrame);
+    state.xrFrames += 1;
+  }
   state.frameMs = median(frameTimes);
-  requestAnimationFrame(frame);
 }
-requestAnimationFrame(frame);
+renderer.setAnimationLoop(frame);
+
+// ---- WebXR -------------------------------------------------------------------------------------
+state.xr = 'none';
+state.xrFrames = 0;
+const xrButton = document.getElementById('xr');
+let xrPlace = false;  // place the viewer on the session's first frame
+// While presenting, three draws from the head's pose relative to the XR camera's parent: the
+// dolly, put where the page's camera stands (runtimes' offset reference spaces are not all
+// faithful; a parent transform is).
+const dolly = new THREE.Group();
+dolly.matrixAutoUpdate = false;
+const xrCamera = new THREE.PerspectiveCamera(50, 1, 0.01, 1000);
+dolly.add(xrCamera);
+
+// dolly = camera · head⁻¹, head the viewer's pose then: the session starts at the page's view.
+function placeViewer(xrFrame) {
+  const pose = xrFrame.getViewerPose(renderer.xr.getReferenceSpace());
+  if (!pose) return;
+  camera.updateMatrixWorld(true);
+  const head = new THREE.Matrix4().fromArray(pose.transform.matrix);
+  dolly.matrix.copy(camera.matrixWorld).multiply(head.invert());
+  dolly.matrixWorldNeedsUpdate = true;
+  if (dolly.parent !== scene) scene.add(dolly);
+  xrPlace = false;
+}
+
+async function setupXr() {
+  if (params.get('xr') === 'emulate') {
+    const { XRDevice, metaQuest3 } = await import('iwer');
+    // Both eyes (iwer draws one unless asked), and no lens mask over the picture.
+    const device = new XRDevice(metaQuest3, { stereoEnabled: true, visibilityMask: null });
+    device.installRuntime({ forceInstall: true });
+  }
+  const supported = navigator.xr && (await navigator.xr.isSessionSupported('immersive-vr').catch(() => false));
+  if (!supported) return;
+  state.xr = 'available';
+  xrButton.hidden = false;
+  xrButton.onclick = () => enterXr().catch((e) => fail('WebXR: ' + e.message));
+}
+
+async function enterXr() {
+  if (renderer.xr.isPresenting) return renderer.xr.getSession().end();
+  const session = await navigator.xr.requestSession('immersive-vr', { optionalFeatures: ['local-floor'] });
+  renderer.xr.enabled = true;
+  renderer.xr.setReferenceSpaceType('local');
+  await renderer.xr.setSession(session);
+  xrPlace = true;
+  state.xr = 'immersive';
+  xrButton.textContent = 'Exit VR';
+  session.addEventListener('end', () => {
+    state.xr = 'available';
+    xrButton.textContent = 'Enter VR';
+    renderer.xr.enabled = false;
+  });
+}
+setupXr().catch((e) => {
+  state.xr = 'failed';
+  fail('WebXR: ' + e.message);
+});
 
 function median(values) {
   if (!values.length) return 0;
@@ -131,6 +195,7 @@ async function loadScene(manifestText, hash) {
   const gltf = await new GLTFLoader(manager).parseAsync(text, '');
   scene.clear();
   scene.add(gltf.scene);
+  if (renderer.xr.isPresenting) scene.add(dolly);  // a session goes on in the new scene
   gltf.scene.traverse((o) => {
     if (o.isMesh) {
       o.castShadow = o.receiveShadow = true;

@@ -168,6 +168,46 @@ try {
   }, 60);
   check(after.checksum === native, `after the producer's restart the page holds the same volume (epochs ${after.epochs})`);
 
+  // WebXR: a Meta Quest 3 emulated in the page (iwer); the button opens an immersive session and
+  // both eyes are drawn, side by side on the canvas, from the probes.
+  const xr = await browser.newPage({ viewport: { width: vw || 320, height: vh || 240 } });
+  xr.on('pageerror', (e) => consoleLines.push('xr page error: ' + e.message));
+  await xr.goto(url(busToken).replace('&scene=', '&xr=emulate&scene='));
+  await until('the XR page to hold the volume', async () => {
+    const v = await xr.evaluate(() => ({ ...window.probecast }));
+    return v.sceneLoaded && v.checksum === native && v.xr === 'available' ? v : null;
+  }, 60);
+  await xr.click('#xr', { timeout: 10000 });
+  const inXr = await until('frames of the immersive session', async () => {
+    const v = await xr.evaluate(() => ({ ...window.probecast }));
+    return v.xr === 'immersive' && v.xrFrames > 10 ? v : null;
+  }, 60);
+  const eyes = await xr.evaluate(() => {
+    const view = document.getElementById('view');
+    const c = document.createElement('canvas');
+    c.width = view.width;
+    c.height = view.height;
+    const g = c.getContext('2d');
+    g.drawImage(view, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    const half = c.width / 2;
+    let left = 0, right = 0, differ = 0;
+    for (let y = 0; y < c.height; ++y)
+      for (let x = 0; x < half; ++x) {
+        const a = (y * c.width + x) * 4, b = (y * c.width + x + half) * 4;
+        left += d[a] + d[a + 1] + d[a + 2];
+        right += d[b] + d[b + 1] + d[b + 2];
+        differ += Math.abs(d[a] - d[b]) + Math.abs(d[a + 1] - d[b + 1]) + Math.abs(d[a + 2] - d[b + 2]);
+      }
+    const n = 3 * half * c.height;
+    return { left: left / n, right: right / n, differ: differ / n, size: [c.width, c.height], png: view.toDataURL('image/png') };
+  });
+  writeFileSync(join(work, 'xr_eyes.png'), Buffer.from(eyes.png.split(',')[1], 'base64'));
+  await xr.screenshot({ path: join(work, 'xr_page.png') });
+  check(eyes.left > 5 && eyes.right > 5 && Math.abs(eyes.left - eyes.right) < 0.2 * eyes.left, `both eyes are drawn, alike (mean ${eyes.left.toFixed(1)} and ${eyes.right.toFixed(1)} of 255, ${inXr.xrFrames} XR frames, ${eyes.size.join('x')})`);
+  check(eyes.differ > 0.3, `the eyes see from two places (mean difference ${eyes.differ.toFixed(2)} of 255)`);
+  await xr.close();
+
   // A wrong token: a clear message, no volume.
   const bad = await browser.newPage({ viewport: { width: 320, height: 240 } });
   await bad.goto(url('wrong-token'));
