@@ -4,7 +4,11 @@
 //
 // Every function takes the handle pc_viewer_new returned. Pointers into the module's memory stay
 // valid until the next pc_viewer_message call.
+#ifdef __EMSCRIPTEN__
 #include <emscripten/emscripten.h>
+#else  // the native build of the same entry points (fuzz/web_fuzz.cpp)
+#define EMSCRIPTEN_KEEPALIVE
+#endif
 
 #include <cstdint>
 #include <cstdio>
