@@ -60,7 +60,8 @@ writeFileSync(join(work, 'nats.conf'), `authorization { token: "${busToken}" }
 websocket { listen: "127.0.0.1:${ports.ws}", no_tls: true }
 `);
 const natsBin = ['/usr/sbin/nats-server', '/usr/bin/nats-server'].find(existsSync) || 'nats-server';
-start(natsBin, ['-c', join(work, 'nats.conf'), '-a', '127.0.0.1', '-p', String(ports.nats), '-js', '-sd', join(work, 'nats')], 'nats.log');
+const natsArgs = ['-c', join(work, 'nats.conf'), '-a', '127.0.0.1', '-p', String(ports.nats), '-js', '-sd', join(work, 'nats')];
+let nats = start(natsBin, natsArgs, 'nats.log');
 
 // The probes hold every emitter (--area-lights off): the page does not draw client area lights yet.
 // PROBECAST_WEB_SPP: paths per probe (the README's screenshot takes 512).
@@ -167,6 +168,18 @@ try {
     return v.epochs > epochsBefore && v.bricksHeld === v.bricks && v.checksum === native ? v : null;
   }, 60);
   check(after.checksum === native, `after the producer's restart the page holds the same volume (epochs ${after.epochs})`);
+
+  // The bus restarts (same store): the page reconnects and holds the producer's volume again.
+  nats.kill('SIGTERM');
+  await until('nats-server to stop', () => nats.exitCode !== null || nats.signalCode !== null, 10);
+  await until('the page to notice', async () => (await probe()).connection !== 'connected', 20);
+  const framesWithoutBus = (await probe()).frames;
+  nats = start(natsBin, natsArgs, 'nats2.log');
+  const back = await until('the page to reconnect to the bus', async () => {
+    const v = await probe();
+    return v.connection === 'connected' && v.frames > framesWithoutBus && v.bricksHeld === v.bricks && v.checksum === native ? v : null;
+  }, 60);
+  check(back.checksum === native, `after the bus restarts the page reconnects and holds the same volume (${back.connection})`);
 
   // WebXR: a Meta Quest 3 emulated in the page (iwer); the button opens an immersive session and
   // both eyes are drawn, side by side on the canvas, from the probes.
