@@ -61,6 +61,8 @@ export class Decoder {
   areaLightRule() { return this.M._pc_viewer_area_light_rule(this.handle); }
   representation() { return this.M.UTF8ToString(this.M._pc_viewer_representation(this.handle)); }
   sceneTime() { return this.M._pc_viewer_scene_time(this.handle); }
+  sceneRate() { return this.M._pc_viewer_scene_rate(this.handle); }
+  sceneClockUs() { return this.M._pc_viewer_scene_clock_us(this.handle); }
   publishedUs() { return this.M._pc_viewer_published_us(this.handle); }
   counts() {
     const c = (i) => this.M._pc_viewer_count(this.handle, i);

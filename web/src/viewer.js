@@ -87,8 +87,31 @@ function resize() {
 
 let last = performance.now();
 const frameTimes = [];
+let animation = null;  // the scene's clips, posed at the display time every frame
+
+// The display clock: the newest lighting's scene time, run on at its rate from the producer's wall
+// clock (clocks on the page's and the producer's machines are taken to agree, as NTP keeps them).
+function displayTime() {
+  if (!codec || !codec.hasVolume()) return 0;
+  const rate = codec.sceneRate();
+  const t = codec.sceneTime();
+  return rate === 0 ? t : t + rate * (Date.now() * 1000 - codec.sceneClockUs()) / 1e6;
+}
+
+function pose(time) {
+  if (!animation) return;
+  const tau = animation.length > 0 ? ((time % animation.length) + animation.length) % animation.length : 0;
+  for (const a of animation.actions) {
+    a.enabled = true;
+    a.time = Math.min(tau, a.getClip().duration);
+  }
+  animation.mixer.update(0);
+  state.sceneTime = time;
+}
+
 function frame(now, xrFrame) {
   if (!renderer.xr.isPresenting) resize();
+  pose(displayTime());
   renderer.render(scene, renderer.xr.isPresenting ? xrCamera : camera);
   frameTimes.push(now - last);
   if (frameTimes.length > 60) frameTimes.shift();
@@ -211,6 +234,19 @@ async function loadScene(manifestText, hash) {
     }
   });
   camera = pickCamera(gltf);
+  // The scene's animation, every clip at once, looped over the longest (as the native viewers).
+  animation = null;
+  if (gltf.animations.length) {
+    const mixer = new THREE.AnimationMixer(gltf.scene);
+    const actions = gltf.animations.map((clip) => {
+      const a = mixer.clipAction(clip);
+      a.setLoop(THREE.LoopOnce, 1);
+      a.clampWhenFinished = true;
+      a.play();
+      return a;
+    });
+    animation = { mixer, actions, length: Math.max(...gltf.animations.map((c) => c.duration)) };
+  }
   state.sceneLoaded = true;
 }
 

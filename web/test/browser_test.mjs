@@ -65,8 +65,10 @@ let nats = start(natsBin, natsArgs, 'nats.log');
 
 // The probes hold every emitter (--area-lights off): the page does not draw client area lights yet.
 // PROBECAST_WEB_SPP: paths per probe (the README's screenshot takes 512).
+// PROBECAST_WEB_TIME: the scene time the probes are traced at (an animated scene is posed there).
+const sceneTime = process.env.PROBECAST_WEB_TIME || '0';
 execFileSync(probecast, ['bake', '--scene', sceneGltf, '--area-lights', 'off', '--grid', '6,6,6', '--spp', process.env.PROBECAST_WEB_SPP || '32', '--updates', '1',
-  '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
+  '--time', sceneTime, '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
 const serveArgs = ['serve', '--probes', join(work, 'served.pcpv'), '--scene', sceneGltf, '--listen', `127.0.0.1:${ports.grpc}`,
   '--plaintext', '--token', 't0k', '--seconds', '200', '--publish', `nats://127.0.0.1:${ports.nats}`, '--stream', 'web',
   '--nats-token-file', join(work, 'bus-token'), '--nats-plaintext'];
@@ -122,10 +124,10 @@ try {
   await page.screenshot({ path: join(work, 'page.png') });
   // The same camera rendered by the native raster client from the same probes: PSNR of the page's
   // canvas against it, both 8-bit pictures through the same curve.
-  execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation,
+  execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
     '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native')], { stdio: 'ignore' });
   const nativePng = 'data:image/png;base64,' + readFileSync(join(work, 'native', 'quilt.png')).toString('base64');
-  const compared = await page.evaluate(async (url) => {
+  const compare = (png) => page.evaluate(async (url) => {
     const img = new Image();
     img.src = url;
     await img.decode();
@@ -144,12 +146,28 @@ try {
     const mse = se / (3 * (a.length / 4));
     return { psnr: 10 * Math.log10((255 * 255) / Math.max(mse, 1e-12)), canvas: view.toDataURL('image/png'),
              size: [view.width, view.height], nativeSize: [img.naturalWidth, img.naturalHeight] };
-  }, nativePng);
+  }, png);
+  const compared = await compare(nativePng);
   writeFileSync(join(work, 'canvas.png'), Buffer.from(compared.canvas.split(',')[1], 'base64'));
   check(compared.size.join('x') === compared.nativeSize.join('x'), `the native render has the page's size (${compared.nativeSize.join('x')})`);
   console.log(`page against the native raster client, same camera and probes: ${compared.psnr.toFixed(2)} dB PSNR`);
   const minPsnr = Number(process.env.PROBECAST_WEB_MIN_PSNR || 0);
   check(compared.psnr >= minPsnr, `the page's picture is within ${minPsnr} dB of the native client's (${compared.psnr.toFixed(2)} dB)`);
+  if (Number(sceneTime) !== 0) {
+    // The page poses the scene at the stream's time: the native picture of the scene at rest
+    // (same probes) is farther from it.
+    execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', '0',
+      '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native-at-rest')], { stdio: 'ignore' });
+    const atRest = await compare('data:image/png;base64,' + readFileSync(join(work, 'native-at-rest', 'quilt.png')).toString('base64'));
+    check(atRest.psnr < compared.psnr - 3, `the page poses the scene at the stream's time ${sceneTime} s (${compared.psnr.toFixed(2)} dB against the native picture then, ${atRest.psnr.toFixed(2)} dB against the scene at rest)`);
+  }
+  if (process.env.PROBECAST_WEB_QUICK) {  // the picture only
+    console.log('browser viewer picture ok');
+    await browser.close().catch(() => {});
+    http.close();
+    cleanup();
+    process.exit(0);
+  }
   const f0 = (await probe()).frames;
   await new Promise((r) => setTimeout(r, 1000));
   const f1 = (await probe()).frames;
