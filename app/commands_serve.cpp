@@ -236,6 +236,9 @@ void addSubscribeCommand(CLI::App& app) {
     fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects{}\n", st.framesApplied,
                st.framesRejected, st.bytesReceived, st.connects, st.lastError.empty() ? "" : ", last error: " + st.lastError);
     if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
+    if (st.statsReceived > 0)
+      fmt::print("subscribe: the server counted {} bytes sent, {} frames acked, frame → ack {:.1f} ms, {} bricks behind\n",
+                 st.serverBytesSent, st.serverFramesAcked, st.serverAckRttUs / 1e3, st.serverBricksBehind);
     service::VolumeSnapshot snap;
     if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connection.connect);
     service::ScenePackage named;
