@@ -333,8 +333,6 @@ async function subscribe() {
       await sleep(1000);
       continue;
     }
-    state.error = '';
-    statusEl.classList.remove('error');
     (async () => {
       for await (const s of nc.status()) {
         if (s.type === 'disconnect' || s.type === 'reconnecting') state.connection = 'reconnecting';

@@ -7,7 +7,7 @@
 // Usage: node browser_test.mjs PROBECAST WEB_DIR SCENE_GLTF WORK_DIR
 import { spawn, execFileSync } from 'node:child_process';
 import { createServer } from 'node:http';
-import { readFileSync, writeFileSync, mkdirSync, rmSync, statSync, existsSync } from 'node:fs';
+import { readFileSync, writeFileSync, mkdirSync, rmSync, statSync, existsSync, readdirSync } from 'node:fs';
 import { dirname, join, extname, resolve, basename, sep } from 'node:path';
 import { chromium } from 'playwright-core';
 
@@ -86,7 +86,8 @@ const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/ja
 const served = new Map();
 const http = createServer((req, res) => {
   const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
-  const [root, rel] = path.startsWith('/scene/') ? [sceneDir, path.slice(7)] : [webDir, path === '/' ? 'index.html' : path.slice(1)];
+  const [root, rel] = path.startsWith('/scene/') ? [sceneDir, path.slice(7)]
+    : path.startsWith('/altered/') ? [join(work, 'altered'), path.slice(9)] : [webDir, path === '/' ? 'index.html' : path.slice(1)];
   const file = resolve(root, rel);
   if (!file.startsWith(root + sep) || !existsSync(file) || !statSync(file).isFile()) { res.writeHead(404); res.end(); return; }
   const body = readFileSync(file);
@@ -247,6 +248,19 @@ try {
     return v.connection === 'refused' && /not authorised/.test(v.text) ? v : null;
   }, 30);
   check(/not authorised/.test(refused.text), `a wrong token is refused with a message: "${refused.error}"`);
+
+  // A scene folder whose glTF is not the stream's (one byte more): refused, with the reason.
+  mkdirSync(join(work, 'altered'), { recursive: true });
+  for (const f of readdirSync(sceneDir)) writeFileSync(join(work, 'altered', f), readFileSync(join(sceneDir, f)));
+  writeFileSync(join(work, 'altered', basename(sceneGltf)), Buffer.concat([readFileSync(sceneGltf), Buffer.from(' ')]));
+  const altered = await browser.newPage({ viewport: { width: 320, height: 240 } });
+  await altered.goto(url(busToken).replace('&scene=/scene/', '&scene=/altered/'));
+  const mismatch = await until('the scene to be refused', async () => {
+    const v = await altered.evaluate(() => ({ ...window.probecast }));
+    return /does not match the stream/.test(v.error) ? v : null;
+  }, 30);
+  check(!mismatch.sceneLoaded, `a scene that is not the stream's is refused: "${mismatch.error}"`);
+  await altered.close();
 
   const weight = [...served].filter(([f]) => /\.(js|mjs|wasm|html)$/.test(f)).reduce((a, [, b]) => a + b, 0);
   const report = {
