@@ -77,17 +77,16 @@ if [ ! -d "$ROOT/web/node_modules/three" ] || [ "$ROOT/web/package-lock.json" -n
   echo "build-web: npm ci (web/package-lock.json)"
   (cd "$ROOT/web" && npm ci --no-audit --no-fund --loglevel=error)
 fi
-rm -rf "$OUT/src" "$OUT/vendor"
-mkdir -p "$OUT/vendor/three/build" "$OUT/vendor/three/examples/jsm/loaders" "$OUT/vendor/three/examples/jsm/utils" "$OUT/vendor/nats.ws" \
-  "$OUT/vendor/iwer"
-cp "$ROOT/web/index.html" "$OUT/"
-cp -r "$ROOT/web/src" "$OUT/src"
+# One minified ES module (esbuild) with three.js and nats.ws; iwer is a chunk of its own, loaded
+# only with xr=emulate. The codec (probecast_codec.mjs/.wasm) stays beside it, loaded at run time.
+rm -rf "$OUT/src" "$OUT/vendor" "$OUT"/viewer.js "$OUT"/chunk-*.js "$OUT"/iwer.module-*.js
 NM="$ROOT/web/node_modules"
-cp "$NM/three/build/three.module.js" "$NM/three/build/three.core.js" "$OUT/vendor/three/build/"
-cp "$NM/three/examples/jsm/loaders/GLTFLoader.js" "$OUT/vendor/three/examples/jsm/loaders/"
-cp "$NM/three/examples/jsm/utils/BufferGeometryUtils.js" "$NM/three/examples/jsm/utils/SkeletonUtils.js" "$OUT/vendor/three/examples/jsm/utils/"
-cp "$NM/nats.ws/esm/nats.js" "$OUT/vendor/nats.ws/nats.js"
-cp "$NM/three/LICENSE" "$OUT/vendor/three/LICENSE"
-cp "$NM/nats.ws/LICENSE" "$OUT/vendor/nats.ws/LICENSE"
-cp "$NM/iwer/build/iwer.module.js" "$NM/iwer/LICENSE" "$OUT/vendor/iwer/"  # loaded only with xr=emulate
+"$NM/.bin/esbuild" "$ROOT/web/src/viewer.js" --bundle --minify --format=esm --splitting --outdir="$OUT" \
+  --external:crypto --alias:nats.ws="$NM/nats.ws/esm/nats.js" --alias:iwer="$NM/iwer/build/iwer.module.js" \
+  --legal-comments=linked --log-level=warning
+cp "$ROOT/web/index.html" "$OUT/"
+mkdir -p "$OUT/licenses"
+cp "$NM/three/LICENSE" "$OUT/licenses/three.LICENSE"
+cp "$NM/nats.ws/LICENSE" "$OUT/licenses/nats.ws.LICENSE"
+cp "$NM/iwer/LICENSE" "$OUT/licenses/iwer.LICENSE"
 echo "build-web: page in $OUT (index.html)"

@@ -1,8 +1,8 @@
 // The probe codec compiled to WebAssembly (web/wasm/probecast_web.cpp): bus messages in, the
 // volume the native client would hold out.
-import createProbecastCodec from '../probecast_codec.mjs';
-
 export async function loadCodec(options = {}) {
+  // Beside the page's script (build/web): loaded at run time, not bundled.
+  const { default: createProbecastCodec } = await import(new URL('./probecast_codec.mjs', import.meta.url).href);
   const M = await createProbecastCodec(options);
   return new Decoder(M);
 }
