@@ -2,9 +2,11 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <fstream>
 #include <thread>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "probecast/codec/probe_file.h"
@@ -30,7 +32,7 @@ struct ServeOptions {
   NoiseRuleCli noise;  // on for live tracing unless --noise-scale 0
   float errorBound = 0.0f;
   uint32_t confirmations = 0;
-  double hz = 10.0, seconds = 0.0, animate = 0.05;
+  double hz = 10.0, seconds = 0.0, animate = 0.05, holdAfter = 0.0;
 };
 
 // The scene package a probe file's viewers are sent: the one it names, with its files from
@@ -153,6 +155,10 @@ void addServeCommand(CLI::App& app) {
   o->bus.add(serve, publish);
   serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
   serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
+  serve->add_option("--hold-after", o->holdAfter,
+                    "publish no new lighting after this many seconds (0 = never): subscribers are still served and "
+                    "settle on the last volume, to be compared bit for bit")
+      ->check(CLI::Range(0.0, 1e9));
   serve->add_option("--animate", o->animate, "live: scene seconds per second (the scene clock's rate; 0: still)")
       ->check(CLI::Range(0.0, 10.0));
   serve->callback([o] {
@@ -187,7 +193,15 @@ void addServeCommand(CLI::App& app) {
     pacing.hz = o->hz;
     pacing.seconds = o->seconds;
     double lastReport = 0.0;
+    bool held = false;
     producer->run(pacing, &gInterrupted, [&](double seconds) {
+      if (o->holdAfter > 0 && seconds >= o->holdAfter && !held) {
+        producer->hold(true);
+        held = true;
+        fmt::print("serve: holding the lighting after {} updates ({:.1f} s); volume checksum {:08x}\n",
+                   producer->stats().updates, seconds, volumeChecksum(producer->hub().reconstruction()));
+        std::fflush(stdout);
+      }
       if (!o->publish.empty() && producer->busStats().displaced)
         throw std::runtime_error("--publish: " + producer->busStats().lastError);
       if (seconds - lastReport < 5.0) return;
@@ -206,11 +220,38 @@ void addServeCommand(CLI::App& app) {
   });
 }
 
+void writeSubscribeJson(const std::string& path, const service::ProbeClient& client, const service::ClientStats& st,
+                        const service::VolumeSnapshot& snap) {
+  nlohmann::json j;
+  j["frames_applied"] = st.framesApplied;
+  j["frames_rejected"] = st.framesRejected;
+  j["bytes"] = st.bytesReceived;
+  j["keyframes"] = st.keyframesReceived;
+  j["deltas"] = st.deltasReceived;
+  j["connects"] = st.connects;
+  j["bricks"] = brickCount(snap.layout);
+  j["checksum"] = fmt::format("{:08x}", volumeChecksum(snap.volume));
+  j["server"] = {{"bytes_sent", st.serverBytesSent},           {"frames_acked", st.serverFramesAcked},
+                 {"ack_rtt_us", st.serverAckRttUs},            {"bricks_behind", st.serverBricksBehind},
+                 {"link_rate", st.serverLinkRate},             {"link_min_rtt_us", st.serverLinkMinRttUs},
+                 {"link_window", st.serverLinkWindow},         {"link_in_flight", st.serverLinkInFlight},
+                 {"link_waits", st.serverLinkWaits}};
+  nlohmann::json frames = nlohmann::json::array();
+  for (const service::AppliedFrame& f : client.appliedFrames())
+    frames.push_back({f.appliedUs, f.latencyUs, f.bytes, f.keyframes, f.deltas, f.bricksHeld});
+  j["frame_fields"] = {"applied_us", "latency_us", "bytes", "keyframes", "deltas", "bricks_held"};
+  j["frames"] = std::move(frames);
+  std::ofstream out(path);
+  out << j.dump() << "\n";
+  if (!out) throw std::runtime_error("cannot write " + path);
+  fmt::print("wrote {}\n", path);
+}
+
 void addSubscribeCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("subscribe", "subscribe to a probe stream; report and save the volume");
   struct SubOptions {
     ConnectOptions connection;
-    std::string out, repr;
+    std::string out, repr, json;
     uint64_t budget = 0;
     double seconds = 5.0;
   };
@@ -219,6 +260,9 @@ void addSubscribeCommand(CLI::App& app) {
   sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
   sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
   sub->add_option("--out", so->out, "write the received volume here (probe volume file)");
+  sub->add_option("--json", so->json,
+                  "write what was received here as JSON: totals, the server's link estimate, and every frame applied "
+                  "(when, its latency from the publish of its lighting, bytes, keyframes, bricks held)");
   addRepresentationOption(sub, so->repr, "representation wanted (default: the server's; a coarser one is transcoded)");
   sub->callback([so] {
     service::ClientConfig cc = so->connection.client("probecast-subscribe");
@@ -236,9 +280,17 @@ void addSubscribeCommand(CLI::App& app) {
     fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects{}\n", st.framesApplied,
                st.framesRejected, st.bytesReceived, st.connects, st.lastError.empty() ? "" : ", last error: " + st.lastError);
     if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
-    if (st.statsReceived > 0)
+    if (st.statsReceived > 0) {
       fmt::print("subscribe: the server counted {} bytes sent, {} frames acked, frame → ack {:.1f} ms, {} bricks behind\n",
                  st.serverBytesSent, st.serverFramesAcked, st.serverAckRttUs / 1e3, st.serverBricksBehind);
+      if (st.serverLinkWindow > 0)
+        fmt::print("subscribe: the server paces to the link: {:.1f} kB/s, round trip {:.1f} ms, window {} bytes, "
+                   "{} in flight, {} waits\n",
+                   st.serverLinkRate / 1e3, st.serverLinkMinRttUs / 1e3, st.serverLinkWindow, st.serverLinkInFlight,
+                   st.serverLinkWaits);
+      else
+        fmt::print("subscribe: the server does not pace this stream to its link\n");
+    }
     service::VolumeSnapshot snap;
     if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connection.connect);
     service::ScenePackage named;
@@ -249,6 +301,7 @@ void addSubscribeCommand(CLI::App& app) {
                    : std::string("no scene named"),
                snap.volume.scene.time, static_cast<double>(snap.clockOffsetUs) / 1e3);
     fmt::print("subscribe: volume checksum {:08x} ({} probes)\n", volumeChecksum(snap.volume), snap.volume.grid.count());
+    if (!so->json.empty()) writeSubscribeJson(so->json, client, st, snap);
     if (!so->out.empty()) {
       std::string error;
       orThrow(writeProbeFile(so->out, snap.volume, error), error);

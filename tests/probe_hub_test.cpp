@@ -5,6 +5,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <thread>
 
 #include "probecast/service/probe_hub.h"
 #include "test_probes.h"
@@ -207,6 +208,78 @@ TEST(ProbeHub, AcksCountAppliedFramesAndRefuseFramesNeverSent) {
   EXPECT_FALSE(hub.acknowledge(id, 1, why));  // backwards
   EXPECT_FALSE(hub.acknowledge(id, 3, why));  // never sent
   EXPECT_EQ(hub.stats(id).framesAcked, 2u);
+}
+
+HubConfig largeConfig() {
+  // 64 × 16 × 16 probes of L2 in bricks of 4: 256 bricks, noisy ones of about 0.5 kB each.
+  HubConfig c = rowConfig();
+  c.layout.grid[0] = 64;
+  c.layout.grid[1] = 16;
+  c.layout.grid[2] = 16;
+  c.bounds.max[0] = 63;
+  c.bounds.max[1] = 15;
+  c.bounds.max[2] = 15;
+  return c;
+}
+
+TEST(ProbeHub, APacedSubscriberWaitsForItsWindowAndAnAckWakesIt) {
+  ProbeHub hub(largeConfig());
+  std::mt19937 rng(5);
+  const int probes = 64 * 16 * 16;
+  hub.publish(test::movingLightFrame(probes, 0, 0.3f, rng).data(), nullptr);  // noisy: bricks of ~1.5 kB
+  int wakes = 0;
+  const uint64_t id = hub.addSubscriber(0, 0, {}, [&] { ++wakes; }, std::nullopt, /*paced=*/true);
+  const uint64_t unpaced = hub.addSubscriber(0, 0, {}, nullptr);
+  StreamDecoder dec(hub.layout());
+  // Before anything is measured, the initial window, in frames of at most a quarter of it: part of
+  // the volume, best bricks first, each frame asking for its ack.
+  std::vector<OutgoingFrame> sent;
+  uint64_t bytes = 0;
+  while (auto f = hub.nextFrame(id)) {
+    EXPECT_LE(f->payloadBytes, LinkEstimator::kInitialWindow / 4 + 2048);
+    EXPECT_TRUE(f->ackNow);
+    bytes += f->payloadBytes;
+    bricksIn(*f, dec);
+    sent.push_back(*f);
+    ASSERT_LE(sent.size(), 8u);
+  }
+  EXPECT_GE(sent.size(), 3u);
+  EXPECT_LE(bytes, LinkEstimator::kInitialWindow + 2048);
+  EXPECT_GT(bytes, LinkEstimator::kInitialWindow / 2);
+  EXPECT_TRUE(hub.stats(id).paced);
+  EXPECT_EQ(hub.stats(id).link.windowWaits, 1u);  // the window is full
+  EXPECT_GT(hub.stats(id).bricksBehind, 0u);
+  const OutgoingFrame* first = &sent.back();
+  // An unpaced subscriber of the same hub takes the whole volume at once.
+  const auto all = hub.nextFrame(unpaced);
+  ASSERT_TRUE(all.has_value());
+  EXPECT_GT(all->payloadBytes, LinkEstimator::kInitialWindow + 16384);
+  EXPECT_FALSE(all->ackNow);
+  EXPECT_FALSE(hub.stats(unpaced).paced);
+  // New lighting while it waits replaces what it lacks; its wake-up finds the window still full
+  // (as a transport's would), and the ack wakes it again.
+  hub.publish(test::movingLightFrame(probes, 20, 0.3f, rng).data(), nullptr);
+  EXPECT_FALSE(hub.nextFrame(id).has_value());
+  EXPECT_EQ(hub.stats(id).link.windowWaits, 2u);
+  const int before = wakes;
+  std::string why;
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(hub.acknowledge(id, first->sequence, why)) << why;
+  EXPECT_EQ(wakes, before + 1);
+  const LinkStats link = hub.stats(id).link;
+  EXPECT_GT(link.rateBytesPerSecond, 0.0);
+  EXPECT_GE(link.minRttUs, 20000u);
+  EXPECT_EQ(link.inFlightBytes, 0u);
+  // Taken one window at a time, acking each, it ends with the newest volume, bit for bit.
+  for (int i = 0; i < 100; ++i) {
+    const auto f = hub.nextFrame(id);
+    if (!f) break;
+    bricksIn(*f, dec);
+    ASSERT_TRUE(hub.acknowledge(id, f->sequence, why)) << why;
+  }
+  EXPECT_EQ(hub.stats(id).bricksBehind, 0u);
+  const std::vector<float> want = hub.reconstruction().probes;
+  EXPECT_EQ(0, std::memcmp(want.data(), dec.probes(), want.size() * sizeof(float)));
 }
 
 TEST(ProbeHub, StaleVersionsAreSkippedNotQueued) {

@@ -84,6 +84,7 @@ TEST(Service, AcksGoAtMostOncePerIntervalAndEveryFrameWithout) {
   Producer producer(hub, 1000000, 5ms);
   ClientConfig rare = clientFor(server.port()), every = clientFor(server.port());
   rare.ackIntervalMs = 3600 * 1000;
+  rare.linkPacing = false;  // a paced stream asks for acks when its window fills (below)
   every.ackIntervalMs = 0;
   ProbeClient rareClient(rare), everyClient(every);
   rareClient.start();
@@ -94,6 +95,27 @@ TEST(Service, AcksGoAtMostOncePerIntervalAndEveryFrameWithout) {
   EXPECT_EQ(rareClient.stats().serverFramesAcked, 1u);
   EXPECT_TRUE(waitFor([&] { return everyClient.stats().serverFramesAcked > 16; }, 5s))
       << everyClient.stats().serverFramesAcked;
+  // The unpaced stream reports no link; the paced one its estimate of loopback.
+  EXPECT_EQ(rareClient.stats().serverLinkWindow, 0u);
+  EXPECT_GE(everyClient.stats().serverLinkWindow, LinkEstimator::kMinWindow);
+  EXPECT_GT(everyClient.stats().serverLinkRate, 0u);
+}
+
+TEST(Service, APacedClientWithRareAcksAcksWhatTheServerAsksFor) {
+  // A client that acks once an hour still acks every frame the server asks for: its window keeps
+  // opening and the stream never stalls.
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 1000000, 5ms);
+  ClientConfig cc = clientFor(server.port());
+  cc.ackIntervalMs = 3600 * 1000;
+  ProbeClient client(cc);
+  client.start();
+  ASSERT_TRUE(waitFor([&] { return client.stats().statsReceived >= 3; }, 10s));
+  const uint32_t applied = client.stats().framesApplied;
+  EXPECT_TRUE(waitFor([&] { return client.stats().framesApplied > applied + 32; }, 5s));
+  EXPECT_GT(client.stats().serverFramesAcked, 1u);
+  EXPECT_GT(client.stats().serverLinkWindow, 0u);
 }
 
 TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {

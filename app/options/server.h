@@ -20,6 +20,7 @@ namespace probecast::app {
 struct ServerOptions {
   std::string listen = "127.0.0.1:50051", tlsCert, tlsKey, token, tokenFile;
   bool plaintext = false, noAuth = false;
+  std::string linkPacing = "on";
   void add(CLI::App* cmd) {
     cmd->add_option("--listen", listen, "address to listen on (host:port)");
     cmd->add_option("--tls-cert", tlsCert, "PEM certificate file")->check(CLI::ExistingFile);
@@ -32,6 +33,10 @@ struct ServerOptions {
         cmd->add_flag("--no-auth", noAuth, "serve without a token: anyone who reaches the port may subscribe");
     t->excludes(f);
     n->excludes(t)->excludes(f);
+    cmd->add_option("--link-pacing", linkPacing,
+                    "on: keep each subscriber that acks on request (every probecast client) within what its link "
+                    "delivers, measured from its acks; off: send as fast as the transport takes frames")
+        ->check(CLI::IsMember({"on", "off"}));
   }
   // The checked configuration: TLS or --plaintext, a non-empty token or --no-auth.
   service::ServerConfig config() const {
@@ -40,6 +45,7 @@ struct ServerOptions {
     sc.token = tokenFrom(token, tokenFile);
     sc.noAuth = noAuth;
     sc.plaintext = plaintext;
+    sc.linkPacing = linkPacing == "on";
     if (!tlsCert.empty() || !tlsKey.empty()) {
       if (tlsCert.empty() || tlsKey.empty()) throw std::runtime_error("--tls-cert and --tls-key go together");
       sc.tlsCertPem = readTextFile(tlsCert);

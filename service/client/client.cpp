@@ -78,8 +78,8 @@ struct ProbeClient::Impl {
   size_t offsetNext = 0;
   uint64_t epoch = 0;
   uint64_t newestServerTimeUs = 0;
-  std::vector<uint32_t> latencies;  // ring of the most recent 4096
-  size_t latencyNext = 0;
+  std::vector<AppliedFrame> applied;  // ring of the most recent 4096
+  size_t appliedNext = 0;
   std::vector<View> views;
   ClientStats stats;
   grpc::ClientContext* context = nullptr;
@@ -169,8 +169,11 @@ struct ProbeClient::Impl {
       else offsets64[offsetNext++ % 64] = sample;
     }
     const uint32_t latency = static_cast<uint32_t>(std::min<uint64_t>(now - std::min(now, f.server_time_us()), UINT32_MAX));
-    if (latencies.size() < 4096) latencies.push_back(latency);
-    else latencies[latencyNext++ % 4096] = latency;
+    uint32_t held = 0;
+    for (uint32_t b = 0; b < brickCount(layout); ++b) held += decoder->brickVersion(b) != 0 ? 1 : 0;
+    const AppliedFrame record{now, latency, static_cast<uint32_t>(f.payload().size()), f.keyframes(), f.deltas(), held};
+    if (applied.size() < 4096) applied.push_back(record);
+    else applied[appliedNext++ % 4096] = record;
     newestServerTimeUs = std::max(newestServerTimeUs, f.server_time_us());
     return true;
   }
@@ -181,6 +184,7 @@ struct ProbeClient::Impl {
     h->set_protocol_version(kProtocolVersion);
     h->set_budget_bytes_per_second(config.budgetBytesPerSecond);
     h->set_client_name(config.name);
+    h->set_acks_on_request(config.linkPacing);
     if (config.representation) h->set_representation(static_cast<pb::Representation>(*config.representation));
     std::lock_guard<std::mutex> lock(mutex);
     if (decoder) {
@@ -242,6 +246,11 @@ struct ProbeClient::Impl {
           stats.serverBricksBehind = msg.stats().bricks_behind();
           stats.serverFramesAcked = msg.stats().frames_acked();
           stats.serverAckRttUs = msg.stats().ack_rtt_us();
+          stats.serverLinkRate = msg.stats().link_rate();
+          stats.serverLinkMinRttUs = msg.stats().link_min_rtt_us();
+          stats.serverLinkWindow = msg.stats().link_window();
+          stats.serverLinkInFlight = msg.stats().link_in_flight();
+          stats.serverLinkWaits = msg.stats().link_waits();
         } else if (msg.has_frame()) {
           if (!onFrame(msg.frame())) {
             dropped = true;
@@ -249,7 +258,10 @@ struct ProbeClient::Impl {
             break;
           }
           const auto now = std::chrono::steady_clock::now();
-          if (!acked || now - lastAck >= std::chrono::milliseconds(config.ackIntervalMs)) {
+          // An ack the server asks for goes at once: a paced server sends nothing more until it
+          // comes (the link's window is full).
+          if (!acked || (config.linkPacing && msg.frame().ack_now()) ||
+              now - lastAck >= std::chrono::milliseconds(config.ackIntervalMs)) {
             pb::ClientMessage ack;
             ack.mutable_ack()->set_frame_sequence(msg.frame().sequence());
             write(ack);
@@ -352,7 +364,21 @@ ClientStats ProbeClient::stats() const {
 
 std::vector<uint32_t> ProbeClient::latenciesUs() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  return impl_->latencies;
+  std::vector<uint32_t> l;
+  l.reserve(impl_->applied.size());
+  for (const AppliedFrame& f : impl_->applied) l.push_back(f.latencyUs);
+  return l;
+}
+
+std::vector<AppliedFrame> ProbeClient::appliedFrames() const {
+  std::vector<AppliedFrame> frames;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    frames = impl_->applied;
+  }
+  std::stable_sort(frames.begin(), frames.end(),
+                   [](const AppliedFrame& a, const AppliedFrame& b) { return a.appliedUs < b.appliedUs; });
+  return frames;
 }
 
 void ProbeClient::dropConnection() {

@@ -394,7 +394,7 @@ uint32_t ProbeHub::serverFrame() const {
 }
 
 uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
-                                 std::function<void()> wake, std::optional<Representation> repr) {
+                                 std::function<void()> wake, std::optional<Representation> repr, bool paced) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!source_) throw std::logic_error("addSubscriber before the hub has a volume (check ready())");
   const uint32_t bricks = brickCount(config_.layout);
@@ -415,6 +415,8 @@ uint64_t ProbeHub::addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, 
     producer = true;
   }
   s.budget = budgetBytesPerSecond;
+  s.paced = paced;
+  s.stats.paced = paced;
   s.tokens = static_cast<double>(budgetBytesPerSecond) * config_.burstSeconds;
   s.refilled = Clock::now();
   s.held.assign(bricks, 0);
@@ -497,6 +499,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id, const FrameStorage
   const uint32_t bricks = brickCount(config_.layout);
   candidates_.assign(bricks, BrickCandidate{});
   uint32_t behind = 0;
+  uint64_t staleBytes = 0;
   for (uint32_t b = 0; b < bricks; ++b) {
     const uint32_t current = source.version(b);
     if (s.held[b] >= current) continue;  // current, or ahead of a lagging edge
@@ -505,6 +508,7 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id, const FrameStorage
     c.change = std::max(source.changeSince(b, s.held[b]), 1e-3f);
     c.ageFrames = frame_ - std::min(frame_, s.staleSince[b]);
     c.bytes = static_cast<uint32_t>(source.sectionFor(b, s.held[b]).size());
+    staleBytes += c.bytes;
   }
   s.stats.bricksBehind = behind;
   if (behind == 0) {
@@ -513,23 +517,26 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id, const FrameStorage
   }
   refill(s, Clock::now());
   chosen_.resize(bricks);
-  if (s.budget == 0 && everyStaleBrickScores()) {
-    // Unlimited: every brick it lacks goes in this frame, and their order within it does not
+  // What may go now: the budget's bucket (saturating: a bucket of 2^64 bytes or more cannot bind,
+  // and converting it would overflow) and a paced subscriber's link window.
+  const uint64_t bucket = s.budget == 0 || s.tokens >= 0x1p64 ? UINT64_MAX
+                                                                : static_cast<uint64_t>(std::max(0.0, s.tokens));
+  const uint64_t link = s.paced ? s.link.allowance(Clock::now()) : UINT64_MAX;
+  if (s.budget == 0 && link >= staleBytes && everyStaleBrickScores()) {
+    // Nothing binds: every brick it lacks goes in this frame, and their order within it does not
     // matter, so the scoring (frustum tests per view and brick, a sort) is skipped.
     size_t n = 0;
     for (uint32_t b = 0; b < bricks; ++b)
       if (s.held[b] < source.version(b)) chosen_[n++] = b;
-    return buildFrame(s, n, behind, to);
+    return buildFrame(s, n, behind, false, to);
   }
   scores_.resize(bricks);
   scoreBricks(config_.layout, config_.bounds, s.views, candidates_, config_.priority, scores_.data());
   const double cap = static_cast<double>(s.budget) * config_.burstSeconds;
-  // A full bucket may always send the best brick, so one larger than the bucket still goes out.
-  // Saturating: a bucket of 2^64 bytes or more cannot bind, and converting it would overflow.
-  const uint64_t allowance = s.budget == 0 || s.tokens >= 0x1p64 ? UINT64_MAX
-                                                                   : static_cast<uint64_t>(std::max(0.0, s.tokens));
-  size_t n = selectBricks(scores_, candidates_, allowance, chosen_.data());
-  if (n == 0 && s.budget != 0 && s.tokens >= cap) {
+  size_t n = selectBricks(scores_, candidates_, std::min(bucket, link), chosen_.data());
+  // A full bucket and an empty link may always send the best brick, so one larger than the bucket
+  // or the window still goes out.
+  if (n == 0 && (s.budget == 0 || s.tokens >= cap) && (!s.paced || s.link.inFlight() == 0)) {
     uint32_t best = 0;
     for (uint32_t b = 1; b < bricks; ++b)
       if (scores_[b] > scores_[best]) best = b;
@@ -539,10 +546,11 @@ std::optional<OutgoingFrame> ProbeHub::nextFrame(uint64_t id, const FrameStorage
     }
   }
   if (n == 0) {
-    s.waiting = true;  // the producer's tick refills and wakes it
+    if (link < bucket) s.link.waited();
+    s.waiting = true;  // the producer's tick refills the bucket, an ack opens the window; both wake it
     return std::nullopt;
   }
-  return buildFrame(s, n, behind, to);
+  return buildFrame(s, n, behind, link < bucket && n < behind, to);
 }
 
 bool ProbeHub::everyStaleBrickScores() const {
@@ -551,7 +559,8 @@ bool ProbeHub::everyStaleBrickScores() const {
   return config_.priority.outOfViewWeight > 0.0f && config_.priority.ageWeight >= 0.0f;
 }
 
-OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, const FrameStorage* storage) {
+OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, bool linkLimited,
+                                   const FrameStorage* storage) {
   OutgoingFrame frame;
   std::vector<std::span<const uint8_t>> sections;
   sections.reserve(n);
@@ -568,12 +577,17 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, con
   frame.state = state_;
   frame.sentUs = nowUs();
   frame.payloadBytes = frameSize(sections);
+  const Clock::time_point now = Clock::now();
+  if (s.paced) {
+    s.link.sent(frame.sequence, frame.payloadBytes, !linkLimited, now);
+    frame.ackNow = s.link.wantsAck();
+  }
   if (storage)
     writeFrame(s.layout, frame.sequence, sections, (*storage)(frame, frame.payloadBytes));
   else
     writeFrame(s.layout, frame.sequence, sections, frame.payload);
   if (s.budget != 0) s.tokens -= static_cast<double>(frame.payloadBytes);
-  s.unacked.emplace_back(frame.sequence, Clock::now());
+  s.unacked.emplace_back(frame.sequence, now);
   if (s.unacked.size() > 1024) s.unacked.pop_front();  // a client that never acks keeps a bounded record
   s.stats.bytesSent += frame.payloadBytes;
   s.stats.framesSent += 1;
@@ -582,24 +596,35 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, con
 }
 
 bool ProbeHub::acknowledge(uint64_t id, uint32_t sequence, std::string& why) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto it = subscribers_.find(id);
-  if (it == subscribers_.end()) return why = "unknown subscriber", false;
-  Subscriber& s = it->second;
-  if (sequence > s.sequence)
-    return why = "ack of frame " + std::to_string(sequence) + " but only " + std::to_string(s.sequence) +
-                 " were sent", false;
-  if (sequence < s.stats.framesAcked)
-    return why = "ack of frame " + std::to_string(sequence) + " after frame " + std::to_string(s.stats.framesAcked),
-           false;
-  s.stats.framesAcked = sequence;
-  while (!s.unacked.empty() && s.unacked.front().first <= sequence) {
-    if (s.unacked.front().first == sequence)
-      s.stats.ackRttUs = static_cast<uint32_t>(std::min<int64_t>(
-          UINT32_MAX,
-          std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - s.unacked.front().second).count()));
-    s.unacked.pop_front();
+  std::function<void()> wake;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = subscribers_.find(id);
+    if (it == subscribers_.end()) return why = "unknown subscriber", false;
+    Subscriber& s = it->second;
+    if (sequence > s.sequence)
+      return why = "ack of frame " + std::to_string(sequence) + " but only " + std::to_string(s.sequence) +
+                   " were sent", false;
+    if (sequence < s.stats.framesAcked)
+      return why = "ack of frame " + std::to_string(sequence) + " after frame " +
+                   std::to_string(s.stats.framesAcked), false;
+    const Clock::time_point now = Clock::now();
+    s.stats.framesAcked = sequence;
+    while (!s.unacked.empty() && s.unacked.front().first <= sequence) {
+      if (s.unacked.front().first == sequence)
+        s.stats.ackRttUs = static_cast<uint32_t>(std::min<int64_t>(
+            UINT32_MAX, std::chrono::duration_cast<std::chrono::microseconds>(now - s.unacked.front().second).count()));
+      s.unacked.pop_front();
+    }
+    if (s.paced) {
+      s.link.acked(sequence, now);
+      if (s.waiting && s.link.allowance(now) > 0 && s.wake) {  // the window opened
+        s.waiting = false;
+        wake = s.wake;
+      }
+    }
   }
+  if (wake) wake();
   return true;
 }
 
@@ -612,7 +637,10 @@ bool ProbeHub::streamEnded(uint64_t id) const {
 SubscriberStats ProbeHub::stats(uint64_t id) const {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = subscribers_.find(id);
-  return it == subscribers_.end() ? SubscriberStats{} : it->second.stats;
+  if (it == subscribers_.end()) return SubscriberStats{};
+  SubscriberStats st = it->second.stats;
+  if (it->second.paced) st.link = it->second.link.stats();
+  return st;
 }
 
 ProbeVolume ProbeHub::reconstruction(Representation repr) {

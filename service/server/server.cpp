@@ -227,6 +227,11 @@ class SubscribeReactor : public RawReactor {
       s->set_server_frame(hub_.serverFrame());
       s->set_frames_acked(st.framesAcked);
       s->set_ack_rtt_us(st.ackRttUs);
+      s->set_link_rate(static_cast<uint64_t>(st.link.rateBytesPerSecond));
+      s->set_link_min_rtt_us(st.link.minRttUs);
+      s->set_link_window(st.paced ? st.link.windowBytes : 0);
+      s->set_link_in_flight(st.link.inFlightBytes);
+      s->set_link_waits(st.link.windowWaits);
       startWriteLocked();
       return;
     }
@@ -241,7 +246,8 @@ class SubscribeReactor : public RawReactor {
         stateBytes_ = w.SerializeAsString();
         stateSerialised_ = true;
       }
-      const FrameFields fields{f.sequence, f.serverTimeUs, payloadBytes, f.keyframes, f.deltas, &stateBytes_, f.sentUs};
+      const FrameFields fields{f.sequence,   f.serverTimeUs, payloadBytes, f.keyframes,
+                               f.deltas,     &stateBytes_,   f.sentUs,     f.ackNow};
       slice = grpc_slice_malloc(framePrefixBytes(fields) + payloadBytes + frameSuffixBytes(fields));
       uint8_t* payload = writeFramePrefix(fields, GRPC_SLICE_START_PTR(slice));
       writeFrameSuffix(fields, payload + payloadBytes);
@@ -349,7 +355,7 @@ class SubscribeReactor : public RawReactor {
             if (link->reactor) link->reactor->tryWriteLocked();
           }
         },
-        repr);
+        repr, config_.linkPacing && h.acks_on_request());
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
     out_.Clear();

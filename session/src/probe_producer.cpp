@@ -87,7 +87,9 @@ void ProbeProducer::freeze(float at) {
 }
 
 void ProbeProducer::step() {
-  if (updater_) {
+  if (held_) {
+    hub_.tick();
+  } else if (updater_) {
     const bool wasFrozen = frozen_;
     const uint64_t clockUs = service::wallClockUs();
     if (!wasFrozen && animation_.mode == Animation::Mode::PerStep) sceneTime_ = sceneTime_ + animation_.perStep;

@@ -111,6 +111,9 @@ class ProbeProducer {
   void freeze(float at);
   // Generated frames: false holds the lighting (steps only tick), true moves on.
   void setMoving(bool moving) { moving_ = moving; }
+  // Any producer: true publishes nothing more (steps only tick the hub, tracing stops), so every
+  // subscriber settles on the last lighting published; false goes on.
+  void hold(bool held) { held_ = held; }
   // The scene time now (wall-clock animation: at this moment; otherwise of the last update), and
   // the built-in scenes' animation parameter t of it.
   double sceneTime() const;
@@ -131,6 +134,7 @@ class ProbeProducer {
   // Source.
   std::unique_ptr<renderer::ProbeUpdater> updater_;
   std::string sceneSpec_;
+  std::atomic<bool> held_{false};
   bool rayBudget_ = false;  // the updater spends a ray budget: it is told the subscribers' views
   bool noiseRule_ = false;  // the hub's encoder holds noise (EncoderOptions::noiseScale): and so is it
   // told how much each probe changes the subscribers' views (probeViewSensitivity): the surfaces

@@ -47,6 +47,12 @@ struct ClientConfig {
   // it must read: a thousand viewers acking every frame at 30 Hz would double its messages. While
   // no frames come, the server's frames_acked may trail the last frame applied.
   int ackIntervalMs = 100;
+  // Link-aware pacing: the client acks at once every frame the server asks it to ack (Frame.ack_now),
+  // and a server that paces (ServerConfig::linkPacing) keeps the stream within what the link
+  // delivers, measured from those acks; the frames it sends are then the newest, best-first
+  // bricks instead of a queue in the network's buffers. Off: the server sends as fast as its
+  // transport takes frames (and the client acks every ackIntervalMs only).
+  bool linkPacing = true;
 };
 
 struct VolumeSnapshot {
@@ -123,6 +129,22 @@ struct ClientStats {
   uint32_t serverBricksBehind = 0;
   uint32_t serverFramesAcked = 0; // our acks as the server counted them
   uint32_t serverAckRttUs = 0;    // frame → ack round trip as the server measured it
+  // The link as the server estimates it (linkPacing, where the server paces; 0 otherwise).
+  uint64_t serverLinkRate = 0;       // delivery rate, bytes per second
+  uint32_t serverLinkMinRttUs = 0;   // frame → ack round trip, windowed minimum
+  uint64_t serverLinkWindow = 0;     // unacknowledged bytes it allows on the way
+  uint64_t serverLinkInFlight = 0;   // unacknowledged bytes on the way
+  uint32_t serverLinkWaits = 0;      // frames that waited for the window
+};
+
+// One frame the client applied (ProbeClient::appliedFrames).
+struct AppliedFrame {
+  uint64_t appliedUs = 0;  // wall clock when it was applied, µs since 1970
+  uint32_t latencyUs = 0;  // from the publish of its newest lighting (server clock) to then
+  uint32_t bytes = 0;      // payload
+  uint32_t keyframes = 0;  // brick sections that were keyframes
+  uint32_t deltas = 0;
+  uint32_t bricksHeld = 0; // bricks of the volume held after it (all of them: a usable volume)
 };
 
 class ProbeClient {
@@ -144,6 +166,8 @@ class ProbeClient {
   // Produce→decoded latencies of the frames applied so far (microseconds, server and client
   // clocks: meaningful on one machine or with synchronised clocks), the most recent 4096.
   std::vector<uint32_t> latenciesUs() const;
+  // The most recent 4096 frames applied, oldest first.
+  std::vector<AppliedFrame> appliedFrames() const;
 
  private:
   struct Impl;

@@ -23,6 +23,7 @@
 #include "probecast/codec/priority.h"
 #include "probecast/codec/stream.h"
 #include "probecast/service/bus_format.h"
+#include "probecast/service/link_estimate.h"
 
 namespace probecast::service {
 
@@ -89,6 +90,7 @@ struct OutgoingFrame {
   uint32_t deltas = 0;
   bus::SceneState state;  // the scene state of the newest lighting in it
   uint64_t sentUs = 0;    // wall clock when it was made, µs since 1970
+  bool ackNow = false;    // a paced subscriber's: the hub waits for this frame's ack to send more
 };
 
 // Where nextFrame writes a frame's payload instead of OutgoingFrame::payload: called under the
@@ -102,6 +104,8 @@ struct SubscriberStats {
   uint32_t framesSent = 0;
   uint32_t framesAcked = 0;  // the highest frame sequence the subscriber says it applied
   uint32_t ackRttUs = 0;     // frame handed to the network → its ack back, latest, microseconds
+  bool paced = false;        // kept within its link (addSubscriber's `paced`)
+  LinkStats link;            // the link as its acks show it (paced subscribers only)
 };
 
 class ProbeHub {
@@ -178,8 +182,13 @@ class ProbeHub {
   // (canTranscode, std::invalid_argument otherwise) is encoded by this hub from the volume it holds,
   // once for every subscriber that wants it, as a stream of its own epoch (volumeFor). It stays
   // for the epoch (at most one per representation), so a subscriber that reconnects resumes.
+  // `paced`: the subscriber acks the frames that ask for it (OutgoingFrame::ackNow) as soon as it
+  // applies them, and the hub keeps its unacknowledged bytes within what its link delivers
+  // (LinkEstimator): what the link cannot take yet waits here, where newer versions replace it and
+  // priorities order it, instead of in the transport's buffers.
   uint64_t addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,
-                         std::function<void()> wake, std::optional<Representation> repr = std::nullopt);
+                         std::function<void()> wake, std::optional<Representation> repr = std::nullopt,
+                         bool paced = false);
   // What a subscriber is told: volume(), with the representation and epoch of its stream.
   bus::Volume volumeFor(uint64_t id) const;
   void removeSubscriber(uint64_t id);
@@ -198,7 +207,8 @@ class ProbeHub {
   bool streamEnded(uint64_t id) const;
   SubscriberStats stats(uint64_t id) const;
   // The subscriber applied frames up to `sequence`. False (with the reason) for an ack of a frame
-  // never sent or one that goes backwards: the client is broken and its stream should end.
+  // never sent or one that goes backwards: the client is broken and its stream should end. A paced
+  // subscriber waiting for its window is woken (outside the hub's lock) when the ack opens it.
   bool acknowledge(uint64_t id, uint32_t sequence, std::string& why);
 
   // The volume every subscriber converges to (the encoder's reconstruction, or on an edge the
@@ -223,6 +233,8 @@ class ProbeHub {
     bool ended = false;
     uint32_t sequence = 0;
     std::deque<std::pair<uint32_t, Clock::time_point>> unacked;  // sequence, when handed out
+    bool paced = false;
+    LinkEstimator link;
     SubscriberStats stats;
   };
 
@@ -231,7 +243,8 @@ class ProbeHub {
   bool everyStaleBrickScores() const;
   // The frame of the first `n` bricks of chosen_ for `s` (who lacked `behind`), its state updated.
   // The payload goes to `storage` when there is one.
-  OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind, const FrameStorage* storage);
+  // linkLimited: bricks were left for the link's window (the frame is not application-limited).
+  OutgoingFrame buildFrame(Subscriber& s, size_t n, uint32_t behind, bool linkLimited, const FrameStorage* storage);
   std::vector<std::function<void()>> collectWakes();
   void markStale(uint32_t brick);
   ProbeVolume reconstructionLocked(const BrickSource& source) const;

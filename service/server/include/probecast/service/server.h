@@ -34,6 +34,10 @@ struct ServerConfig {
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
   static constexpr int kTickMs = 50;
+  // Link-aware pacing: a subscriber that acks on request (Hello.acks_on_request, as ProbeClient
+  // does) is kept within what its link delivers, measured from its acks (ProbeHub::addSubscriber).
+  // Off: every subscriber is sent frames as fast as the transport takes them.
+  bool linkPacing = true;
   // The scene package GetScene delivers (its files read from their sources on this machine); none:
   // GetScene answers NOT_FOUND. It should be the one the hub's descriptions name.
   std::shared_ptr<const ScenePackage> scene;
