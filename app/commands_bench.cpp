@@ -404,7 +404,7 @@ void addBenchStream(CLI::App* bench) {
   CLI::App* stream = bench->add_subcommand(
       "stream", "the service under N subscribers on loopback: server and light load clients in processes of their own");
   struct StreamOptions {
-    std::string json, chart;
+    std::string json, chart, linkPacing = "on";
     GridOptions grid{{bench::kLightingGrid[0], bench::kLightingGrid[1], bench::kLightingGrid[2]}, {}};
     bench::StreamBenchOptions bench;
   };
@@ -423,6 +423,10 @@ void addBenchStream(CLI::App* bench) {
   stream->add_option("--ack-interval", so->bench.ackIntervalMs,
                      "load clients ack the newest frame at most every this many ms, as ProbeClient does (0: every frame)")
       ->check(CLI::Range(0, 60000));
+  stream->add_option("--link-pacing", so->linkPacing,
+                     "on: load clients ack what the server asks for and it paces each to its link (as ProbeClient); "
+                     "off: they do not, and it sends as fast as the transport takes frames")
+      ->check(CLI::IsMember({"on", "off"}));
   so->grid.add(stream, false, 2, 256);  // the benchmark volume, probes 1 m apart
   stream->add_option("--edges", so->bench.edges,
                      "0: subscribers connect to the producer; N: through a nats-server and N edges")
@@ -433,6 +437,7 @@ void addBenchStream(CLI::App* bench) {
   stream->callback([so] {
     so->bench.command = commandLine();
     so->bench.progress = progressLine;
+    so->bench.linkPacing = so->linkPacing == "on";
     for (int a = 0; a < 3; ++a) so->bench.grid[a] = static_cast<uint16_t>(so->grid.dims[a]);
     const bench::StreamBenchResult r = bench::runStreamBench(so->bench);
     writeBenchOutputs(r.table, r.json.dump(2) + "\n", so->json, r.svg, so->chart);

@@ -229,6 +229,7 @@ void writeSubscribeJson(const std::string& path, const service::ProbeClient& cli
   j["keyframes"] = st.keyframesReceived;
   j["deltas"] = st.deltasReceived;
   j["connects"] = st.connects;
+  j["silences"] = st.silences;
   j["bricks"] = brickCount(snap.layout);
   j["checksum"] = fmt::format("{:08x}", volumeChecksum(snap.volume));
   j["server"] = {{"bytes_sent", st.serverBytesSent},           {"frames_acked", st.serverFramesAcked},

@@ -58,8 +58,9 @@ struct Tally {
 
 class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerMessage> {
  public:
-  Subscriber(Tally& tally, uint32_t index, bool decodes, uint32_t ackIntervalMs)
-      : tally_(tally), index_(index), decodes_(decodes), ackIntervalUs_(uint64_t{ackIntervalMs} * 1000) {}
+  Subscriber(Tally& tally, uint32_t index, bool decodes, uint32_t ackIntervalMs, bool linkPacing)
+      : tally_(tally), index_(index), decodes_(decodes), ackIntervalUs_(uint64_t{ackIntervalMs} * 1000),
+        linkPacing_(linkPacing) {}
 
   void start(pb::ProbeStream::Stub& stub, const std::string& token, uint64_t budget, const std::optional<View>& view) {
     if (!token.empty()) ctx_.AddMetadata("authorization", "Bearer " + token);
@@ -67,6 +68,7 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
     h->set_protocol_version(service::kProtocolVersion);
     h->set_budget_bytes_per_second(budget);
     h->set_client_name("probecast-load-" + std::to_string(index_));
+    h->set_acks_every_frame(linkPacing_);
     if (view) service::viewsToWire({*view}, *views_.mutable_views());
     haveViews_ = view.has_value();
     stub.async()->Subscribe(&ctx_, this);
@@ -178,14 +180,14 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
   }
 
   // One write in flight: hello, then the view set, then the newest ack whenever one is due (the
-  // first at once, then at most one per ackIntervalMs).
+  // first at once, then at most one per ackIntervalMs; every one when paced).
   void pumpLocked() {
     if (writing_) return;
     if (haveViews_) {
       haveViews_ = false;
       writing_ = true;
       StartWrite(&views_);
-    } else if (ackPending_ != 0 && (lastAckUs_ == 0 || systemNowUs() - lastAckUs_ >= ackIntervalUs_)) {
+    } else if (ackPending_ != 0 && (lastAckUs_ == 0 || linkPacing_ || systemNowUs() - lastAckUs_ >= ackIntervalUs_)) {
       lastAckUs_ = systemNowUs();
       ack_.mutable_ack()->set_frame_sequence(ackPending_);
       ackPending_ = 0;
@@ -198,6 +200,7 @@ class Subscriber : public grpc::ClientBidiReactor<pb::ClientMessage, pb::ServerM
   const uint32_t index_;
   const bool decodes_;
   const uint64_t ackIntervalUs_;
+  const bool linkPacing_;
   std::atomic<bool> stopping_{false};
   grpc::ClientContext ctx_;
   pb::ClientMessage hello_, views_, ack_;
@@ -249,7 +252,8 @@ void LoadClient::start() {
   const size_t addresses = c.addresses.size();
   for (uint32_t i = 0; i < c.subscribers; ++i) {
     const uint32_t index = c.firstIndex + i;
-    s.subscribers.push_back(std::make_unique<Subscriber>(s.tally, index, index % c.sampleEvery == 0, c.ackIntervalMs));
+    s.subscribers.push_back(std::make_unique<Subscriber>(s.tally, index, index % c.sampleEvery == 0, c.ackIntervalMs,
+                                                        c.linkPacing));
     const size_t a = index % addresses, channel = (index / addresses) % c.channelsPerAddress;
     std::optional<View> view;
     if (c.view) view = c.view(index);

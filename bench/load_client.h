@@ -30,6 +30,7 @@ struct LoadClientConfig {
   uint64_t budgetBytesPerSecond = 0;  // per subscriber, 0 = unlimited
   std::function<View(uint32_t index)> view;  // the view of subscriber `index` (null: no view set)
   uint32_t ackIntervalMs = 100;    // acks of the newest frame at most this often, as ProbeClient's (0: every frame)
+  bool linkPacing = true;          // ack every frame, as ProbeClient (the server paces it)
 };
 
 struct LoadFigures {

@@ -427,6 +427,7 @@ std::vector<std::unique_ptr<testing::ChildProcess>> startLoads(const StreamBench
     lc.subscribers = static_cast<uint32_t>(static_cast<int64_t>(n) * (k + 1) / processes) - lc.firstIndex;
     lc.sampleEvery = static_cast<uint32_t>(o.sampleEvery);
     lc.ackIntervalMs = static_cast<uint32_t>(o.ackIntervalMs);
+    lc.linkPacing = o.linkPacing;
     lc.budgetBytesPerSecond = o.budgetBytesPerSecond;
     lc.view = [dims = o.grid](uint32_t i) { return randomView(i, dims); };
     loads.push_back(std::make_unique<testing::ChildProcess>(
@@ -574,6 +575,7 @@ nlohmann::json streamJson(const StreamBenchOptions& o, const std::vector<Subscri
           {"seconds", o.seconds},
           {"budget_bytes_per_s", o.budgetBytesPerSecond},
           {"ack_interval_ms", o.ackIntervalMs},
+          {"link_pacing", o.linkPacing},
           {"topology", o.edges > 0 ? fmt::format("nats: the producer publishes to a nats-server (JetStream); {} edge "
                                                  "processes serve the subscribers, split evenly; server figures sum "
                                                  "producer, edges and nats-server", o.edges)

@@ -29,6 +29,7 @@ struct StreamBenchOptions {
   int edges = 0;
   int sampleEvery = 50;  // 1 in this many subscribers decodes fully (subscriber 0 always does)
   int ackIntervalMs = 100;  // load clients ack the newest frame at most this often (0: every frame)
+  bool linkPacing = true;   // load clients ack on request and the server paces them to their link
   std::array<uint16_t, 3> grid = {kLightingGrid[0], kLightingGrid[1], kLightingGrid[2]};  // probes per axis, 1 m apart
   std::string command;
   std::function<void(const std::string&)> progress;

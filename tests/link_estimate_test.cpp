@@ -63,7 +63,6 @@ TEST(LinkEstimator, StartsWithTheInitialWindowAndNoEstimate) {
   LinkEstimator link;
   EXPECT_FALSE(link.measured());
   EXPECT_EQ(link.window(), LinkEstimator::kInitialWindow);
-  EXPECT_TRUE(link.wantsAck());
   link.sent(1, 1000, false, at(0));
   EXPECT_EQ(link.inFlight(), 1000u);
   // A frame carries at most a quarter of the window.
@@ -80,10 +79,10 @@ TEST(LinkEstimator, FindsTheRateAndRoundTripOfASlowLink) {
   EXPECT_LT(s.minRttUs, 250000u + 2 * 32000u + 2000u);  // one frame's serialisation and the simulation's step
   // The window holds the link busy: nearly all of its rate is used ...
   EXPECT_GT(r.deliveredBytesPerSecond, 125000.0 * 0.85);
-  // ... and what queues at the bottleneck is at most one window (two bandwidth-delay products, the
+  // ... and what queues at the bottleneck is at most one window (1.5 bandwidth-delay products, the
   // burst after a round-trip probe has drained the link), not the seconds an unbounded sender
   // queues (below).
-  EXPECT_LT(r.maxQueueSeconds, 2 * 0.282 + 0.01);
+  EXPECT_LT(r.maxQueueSeconds, LinkEstimator::kWindowGain * 0.282 + 0.01);
 }
 
 TEST(LinkEstimator, GrowsQuicklyOnAFastLink) {
@@ -131,7 +130,9 @@ TEST(LinkEstimator, ALinkThatSlowsDownIsFoundWithinTheRateWindow) {
   // estimate follows; the queue that built in the meantime drains.
   LinkEstimator link;
   const SimResult r = simulate(link, 625000.0, 0.05, 8000, 12.0, 125000.0, 4.0);
-  EXPECT_NEAR(link.stats().rateBytesPerSecond, 125000.0, 125000.0 * 0.15);
+  // (Within a quarter: the round trip's minimum is still the fast link's, and a window of 1.5 of
+  // its product leaves the slow link a little idle between frames.)
+  EXPECT_NEAR(link.stats().rateBytesPerSecond, 125000.0, 125000.0 * 0.25);
   EXPECT_LT(r.maxQueueSeconds, 2.0);
 }
 

@@ -84,7 +84,7 @@ TEST(Service, AcksGoAtMostOncePerIntervalAndEveryFrameWithout) {
   Producer producer(hub, 1000000, 5ms);
   ClientConfig rare = clientFor(server.port()), every = clientFor(server.port());
   rare.ackIntervalMs = 3600 * 1000;
-  rare.linkPacing = false;  // a paced stream asks for acks when its window fills (below)
+  rare.linkPacing = false;  // a paced client acks every frame (below)
   every.ackIntervalMs = 0;
   ProbeClient rareClient(rare), everyClient(every);
   rareClient.start();
@@ -101,8 +101,8 @@ TEST(Service, AcksGoAtMostOncePerIntervalAndEveryFrameWithout) {
   EXPECT_GT(everyClient.stats().serverLinkRate, 0u);
 }
 
-TEST(Service, APacedClientWithRareAcksAcksWhatTheServerAsksFor) {
-  // A client that acks once an hour still acks every frame the server asks for: its window keeps
+TEST(Service, APacedClientAcksEveryFrameWhateverItsInterval) {
+  // Paced, a client given an ack interval of an hour still acks every frame: the window keeps
   // opening and the stream never stalls.
   ProbeHub hub(volumeConfig());
   ProbeServer server(plaintextConfig(), hub);
@@ -114,7 +114,7 @@ TEST(Service, APacedClientWithRareAcksAcksWhatTheServerAsksFor) {
   ASSERT_TRUE(waitFor([&] { return client.stats().statsReceived >= 3; }, 10s));
   const uint32_t applied = client.stats().framesApplied;
   EXPECT_TRUE(waitFor([&] { return client.stats().framesApplied > applied + 32; }, 5s));
-  EXPECT_GT(client.stats().serverFramesAcked, 1u);
+  EXPECT_GT(client.stats().serverFramesAcked, applied);
   EXPECT_GT(client.stats().serverLinkWindow, 0u);
 }
 

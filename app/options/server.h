@@ -34,7 +34,7 @@ struct ServerOptions {
     t->excludes(f);
     n->excludes(t)->excludes(f);
     cmd->add_option("--link-pacing", linkPacing,
-                    "on: keep each subscriber that acks on request (every probecast client) within what its link "
+                    "on: keep each subscriber that acks every frame (every probecast client) within what its link "
                     "delivers, measured from its acks; off: send as fast as the transport takes frames")
         ->check(CLI::IsMember({"on", "off"}));
   }

@@ -26,6 +26,9 @@ std::shared_ptr<grpc::Channel> makeChannel(const ClientConfig& config, const std
   args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, config.keepaliveTimeoutMs);
   args.SetInt(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
   args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);  // a still volume sends nothing for long
+  // Every subscription gets a connection of its own: after a cut (ClientConfig::silenceMs) a new
+  // channel must not reuse the stalled connection from gRPC's shared pool.
+  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
   std::shared_ptr<grpc::ChannelCredentials> creds;
   if (config.tls) {
     grpc::SslCredentialsOptions options;
@@ -84,6 +87,27 @@ struct ProbeClient::Impl {
   ClientStats stats;
   grpc::ClientContext* context = nullptr;
   Stream* stream = nullptr;
+  // The silence watchdog (ClientConfig::silenceMs): when the call began, its last message, the
+  // server's heartbeat promise (kept across calls), and whether the watchdog cut the call.
+  std::thread watchdog;
+  std::chrono::steady_clock::time_point callStarted, lastMessage;
+  uint32_t heartbeatMs = 0;
+  bool silenced = false;
+
+  void watch() {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stopping) {
+      wakeup.wait_for(lock, std::chrono::milliseconds(100), [&] { return stopping.load(); });
+      if (stopping || !context || heartbeatMs == 0 || silenced) continue;
+      const auto now = std::chrono::steady_clock::now();
+      const bool heard = lastMessage > callStarted;
+      const int limit = heard ? config.silenceMs : config.reconnectSilenceMs;
+      if (limit <= 0 || now - (heard ? lastMessage : callStarted) < std::chrono::milliseconds(limit)) continue;
+      silenced = true;
+      stats.silences += 1;
+      context->TryCancel();
+    }
+  }
   std::mutex writeMutex;  // one writer at a time on the stream
 
   bool write(const pb::ClientMessage& m) {
@@ -184,7 +208,7 @@ struct ProbeClient::Impl {
     h->set_protocol_version(kProtocolVersion);
     h->set_budget_bytes_per_second(config.budgetBytesPerSecond);
     h->set_client_name(config.name);
-    h->set_acks_on_request(config.linkPacing);
+    h->set_acks_every_frame(config.linkPacing);
     if (config.representation) h->set_representation(static_cast<pb::Representation>(*config.representation));
     std::lock_guard<std::mutex> lock(mutex);
     if (decoder) {
@@ -213,6 +237,8 @@ struct ProbeClient::Impl {
         std::lock_guard<std::mutex> lock(mutex);
         context = &ctx;
         stream = rw.get();
+        callStarted = std::chrono::steady_clock::now();
+        silenced = false;
       }
       if (stopping) ctx.TryCancel();
       write(hello());
@@ -230,6 +256,10 @@ struct ProbeClient::Impl {
       bool acked = false;    // on this connection
       std::chrono::steady_clock::time_point lastAck;
       while (rw->Read(&msg)) {
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          lastMessage = std::chrono::steady_clock::now();
+        }
         if (msg.has_volume()) {
           if (!onVolume(msg.volume(), servers[at])) {
             dropped = true;
@@ -251,6 +281,7 @@ struct ProbeClient::Impl {
           stats.serverLinkWindow = msg.stats().link_window();
           stats.serverLinkInFlight = msg.stats().link_in_flight();
           stats.serverLinkWaits = msg.stats().link_waits();
+          heartbeatMs = msg.stats().heartbeat_ms();
         } else if (msg.has_frame()) {
           if (!onFrame(msg.frame())) {
             dropped = true;
@@ -258,9 +289,8 @@ struct ProbeClient::Impl {
             break;
           }
           const auto now = std::chrono::steady_clock::now();
-          // An ack the server asks for goes at once: a paced server sends nothing more until it
-          // comes (the link's window is full).
-          if (!acked || (config.linkPacing && msg.frame().ack_now()) ||
+          // A paced stream's acks are its link's measurement: every frame is acked at once.
+          if (!acked || config.linkPacing ||
               now - lastAck >= std::chrono::milliseconds(config.ackIntervalMs)) {
             pb::ClientMessage ack;
             ack.mutable_ack()->set_frame_sequence(msg.frame().sequence());
@@ -278,10 +308,17 @@ struct ProbeClient::Impl {
       }
       const grpc::Status status = rw->Finish();
       const auto code = status.error_code();
+      bool wasSilenced = false;
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
-        if (!status.ok() && !stopping && !dropped) stats.lastError = servers[at] + ": " + status.error_message();
+        wasSilenced = silenced;
+        silenced = false;
+        if (wasSilenced)
+          stats.lastError = servers[at] + ": the connection went silent (the server promised a message every " +
+                            std::to_string(heartbeatMs) + " ms): connecting afresh";
+        else if (!status.ok() && !stopping && !dropped)
+          stats.lastError = servers[at] + ": " + status.error_message();
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {
           stats.fatal = true;
@@ -293,6 +330,12 @@ struct ProbeClient::Impl {
       // again at once. Anything else (unavailable, a dead connection): the next server, at once,
       // until every one has failed in turn; then back off.
       if (code == grpc::StatusCode::ABORTED && gotVolume) continue;
+      // Cut for silence (a link outage stalls TCP, whose retransmissions back off for seconds after
+      // the link returns): a fresh connection at once, on the next server if there are several.
+      if (wasSilenced) {
+        if (servers.size() > 1) at = (at + 1) % servers.size();
+        continue;
+      }
       const bool moved = servers.size() > 1 && code != grpc::StatusCode::ABORTED;
       if (moved) {
         at = (at + 1) % servers.size();
@@ -317,6 +360,7 @@ void ProbeClient::start() {
   if (impl_->worker.joinable()) return;
   impl_->stopping = false;
   impl_->worker = std::thread([this] { impl_->run(); });
+  impl_->watchdog = std::thread([this] { impl_->watch(); });
 }
 
 void ProbeClient::stop() {
@@ -328,6 +372,7 @@ void ProbeClient::stop() {
   }
   s.wakeup.notify_all();
   if (s.worker.joinable()) s.worker.join();
+  if (s.watchdog.joinable()) s.watchdog.join();
 }
 
 void ProbeClient::setViews(std::vector<View> views) {

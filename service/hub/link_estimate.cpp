@@ -123,10 +123,6 @@ uint64_t LinkEstimator::allowance(Time now) {
   return std::min(w - f, std::max(kMinFrame, w / 4));
 }
 
-bool LinkEstimator::wantsAck() const {
-  return !measured() || phase_ != Phase::Normal || inFlight() * 2 >= window();
-}
-
 LinkStats LinkEstimator::stats() const {
   LinkStats s;
   s.rateBytesPerSecond = rate();

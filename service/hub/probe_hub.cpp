@@ -578,10 +578,7 @@ OutgoingFrame ProbeHub::buildFrame(Subscriber& s, size_t n, uint32_t behind, boo
   frame.sentUs = nowUs();
   frame.payloadBytes = frameSize(sections);
   const Clock::time_point now = Clock::now();
-  if (s.paced) {
-    s.link.sent(frame.sequence, frame.payloadBytes, !linkLimited, now);
-    frame.ackNow = s.link.wantsAck();
-  }
+  if (s.paced) s.link.sent(frame.sequence, frame.payloadBytes, !linkLimited, now);
   if (storage)
     writeFrame(s.layout, frame.sequence, sections, (*storage)(frame, frame.payloadBytes));
   else

@@ -218,21 +218,7 @@ class SubscribeReactor : public RawReactor {
       return;
     }
     if (framesSinceStats_ >= kFramesPerStats) {  // a Stats message every kFramesPerStats frames
-      framesSinceStats_ = 0;
-      const SubscriberStats st = hub_.stats(id_);
-      out_.Clear();
-      pb::Stats* s = out_.mutable_stats();
-      s->set_bytes_sent(st.bytesSent);
-      s->set_bricks_behind(st.bricksBehind);
-      s->set_server_frame(hub_.serverFrame());
-      s->set_frames_acked(st.framesAcked);
-      s->set_ack_rtt_us(st.ackRttUs);
-      s->set_link_rate(static_cast<uint64_t>(st.link.rateBytesPerSecond));
-      s->set_link_min_rtt_us(st.link.minRttUs);
-      s->set_link_window(st.paced ? st.link.windowBytes : 0);
-      s->set_link_in_flight(st.link.inFlightBytes);
-      s->set_link_waits(st.link.windowWaits);
-      startWriteLocked();
+      sendStatsLocked();
       return;
     }
     // The hub writes the payload straight into the message's one slice: its sections are copied
@@ -246,8 +232,7 @@ class SubscribeReactor : public RawReactor {
         stateBytes_ = w.SerializeAsString();
         stateSerialised_ = true;
       }
-      const FrameFields fields{f.sequence,   f.serverTimeUs, payloadBytes, f.keyframes,
-                               f.deltas,     &stateBytes_,   f.sentUs,     f.ackNow};
+      const FrameFields fields{f.sequence, f.serverTimeUs, payloadBytes, f.keyframes, f.deltas, &stateBytes_, f.sentUs};
       slice = grpc_slice_malloc(framePrefixBytes(fields) + payloadBytes + frameSuffixBytes(fields));
       uint8_t* payload = writeFramePrefix(fields, GRPC_SLICE_START_PTR(slice));
       writeFrameSuffix(fields, payload + payloadBytes);
@@ -256,6 +241,11 @@ class SubscribeReactor : public RawReactor {
     const std::optional<OutgoingFrame> frame = hub_.nextFrame(id_, storage);
     if (!frame) {
       grpc_slice_unref(slice);
+      // Nothing to send (all held, or a paced link's window is full): a client that acks every
+      // frame is still written to every kHeartbeatMs, so it can tell a cut connection from a
+      // quiet one (the hub's tick wakes a waiting subscriber every ServerConfig::kTickMs).
+      if (heartbeat_ && std::chrono::steady_clock::now() - lastWrite_ >= std::chrono::milliseconds(kHeartbeatMs))
+        sendStatsLocked();
       return;
     }
     grpc::Slice message(slice, grpc::Slice::STEAL_REF);
@@ -263,10 +253,31 @@ class SubscribeReactor : public RawReactor {
     ++framesSinceStats_;
     frameServerTimeUs_ = frame->serverTimeUs;
     writing_ = true;
+    lastWrite_ = std::chrono::steady_clock::now();
     StartWrite(&outBytes_);
   }
 
  private:
+  // A Stats message (the link is locked, no write is in flight).
+  void sendStatsLocked() {
+    framesSinceStats_ = 0;
+    const SubscriberStats st = hub_.stats(id_);
+    out_.Clear();
+    pb::Stats* s = out_.mutable_stats();
+    s->set_bytes_sent(st.bytesSent);
+    s->set_bricks_behind(st.bricksBehind);
+    s->set_server_frame(hub_.serverFrame());
+    s->set_frames_acked(st.framesAcked);
+    s->set_ack_rtt_us(st.ackRttUs);
+    s->set_link_rate(static_cast<uint64_t>(st.link.rateBytesPerSecond));
+    s->set_link_min_rtt_us(st.link.minRttUs);
+    s->set_link_window(st.paced ? st.link.windowBytes : 0);
+    s->set_link_in_flight(st.link.inFlightBytes);
+    s->set_link_waits(st.link.windowWaits);
+    if (heartbeat_) s->set_heartbeat_ms(kHeartbeatMs);
+    startWriteLocked();
+  }
+
   // A client's mistake: refused with INVALID_ARGUMENT and logged, so a broken client is visible on
   // both ends.
   grpc::Status invalid(const std::string& why) {
@@ -280,6 +291,7 @@ class SubscribeReactor : public RawReactor {
     outBytes_.Clear();
     grpc::SerializationTraits<pb::ServerMessage>::Serialize(out_, &outBytes_, &own);
     writing_ = true;
+    lastWrite_ = std::chrono::steady_clock::now();
     StartWrite(&outBytes_);
   }
 
@@ -355,9 +367,10 @@ class SubscribeReactor : public RawReactor {
             if (link->reactor) link->reactor->tryWriteLocked();
           }
         },
-        repr, config_.linkPacing && h.acks_on_request());
+        repr, config_.linkPacing && h.acks_every_frame());
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
+    heartbeat_ = h.acks_every_frame();
     out_.Clear();
     volumeToWire(hub_.volumeFor(id), *out_.mutable_volume());
     startWriteLocked();  // the volume description first; frames follow from OnWriteDone
@@ -388,6 +401,9 @@ class SubscribeReactor : public RawReactor {
   pb::ClientMessage in_;
   pb::ServerMessage out_;
   static constexpr uint32_t kFramesPerStats = 16;
+  static constexpr uint32_t kHeartbeatMs = 1000;
+  bool heartbeat_ = false;  // the client acks every frame: it is written to at least every kHeartbeatMs
+  std::chrono::steady_clock::time_point lastWrite_{};
   uint32_t framesSinceStats_ = 0;
   uint64_t frameServerTimeUs_ = 0;  // of the frame being written (0: no frame in flight)
   bus::SceneState state_;           // the scene state last serialised, and its bytes

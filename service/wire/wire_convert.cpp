@@ -152,7 +152,7 @@ size_t stateFieldBytes(const FrameFields& f) {
 size_t frameMessageBytes(const FrameFields& f) {
   const size_t payload = f.payloadBytes == 0 ? 0 : 1 + CodedOutputStream::VarintSize64(f.payloadBytes) + f.payloadBytes;
   return varintFieldBytes(f.sequence) + varintFieldBytes(f.serverTimeUs) + payload + varintFieldBytes(f.keyframes) +
-         varintFieldBytes(f.deltas) + stateFieldBytes(f) + varintFieldBytes(f.sentUs) + varintFieldBytes(f.ackNow);
+         varintFieldBytes(f.deltas) + stateFieldBytes(f) + varintFieldBytes(f.sentUs);
 }
 
 }  // namespace
@@ -164,8 +164,7 @@ size_t framePrefixBytes(const FrameFields& f) {
 }
 
 size_t frameSuffixBytes(const FrameFields& f) {
-  return varintFieldBytes(f.keyframes) + varintFieldBytes(f.deltas) + stateFieldBytes(f) + varintFieldBytes(f.sentUs) +
-         varintFieldBytes(f.ackNow);
+  return varintFieldBytes(f.keyframes) + varintFieldBytes(f.deltas) + stateFieldBytes(f) + varintFieldBytes(f.sentUs);
 }
 
 uint8_t* writeFramePrefix(const FrameFields& f, uint8_t* out) {
@@ -189,8 +188,7 @@ uint8_t* writeFrameSuffix(const FrameFields& f, uint8_t* out) {
     out = CodedOutputStream::WriteVarint64ToArray(f.sceneState->size(), out);
     out = CodedOutputStream::WriteRawToArray(f.sceneState->data(), static_cast<int>(f.sceneState->size()), out);
   }
-  out = putVarintField(v1::Frame::kSentUsFieldNumber, f.sentUs, out);
-  return putVarintField(v1::Frame::kAckNowFieldNumber, f.ackNow ? 1 : 0, out);
+  return putVarintField(v1::Frame::kSentUsFieldNumber, f.sentUs, out);
 }
 
 void stateToWire(const bus::SceneState& in, v1::SceneState& out) {

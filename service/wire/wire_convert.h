@@ -40,7 +40,6 @@ struct FrameFields {
   uint32_t deltas = 0;
   const std::string* sceneState = nullptr;  // a serialised SceneState (null: the field is left out)
   uint64_t sentUs = 0;
-  bool ackNow = false;
 };
 // Bytes before the payload and after it.
 size_t framePrefixBytes(const FrameFields& f);

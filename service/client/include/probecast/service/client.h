@@ -42,17 +42,23 @@ struct ClientConfig {
   // one (canTranscode in probe_hub.h) and refuses a finer one (INVALID_ARGUMENT: fatal); a
   // description of another representation is refused and the server tried again later.
   std::optional<Representation> representation;
-  // Acks (of the newest applied frame) go at most this often; 0: one per frame. The server reads
-  // them for its statistics (frames_acked, ack_rtt_us) and nothing else, and each is a message
-  // it must read: a thousand viewers acking every frame at 30 Hz would double its messages. While
-  // no frames come, the server's frames_acked may trail the last frame applied.
+  // Without link pacing (below), acks (of the newest applied frame) go at most this often; 0: one
+  // per frame. The server then reads them for its statistics (frames_acked, ack_rtt_us) only, and
+  // while no frames come its frames_acked may trail the last frame applied.
   int ackIntervalMs = 100;
-  // Link-aware pacing: the client acks at once every frame the server asks it to ack (Frame.ack_now),
-  // and a server that paces (ServerConfig::linkPacing) keeps the stream within what the link
+  // Link-aware pacing: the client acks every frame at once (ackIntervalMs does not apply), and a
+  // server that paces (ServerConfig::linkPacing) keeps the stream within what the link
   // delivers, measured from those acks; the frames it sends are then the newest, best-first
   // bricks instead of a queue in the network's buffers. Off: the server sends as fast as its
   // transport takes frames (and the client acks every ackIntervalMs only).
   bool linkPacing = true;
+  // A server that promises a message at least every so often (Stats heartbeat_ms: it does for a
+  // client that acks every frame) and says nothing for silenceMs has a cut connection: a link outage
+  // stalls TCP, whose retransmissions back off for seconds after the link returns. The client
+  // drops it and connects afresh at once, giving each new attempt reconnectSilenceMs to answer.
+  // 0: wait for TCP and the keepalive.
+  int silenceMs = 3000;
+  int reconnectSilenceMs = 2000;
 };
 
 struct VolumeSnapshot {
@@ -135,6 +141,7 @@ struct ClientStats {
   uint64_t serverLinkWindow = 0;     // unacknowledged bytes it allows on the way
   uint64_t serverLinkInFlight = 0;   // unacknowledged bytes on the way
   uint32_t serverLinkWaits = 0;      // frames that waited for the window
+  uint32_t silences = 0;             // connections dropped for silence (ClientConfig::silenceMs)
 };
 
 // One frame the client applied (ProbeClient::appliedFrames).

@@ -90,7 +90,6 @@ struct OutgoingFrame {
   uint32_t deltas = 0;
   bus::SceneState state;  // the scene state of the newest lighting in it
   uint64_t sentUs = 0;    // wall clock when it was made, µs since 1970
-  bool ackNow = false;    // a paced subscriber's: the hub waits for this frame's ack to send more
 };
 
 // Where nextFrame writes a frame's payload instead of OutgoingFrame::payload: called under the
@@ -182,8 +181,7 @@ class ProbeHub {
   // (canTranscode, std::invalid_argument otherwise) is encoded by this hub from the volume it holds,
   // once for every subscriber that wants it, as a stream of its own epoch (volumeFor). It stays
   // for the epoch (at most one per representation), so a subscriber that reconnects resumes.
-  // `paced`: the subscriber acks the frames that ask for it (OutgoingFrame::ackNow) as soon as it
-  // applies them, and the hub keeps its unacknowledged bytes within what its link delivers
+  // `paced`: the subscriber acks every frame as soon as it applies it, and the hub keeps its unacknowledged bytes within what its link delivers
   // (LinkEstimator): what the link cannot take yet waits here, where newer versions replace it and
   // priorities order it, instead of in the transport's buffers.
   uint64_t addSubscriber(uint64_t budgetBytesPerSecond, uint64_t epoch, std::span<const HeldBrick> held,

@@ -34,7 +34,7 @@ struct ServerConfig {
   // The server ticks the hub this often (ms), so byte budgets refill and wake their subscribers
   // even while nothing new is published.
   static constexpr int kTickMs = 50;
-  // Link-aware pacing: a subscriber that acks on request (Hello.acks_on_request, as ProbeClient
+  // Link-aware pacing: a subscriber that acks every frame (Hello.acks_every_frame, as ProbeClient
   // does) is kept within what its link delivers, measured from its acks (ProbeHub::addSubscriber).
   // Off: every subscriber is sent frames as fast as the transport takes them.
   bool linkPacing = true;
