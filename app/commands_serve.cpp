@@ -49,7 +49,8 @@ std::shared_ptr<const service::ScenePackage> filePackage(const SceneOptions& giv
     return std::make_shared<const service::ScenePackage>(given.package());
   }
   service::ScenePackage named;
-  orThrow(service::parseManifest(file.scene.manifest, named, error), "the probe file's scene: " + error);
+  if (!service::parseManifest(file.scene.manifest, named, error))
+    throw std::runtime_error("the probe file's scene: " + error);
   if (named.files.empty() && !given.sceneGiven()) return std::make_shared<const service::ScenePackage>(named);
   if (given.sceneGiven()) {
     const service::ScenePackage local = given.package();
@@ -287,7 +288,7 @@ void addSubscribeCommand(CLI::App& app) {
       if (st.serverLinkWindow > 0)
         fmt::print("subscribe: the server paces to the link: {:.1f} kB/s, round trip {:.1f} ms, window {} bytes, "
                    "{} in flight, {} waits\n",
-                   st.serverLinkRate / 1e3, st.serverLinkMinRttUs / 1e3, st.serverLinkWindow, st.serverLinkInFlight,
+                   static_cast<double>(st.serverLinkRate) / 1e3, st.serverLinkMinRttUs / 1e3, st.serverLinkWindow, st.serverLinkInFlight,
                    st.serverLinkWaits);
       else
         fmt::print("subscribe: the server does not pace this stream to its link\n");

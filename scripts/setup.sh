@@ -13,7 +13,7 @@ PACKAGES=(
   libglfw3-dev xvfb xauth xdotool libmeshoptimizer-dev
   clang-14 libclang-rt-14-dev openssl libssl-dev
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev python3-venv
-  emscripten node-acorn nodejs chromium
+  emscripten node-acorn nodejs chromium ffmpeg
 )
 # npm comes with nodejs where nodejs is not Debian's (NodeSource's): Debian's npm only without one.
 command -v npm >/dev/null 2>&1 || PACKAGES+=(npm)
