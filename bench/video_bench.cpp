@@ -314,8 +314,8 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
   const double seconds = static_cast<double>(o.frames) / o.fps;
 
   nlohmann::json results = nlohmann::json::array();
-  std::string table = fmt::format("{:<10} {:<8} {:<8} {:>10} {:>7} {:>9} {:>10} {:>9} {:>8}\n", "display", "motion",
-                                  "stream", "probes B/s", "dB", "video", "video B/s", "video dB*", "ratio");
+  std::string table = fmt::format("{:<10} {:<8} {:<8} {:>10} {:>7} {:>9} {:>10} {:>8}\n", "display", "motion",
+                                  "stream", "probes B/s", "dB", "video", "video B/s", "ratio");
   std::vector<std::pair<std::string, std::vector<imaging::ChartSeries>>> chartSeries;
   for (const VideoDisplay& d : o.displays) chartSeries.push_back({d.name, {}});
 
@@ -454,10 +454,10 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
         chartSeries[i].second.push_back(
             {m.name + " " + st.config->name, {{std::max(bytesPerSecond, 1.0), std::isfinite(psnr) ? psnr : 99.0, st.config->name}}, false});
         const char* mark = bestBound == "at_least" ? "≥" : (bestBound == "at_most" ? "≤" : "");
-        table += fmt::format("{:<10} {:<8} {:<8} {:>10.0f} {:>7} {:>9} {:>9}{:.0f} {:>9} {:>7}{}\n", df.display->name,
+        table += fmt::format("{:<10} {:<8} {:<8} {:>10.0f} {:>7} {:>9} {:>3}{:>7.0f} {:>3}{:>5}\n", df.display->name,
                              m.name, st.config->name, bytesPerSecond,
                              std::isfinite(psnr) ? fmt::format("{:.2f}", psnr) : std::string("same"), bestName, mark,
-                             bestBytes, "", mark, std::isfinite(ratio) ? fmt::format("{:.1f}", ratio) : std::string("-"));
+                             bestBytes, mark, std::isfinite(ratio) ? fmt::format("{:.1f}", ratio) : std::string("-"));
       }
       results.push_back({{"display", df.display->name},
                          {"view_set", df.display->viewSet},
