@@ -1,7 +1,9 @@
 // `probecast serve` (live from the updater, or a baked probe file) and `probecast subscribe`.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -253,9 +255,9 @@ void addSubscribeCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("subscribe", "subscribe to a probe stream; report and save the volume");
   struct SubOptions {
     ConnectOptions connection;
-    std::string out, repr, json;
+    std::string out, repr, json, snapshotDir;
     uint64_t budget = 0;
-    double seconds = 5.0;
+    double seconds = 5.0, snapshotEvery = 0.0;
   };
   auto so = std::make_shared<SubOptions>();
   so->connection.add(sub, "server address host:port (several comma-separated: edges to fail over between)", true, true);
@@ -266,17 +268,57 @@ void addSubscribeCommand(CLI::App& app) {
                   "write what was received here as JSON: totals, the server's link estimate, and every frame applied "
                   "(when, its latency from the publish of its lighting, bytes, keyframes, bricks held)");
   addRepresentationOption(sub, so->repr, "representation wanted (default: the server's; a coarser one is transcoded)");
+  CLI::Option* every =
+      sub->add_option("--snapshot-every", so->snapshotEvery,
+                      "write the volume held every this many seconds, at multiples of it on the system clock (so "
+                      "subscribers on one machine write theirs at the same instants): DIR/TICK.pcpv, TICK = the "
+                      "Unix time divided by the period; ticks before the first volume are skipped")
+          ->check(CLI::Range(0.05, 3600.0));
+  sub->add_option("--snapshot-dir", so->snapshotDir, "folder for --snapshot-every (created if missing)")
+      ->needs(every);
+  every->needs(sub->get_option("--snapshot-dir"));
   sub->callback([so] {
+    if (!so->snapshotDir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(so->snapshotDir, ec);
+      if (ec || !std::filesystem::is_directory(so->snapshotDir))
+        throw std::runtime_error("cannot create the snapshot folder " + so->snapshotDir +
+                                 (ec ? ": " + ec.message() : std::string()));
+    }
     service::ClientConfig cc = so->connection.client("probecast-subscribe");
     cc.budgetBytesPerSecond = so->budget;
     if (!so->repr.empty()) cc.representation = session::parseRepresentationOrThrow(so->repr);
     service::ProbeClient client(cc);
     client.start();
     const auto start = std::chrono::steady_clock::now();
-    while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(so->seconds)) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const auto end = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(so->seconds));
+    // Snapshot ticks: multiples of the period on the system clock.
+    const auto tickOf = [&](std::chrono::system_clock::time_point t) {
+      return static_cast<int64_t>(std::floor(std::chrono::duration<double>(t.time_since_epoch()).count() / so->snapshotEvery));
+    };
+    int64_t nextTick = so->snapshotEvery > 0 ? tickOf(std::chrono::system_clock::now()) + 1 : 0;
+    uint32_t written = 0;
+    while (std::chrono::steady_clock::now() < end) {
+      auto wake = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+      if (so->snapshotEvery > 0) {
+        const auto tickAt = std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
+            std::chrono::duration<double>(static_cast<double>(nextTick) * so->snapshotEvery)));
+        wake = std::min(wake, std::chrono::steady_clock::now() + (tickAt - std::chrono::system_clock::now()));
+      }
+      std::this_thread::sleep_until(std::min(wake, end));
       if (client.stats().fatal) break;
+      if (so->snapshotEvery > 0 && tickOf(std::chrono::system_clock::now()) >= nextTick) {
+        service::VolumeSnapshot held;
+        if (client.snapshot(held)) {
+          std::string error;
+          orThrow(writeProbeFile(fmt::format("{}/{}.pcpv", so->snapshotDir, nextTick), held.volume, error), error);
+          ++written;
+        }
+        nextTick = tickOf(std::chrono::system_clock::now()) + 1;
+      }
     }
+    if (so->snapshotEvery > 0) fmt::print("subscribe: {} snapshots in {}\n", written, so->snapshotDir);
     client.stop();
     const service::ClientStats st = client.stats();
     fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects{}\n", st.framesApplied,

@@ -9,8 +9,11 @@ with the server's volume, bit for bit (its checksum).
 
 Per profile and path (direct, or through NATS and an edge) it reports delivered bytes per second,
 produce → receive latency (p50, p99) while the light moves, the late joiner's time to a usable
-volume (every brick held), the time from the link's return to the next frame, and whether every
-subscriber settled on the server's volume. JSON on stdout (or --json) and an SVG chart (--svg).
+volume (every brick held), the time from the link's return to the next frame, whether every
+subscriber settled on the server's volume, and how far the first subscriber's picture is from a
+perfect link's: a subscriber beside the server (no emulated link) and the first one write the volume
+they hold at the same instants (subscribe --snapshot-every), each pair is drawn by `probecast view`
+and compared (PSNR while the light moves, while the link is out, and after it returns). JSON on stdout (or --json) and an SVG chart (--svg).
 
 Needs root (network namespaces), iproute2, and for the bus path nats-server.
 
@@ -20,6 +23,7 @@ Needs root (network namespaces), iproute2, and for the bus path nats-server.
 """
 import argparse
 import json
+import math
 import os
 import shutil
 import signal
@@ -135,9 +139,11 @@ class Run:
             delay = start + at - time.time()
             if delay > 0:
                 time.sleep(delay)
-            return (name, time.time(), self.spawn(ns, [a.probecast, "subscribe", "--connect", addr, "--token-file", token,
-                                                       "--seconds", str(until - at), "--json",
-                                                       os.path.join(self.work, name + ".json")], name + ".log"))
+            argv = [a.probecast, "subscribe", "--connect", addr, "--token-file", token, "--seconds", str(until - at),
+                    "--json", os.path.join(self.work, name + ".json")]
+            if a.gap_period > 0 and name in ("reference", "first"):  # their pictures are compared afterwards
+                argv += ["--snapshot-every", str(a.gap_period), "--snapshot-dir", os.path.join(self.work, name + "-snapshots")]
+            return (name, time.time(), self.spawn(ns, argv, name + ".log"))
 
         subs = [subscriber("reference", self.ns_a, T["first"], T["end"], address),
                 subscriber("first", self.ns_b, T["first"], T["end"], address)]
@@ -168,7 +174,67 @@ class Run:
         T = dict(T, bricks=ref[-1][5] if ref else 0)
         for name, (j, began, rc) in loaded.items():
             out[name] = summarise(j, began, start, T, outage, server_checksum, rc)
+        if a.gap_period > 0:
+            out["first"]["picture_gap"] = picture_gap(a, self.work, T, start, t0, outage)
         return out
+
+
+def picture_gap(a, work, T, start, t0, outage):
+    """The first subscriber's picture against the perfect link's (the reference subscriber beside
+    the server), from the volumes both held at the same instants: each pair is drawn by `probecast
+    view` (same views, same scene time, so only the probes differ) and compared. PSNR from the
+    mean squared error pooled over the instants of each phase: while the light moves, while the
+    link is out, and from 2 s after its return until the lighting holds; and the worst instant."""
+    ref_dir, sub_dir = os.path.join(work, "reference-snapshots"), os.path.join(work, "first-snapshots")
+    ticks = sorted(set(f for f in os.listdir(ref_dir) if f.endswith(".pcpv")) &
+                   set(f for f in os.listdir(sub_dir) if f.endswith(".pcpv")))
+    views, size = a.gap_views.split("@")
+    phases = {"moving": (T["steady"][0], T["steady"][1]), "outage": None, "after_outage": None}
+    if outage:
+        phases["outage"] = (outage[0] - start, outage[1] - start)
+        phases["after_outage"] = (outage[1] - start + 2.0, T["hold"])
+    sums = {k: [0.0, 0] for k in phases}
+    worst = None
+    render = os.path.join(work, "gap-render")
+    for name in ticks:
+        at = int(name[:-5]) * a.gap_period - start  # the instant on the timeline
+        if not T["steady"][0] <= at < T["hold"]:
+            continue
+        scene_time = max(0.0, (int(name[:-5]) * a.gap_period - t0) * a.animate)
+        images = []
+        for side, folder in (("reference", ref_dir), ("first", sub_dir)):
+            out = os.path.join(render, side)
+            subprocess.run([a.probecast, "-q", "view", "--scene", a.scene, "--time", "%.4f" % scene_time, "--probes",
+                            os.path.join(folder, name), "--views", views, "--size", size, "--visibility", "off",
+                            "--out", out], check=True, stdout=subprocess.DEVNULL)
+            images.append(os.path.join(out, "quilt.exr"))
+        metrics = os.path.join(render, "compare.json")
+        subprocess.run([a.probecast, "-q", "compare", images[1], images[0], "--json", metrics], check=True,
+                       stdout=subprocess.DEVNULL)
+        with open(metrics) as f:
+            m = json.load(f)
+        if worst is None or m["mse"] > worst[0]:
+            worst = (m["mse"], m["psnr_db"], round(at, 1))
+        for k, span in phases.items():
+            if span and span[0] <= at < span[1]:
+                sums[k][0] += m["mse"]
+                sums[k][1] += 1
+    shutil.rmtree(render, ignore_errors=True)
+    peak = 1.0  # compare's images after gamma: PSNR = 10 log10(1 / MSE)
+
+    def pooled(k):
+        total, n = sums[k]
+        if n == 0:
+            return None
+        return round(10 * math.log10(peak / (total / n)), 1) if total > 0 else "identical"
+
+    gap = {"views": a.gap_views, "period_s": a.gap_period, "instants": sum(n for _, n in sums.values())}
+    for k in phases:
+        gap[k + "_psnr_db"] = pooled(k)
+        gap[k + "_instants"] = sums[k][1]
+    if worst:
+        gap["worst_psnr_db"], gap["worst_at_s"] = round(worst[1], 1), worst[2]
+    return gap
 
 
 def percentile(values, p):
@@ -253,6 +319,10 @@ def main():
     ap.add_argument("--bounces", type=int, default=2)
     ap.add_argument("--hz", type=float, default=10.0)
     ap.add_argument("--animate", type=float, default=0.2, help="scene seconds per second (the light moves)")
+    ap.add_argument("--gap-period", type=float, default=1.0,
+                    help="seconds between the instants at which the first subscriber's picture is set against the perfect "
+                         "link's (0: not measured)")
+    ap.add_argument("--gap-views", default="stereo@96x96", help="views drawn for that comparison, VIEWSET@WxH")
     ap.add_argument("--json", default=None)
     ap.add_argument("--svg", default=None)
     ap.add_argument("--test", action="store_true", help="a short run with assertions (ctest net.wan_pacing)")
@@ -282,10 +352,12 @@ def main():
                     r = run.go()
                 results.append(r)
                 f = r["first"]
-                log("  %s kB/s, p50 %s ms, p99 %s ms, late joiner usable in %s s, resume %s s, settled %s/%s/%s" % (
-                    round(f["steady_bytes_per_s"] / 1e3, 1), f["latency_p50_ms"], f["latency_p99_ms"],
-                    r["late"]["first_usable_s"], f.get("resume_s"), r["reference"]["settled"], f["settled"],
-                    r["late"]["settled"]))
+                g = f.get("picture_gap", {})
+                log("  %s kB/s, p50 %s ms, p99 %s ms, late joiner usable in %s s, resume %s s, settled %s/%s/%s, "
+                    "picture against a perfect link %s dB moving, %s dB after the outage" % (
+                        round(f["steady_bytes_per_s"] / 1e3, 1), f["latency_p50_ms"], f["latency_p99_ms"],
+                        r["late"]["first_usable_s"], f.get("resume_s"), r["reference"]["settled"], f["settled"],
+                        r["late"]["settled"], g.get("moving_psnr_db"), g.get("after_outage_psnr_db")))
     report = {"command": " ".join(sys.argv), "timeline_s": timeline, "scene": args.scene, "grid": args.grid,
               "repr": args.repr, "spp": args.spp, "bounces": args.bounces, "hz": args.hz, "animate": args.animate, "results": results}
     text = json.dumps(report, indent=1)
@@ -301,8 +373,9 @@ def main():
 
 
 def check(results):
-    """What must hold: paced, the slow link's latency stays bounded and nothing is lost; unpaced,
-    the same stream's latency grows (the test can tell the two apart)."""
+    """What must hold: paced, the slow link's latency stays bounded, the picture keeps a PSNR of at
+    least 25 dB against a perfect link's and is closer to it than unpaced, and nothing is lost; unpaced, the same
+    stream's latency grows (the test can tell the two apart)."""
     failures = []
     by = {r["link_pacing"]: r for r in results}
     on, off = by[True], by[False]
@@ -326,6 +399,15 @@ def check(results):
     # and no less than a third of what the unpaced stream got through it.
     if not off["first"]["steady_bytes_per_s"] / 3 <= rate <= 1.3 * 125000:
         failures.append("paced: the server estimates %d B/s for a 125 kB/s link" % rate)
+    # The picture a subscriber draws while the light moves, against a perfect link's.
+    gap_on = f.get("picture_gap", {}).get("moving_psnr_db")
+    gap_off = off["first"].get("picture_gap", {}).get("moving_psnr_db")
+    if gap_on is not None and gap_on != "identical":
+        if gap_on < 25.0:
+            failures.append("paced: the picture is %.1f dB from a perfect link's while the light moves (bound 25 dB)" % gap_on)
+        if gap_off not in (None, "identical") and gap_on <= gap_off:
+            failures.append("paced: the picture (%.1f dB from a perfect link's) is no closer than unpaced (%.1f dB)" %
+                            (gap_on, gap_off))
     if f.get("resume_s") is None or f["resume_s"] > 3.0:
         failures.append("paced: no frame within 3 s of the link's return (%s)" % f.get("resume_s"))
     if off["first"]["latency_p99_ms"] is not None and off["first"]["latency_p99_ms"] < 2 * f["latency_p99_ms"]:
@@ -334,9 +416,10 @@ def check(results):
     for m in failures:
         print("FAIL:", m)
     if not failures:
-        print("wan_pacing: paced p99 %.0f ms (unpaced %.0f ms), %.1f kB/s, link estimate %.1f kB/s, resume %.2f s, settled" %
+        print("wan_pacing: paced p99 %.0f ms (unpaced %.0f ms), %.1f kB/s, link estimate %.1f kB/s, resume %.2f s, "
+              "picture %s dB from a perfect link's (unpaced %s dB), settled" %
               (f["latency_p99_ms"], off["first"]["latency_p99_ms"] or 0, f["steady_bytes_per_s"] / 1e3, rate / 1e3,
-               f["resume_s"]))
+               f["resume_s"], gap_on, gap_off))
     return 1 if failures else 0
 
 

@@ -34,6 +34,21 @@ rel = (num / den) ** 0.5
 print("relative coefficient error %.4f" % rel)
 assert rel < 0.02, rel
 PY
+# Snapshots at multiples of 0.25 s on the system clock: consecutive ticks, each the volume held
+# (a file served as is: every snapshot equals the final volume, byte for byte).
+"$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1.2 --snapshot-every 0.25 \
+  --snapshot-dir "$work/snaps" --out "$work/received-snap.pcpv" | tee "$work/snap.log"
+python3 - "$work/snaps" "$work/received-snap.pcpv" <<'PY'
+import os, sys
+names = sorted(os.listdir(sys.argv[1]))
+ticks = [int(n[:-5]) for n in names if n.endswith(".pcpv")]
+assert len(ticks) == len(names) and 2 <= len(ticks) <= 5, names
+assert ticks == list(range(ticks[0], ticks[0] + len(ticks))), ticks
+final = open(sys.argv[2], "rb").read()
+assert all(open(os.path.join(sys.argv[1], n), "rb").read() == final for n in names), "a snapshot differs"
+print("%d snapshots, consecutive ticks, each the served volume" % len(ticks))
+PY
+grep -q "snapshots in $work/snaps" "$work/snap.log"
 # A coarser representation is transcoded by the server; a finer one is refused.
 "$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1 --repr l1 --out "$work/received-l1.pcpv"
 if "$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1 --repr fp16 2>"$work/finer.log"; then
