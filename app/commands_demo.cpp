@@ -45,6 +45,12 @@ void addDemoCommand(CLI::App& app) {
   o->areaLights.add(demo);
   o->device.add(demo);
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");
+  demo->add_option("--video", o->video,
+                   "on: the report sets the stream's bytes against AV1 and x265 video of both viewers' views at equal "
+                   "PSNR (a short run of bench video; needs ffmpeg); off: left out")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  demo->add_option("--ffmpeg", o->ffmpeg, "the ffmpeg that --video runs")->capture_default_str();
   o->environment.add(demo);
   demo->callback([o] {
     if (o->referenceSpp < 2)

@@ -41,6 +41,8 @@ struct DemoOptions {
   std::string referenceCache;    // empty: bench::defaultReferenceCacheDir()
   uint64_t lightFieldBudget = 6 * 1024;  // bytes/s: the display sits on a thin link
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
+  std::string video = "on";              // on: the report sets the stream against video of the viewers' views
+  std::string ffmpeg = "ffmpeg";         // for that comparison
   EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
   std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)

@@ -16,6 +16,7 @@
 #include "probecast/session/scene_loading.h"
 #include "probecast/session/stats.h"
 #include "stability.h"
+#include "video_bench.h"
 #include "probecast/imaging/svg_chart.h"
 
 namespace probecast::app {
@@ -69,6 +70,71 @@ std::string runSuites(const DemoOptions& o, const std::string& dir, const scene:
          "\n## Stability: where probe lighting fails, measured\n\nEach case is also a test "
          "(`ctest -L stability`). Data: [stability.json](stability.json).\n\n" +
          sr.markdown;
+}
+
+// The stream against video of the viewers' own views (bench video, one motion: the demo's scene at
+// its rate, one second of frames), written next to the report; returns its report section. Without
+// ffmpeg the section says so and the demo goes on.
+std::string runVideoComparison(const DemoOptions& o, const DemoRun& run, const std::string& dir, nlohmann::json& report) {
+  const auto phaseStart = DemoClock::now();
+  Progress progress("demo");
+  bench::VideoBenchOptions vo;
+  vo.motions = {{"demo", o.scene, o.rate}};
+  for (const DemoViewer& v : run.viewers)
+    vo.displays.push_back({v.viewSet == "stereo" ? "headset" : "lightfield", v.viewSet, v.width, v.height});
+  const std::vector<int> x265Crfs{20, 28, 36, 44}, av1Crfs{20, 32, 44, 56, 63};
+  for (const char* name : {"av1-444", "x265-444"}) {
+    bench::VideoCodec codec;
+    std::string error;
+    orThrow(bench::parseVideoCodec(name, x265Crfs, av1Crfs, codec, error), error);
+    vo.codecs.push_back(codec);
+  }
+  const ProbeGrid grid = run.grid;
+  vo.grid = [grid](const scene::Scene&) { return grid; };
+  vo.updater.samplesPerProbe = o.spp;
+  vo.updater.environment = o.sky;
+  vo.raster = bench::singleSampleRaster();
+  vo.raster.environment = o.sky;
+  vo.updater.areaLights = vo.raster.areaLights = o.areaLights.options();
+  vo.context = o.device.context();
+  bench::VideoStream stream;
+  stream.name = o.repr;
+  stream.repr = session::parseRepresentationOrThrow(o.repr);
+  stream.encoder.deadzone = 1;
+  stream.encoder.noiseScale = o.encoder.noiseScale;
+  stream.encoder.refinementInterval = o.encoder.refinementInterval;
+  vo.streams = {stream};
+  vo.frames = 30;
+  vo.warmup = 8;
+  vo.ffmpeg = o.ffmpeg;
+  vo.command = commandLine() + " (video part)";
+  vo.progress = [&progress](const std::string& s) { progress.message(s); };
+  std::string section = "\n## Against video of the same views\n\n";
+  try {
+    const bench::VideoBenchResult r = bench::runVideoBench(vo);
+    progress.finish();
+    writeTextFile(dir + "/video.json", r.json.dump(2) + "\n");
+    for (const auto& [display, svg] : r.charts) {
+      writeTextFile(dir + "/video_" + display + ".svg", svg);
+      section += fmt::format("![{}: bytes against PSNR, the stream and each video codec](video_{}.svg)\n\n", display,
+                             display);
+    }
+    section += fmt::format(
+        "Both viewers' views drawn for one second at 30 frames per second from the updater's float probes "
+        "(what a video server would encode) and from what a subscriber decodes from the {} stream; the float "
+        "frames encoded with AV1 and x265 at 4:4:4 (low latency, GOP 30, a CRF sweep). Video bytes at the "
+        "stream's PSNR against the float frames; ≥ or ≤ where the sweep does not reach it. Data: "
+        "[video.json](video.json); `probecast bench video` measures more motions, displays and codecs.\n\n```\n{}```\n",
+        o.repr, r.table);
+    report["video"] = r.json;
+  } catch (const std::runtime_error& e) {
+    progress.finish();
+    fmt::print("demo: the comparison with video was left out: {}\n", e.what());
+    section += fmt::format("Left out: {}\n", e.what());
+    report["video"] = {{"left_out", e.what()}};
+  }
+  report["phase_seconds"]["video"] = secondsSince(phaseStart);
+  return section;
 }
 
 // report.md without the suites' sections.
@@ -336,6 +402,7 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
     suites = runSuites(o, o.out, finalScene, run.finalT, run.grid, phases);
     report["phase_seconds"] = phases;
   }
+  if (o.video == "on") suites += runVideoComparison(o, run, o.out, report);
   const double wall = secondsSince(run.wallStart);
   report["wall_seconds"] = wall;
   writeTextFile(o.out + "/report.json", report.dump(2) + "\n");

@@ -36,6 +36,7 @@ assert rel < 0.02, rel
 PY
 # Snapshots at multiples of 0.25 s on the system clock: consecutive ticks, each the volume held
 # (a file served as is: every snapshot equals the final volume, byte for byte).
+rm -rf "$work/snaps"
 "$probecast" subscribe --connect "127.0.0.1:$port" --token s3cret --seconds 1.2 --snapshot-every 0.25 \
   --snapshot-dir "$work/snaps" --out "$work/received-snap.pcpv" | tee "$work/snap.log"
 python3 - "$work/snaps" "$work/received-snap.pcpv" <<'PY'

@@ -212,6 +212,10 @@ class SubscribeReactor : public RawReactor {
   // Called by the hub's wake-up with the link locked.
   void tryWriteLocked() {
     if (writing_ || finished_ || pendingFinish_ || !id_) return;
+    if (descriptionPending_) {
+      writeDescriptionLocked();
+      return;
+    }
     if (hub_.streamEnded(id_)) {  // an edge whose producer restarted: what we sent belongs to another epoch
       finishLocked(grpc::Status(grpc::StatusCode::ABORTED, "the stream epoch changed (the producer restarted); "
                                                            "subscribe again"));
@@ -275,6 +279,14 @@ class SubscribeReactor : public RawReactor {
     s->set_link_in_flight(st.link.inFlightBytes);
     s->set_link_waits(st.link.windowWaits);
     if (heartbeat_) s->set_heartbeat_ms(kHeartbeatMs);
+    startWriteLocked();
+  }
+
+  // The volume description (the link is locked, no write is in flight); frames follow it.
+  void writeDescriptionLocked() {
+    descriptionPending_ = false;
+    out_.Clear();
+    volumeToWire(hub_.volumeFor(id_), *out_.mutable_volume());
     startWriteLocked();
   }
 
@@ -371,9 +383,15 @@ class SubscribeReactor : public RawReactor {
     std::lock_guard<std::mutex> lock(link_->mutex);
     id_ = id;
     heartbeat_ = h.acks_every_frame();
-    out_.Clear();
-    volumeToWire(hub_.volumeFor(id), *out_.mutable_volume());
-    startWriteLocked();  // the volume description first; frames follow from OnWriteDone
+    if (heartbeat_) {
+      // A small Stats first, with the heartbeat promise: the client hears within a round trip that
+      // this connection works, however long the description takes over a slow link (its silence
+      // watchdog would otherwise cut a fresh connection that is still receiving it).
+      descriptionPending_ = true;
+      sendStatsLocked();
+      return grpc::Status::OK;
+    }
+    writeDescriptionLocked();  // the volume description first; frames follow from OnWriteDone
     return grpc::Status::OK;
   }
 
@@ -402,6 +420,7 @@ class SubscribeReactor : public RawReactor {
   pb::ServerMessage out_;
   static constexpr uint32_t kFramesPerStats = 16;
   static constexpr uint32_t kHeartbeatMs = 1000;
+  bool descriptionPending_ = false;  // a paced client's first Stats went first; the description is next
   bool heartbeat_ = false;  // the client acks every frame: it is written to at least every kHeartbeatMs
   std::chrono::steady_clock::time_point lastWrite_{};
   uint32_t framesSinceStats_ = 0;
