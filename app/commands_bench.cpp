@@ -354,7 +354,7 @@ void addBenchVideo(CLI::App* bench) {
       ->capture_default_str();
   cmd->add_option("--exposure", vo->bench.exposure, "scale before the tone map (both pictures)")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_option("--ffmpeg", vo->bench.ffmpeg, "the ffmpeg to encode and decode with")->capture_default_str();
-  cmd->add_option("--work-dir", vo->bench.workDir, "frames and bitstreams go here (default: a temporary folder)");
+  cmd->add_option("--work-dir", vo->bench.workDir, "a folder of this run's own is made in here for the frames and bitstreams (default: the system's temporary folder); removed at the end unless --keep-files");
   cmd->add_flag("--keep-files", vo->bench.keepFiles, "keep the frames and bitstreams");
   cmd->add_option("--streams", vo->streams,
                   "probe stream configurations measured side by side, REPR[:NOISE_SCALE] (l1, zh3h, zh3, l2; the noise "

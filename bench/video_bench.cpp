@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -303,12 +306,34 @@ Sweeps sweepVideo(const VideoBenchOptions& o, const VideoMotion& m, DisplayFrame
 
 }  // namespace
 
+// A folder of this run's own inside `parent`: runs at the same time never share files, and nothing
+// else in `parent` is touched. Removed with everything in it when the run ends (or fails) unless
+// the files are kept.
+struct RunFolder {
+  std::string path;
+  bool keep = false;
+  RunFolder(const std::string& parent, bool keepFiles) : keep(keepFiles) {
+    std::error_code ec;
+    fs::create_directories(parent, ec);
+    std::string pattern = (fs::path(parent) / "probecast-video-XXXXXX").string();
+    if (ec || !mkdtemp(pattern.data()))
+      throw std::runtime_error("bench video: cannot make a folder in " + parent + ": " +
+                               (ec ? ec.message() : std::string(std::strerror(errno))));
+    path = pattern;
+  }
+  RunFolder(const RunFolder&) = delete;
+  RunFolder& operator=(const RunFolder&) = delete;
+  ~RunFolder() {
+    std::error_code ec;
+    if (!keep) fs::remove_all(path, ec);
+  }
+};
+
 VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
   checkOptions(o);
-  const std::string work = o.workDir.empty() ? (fs::temp_directory_path() / "probecast-video").string() : o.workDir;
-  std::error_code ec;
-  fs::create_directories(work, ec);
-  if (ec) throw std::runtime_error("bench video: cannot create " + work + ": " + ec.message());
+  const RunFolder folder(o.workDir.empty() ? fs::temp_directory_path().string() : o.workDir, o.keepFiles);
+  const std::string& work = folder.path;
+  if (o.keepFiles && o.progress) o.progress("frames and bitstreams go to " + work);
   checkFfmpeg(o, work);
   renderer::VulkanContext context(o.context);
   const double seconds = static_cast<double>(o.frames) / o.fps;
@@ -471,7 +496,6 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
                          {"streams", streamResults}});
     }
   }
-  if (!o.keepFiles) fs::remove_all(fs::path(work), ec);
 
   VideoBenchResult r;
   r.json = {{"command", o.command},
@@ -486,6 +510,7 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
             {"psnr", "8-bit RGB of every frame against the float-probe render's, from the summed squared error"},
             {"probe_bytes", "stream frames of the changed bricks after the warm-up (the join keyframe apart)"},
             {"results", results}};
+  if (o.keepFiles) r.json["kept_files"] = work;  // the run's own folder in --work-dir
   r.table = "bench video: bytes per second at equal PSNR against the float-probe render (≤/≥: beyond the CRF sweep)\n" + table;
   for (auto& [name, series] : chartSeries) {
     imaging::ChartSpec spec;

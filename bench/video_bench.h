@@ -81,7 +81,7 @@ struct VideoBenchOptions {
   std::string preset = "medium";  // x265's preset; AV1 (libaom, realtime) runs at cpu-used 6
   float exposure = 1.0f;
   std::string ffmpeg = "ffmpeg";
-  std::string workDir;  // frames and bitstreams (created; removed at the end unless keepFiles)
+  std::string workDir;  // a folder of the run's own is made in here (removed at the end unless keepFiles)
   bool keepFiles = false;
   std::string command;
   std::function<void(const std::string&)> progress;

@@ -3,6 +3,7 @@
 # and PSNR, a sweep whose lower CRF costs more bytes for a higher PSNR, and the best video's bytes
 # at each stream's PSNR; l2 without the noise rule comes closer to the float probes than zh3 with it.
 file(REMOVE_RECURSE ${WORK})
+file(WRITE ${WORK}/work/mine.txt "a file of the user's in the work folder")
 execute_process(COMMAND ${PROBECAST} bench video --scene builtin:cornell --grid 4,2,4 --spp 8 --motions still=0,fast=0.5
                         --displays stereo=stereo@32x32 --codecs x265-420,av1-444 --x265-crf 8,40 --av1-crf 10,55
                         --streams zh3,l2:0 --frames 6 --warmup 2 --gop 3 --preset ultrafast --work-dir ${WORK}/work
@@ -19,8 +20,13 @@ file(READ ${WORK}/video.svg svg)
 if(NOT svg MATCHES "<svg")
   message(FATAL_ERROR "the chart is not an SVG")
 endif()
-if(EXISTS ${WORK}/work)
-  message(FATAL_ERROR "the work folder was left behind without --keep-files")
+# The run's own folder inside --work-dir is gone without --keep-files; the user's files stay.
+file(GLOB left ${WORK}/work/probecast-video-*)
+if(left)
+  message(FATAL_ERROR "the run's folder was left behind without --keep-files: ${left}")
+endif()
+if(NOT EXISTS ${WORK}/work/mine.txt)
+  message(FATAL_ERROR "bench video removed a file it did not write from --work-dir")
 endif()
 string(JSON n LENGTH "${json}" results)
 if(NOT n EQUAL 2)
