@@ -127,6 +127,7 @@ std::string runVideoComparison(const DemoOptions& o, const DemoRun& run, const s
         "[video.json](video.json); `probecast bench video` measures more motions, displays and codecs.\n\n```\n{}```\n",
         o.repr, r.table);
     report["video"] = r.json;
+    fmt::print("demo: the stream against video of the same views\n{}", r.table);
   } catch (const std::runtime_error& e) {
     progress.finish();
     fmt::print("demo: the comparison with video was left out: {}\n", e.what());
