@@ -186,8 +186,10 @@ def picture_gap(a, work, T, start, t0, outage):
     mean squared error pooled over the instants of each phase: while the light moves, while the
     link is out, and from 2 s after its return until the lighting holds; and the worst instant."""
     ref_dir, sub_dir = os.path.join(work, "reference-snapshots"), os.path.join(work, "first-snapshots")
-    ticks = sorted(set(f for f in os.listdir(ref_dir) if f.endswith(".pcpv")) &
-                   set(f for f in os.listdir(sub_dir) if f.endswith(".pcpv")))
+    def held(folder):  # none when the subscriber never held a volume
+        return set(f for f in os.listdir(folder) if f.endswith(".pcpv")) if os.path.isdir(folder) else set()
+
+    ticks = sorted(held(ref_dir) & held(sub_dir))
     views, size = a.gap_views.split("@")
     phases = {"moving": (T["steady"][0], T["steady"][1]), "outage": None, "after_outage": None}
     if outage:
