@@ -118,6 +118,44 @@ TEST(Service, APacedClientAcksEveryFrameWhateverItsInterval) {
   EXPECT_GT(client.stats().serverLinkWindow, 0u);
 }
 
+TEST(Service, APacedSubscriberHearsStatsBeforeTheDescriptionAnUnpacedOneTheDescriptionFirst) {
+  // A paced subscriber's first message is a small Stats with the heartbeat promise, so its silence
+  // watchdog hears a fresh connection within a round trip however long the description takes;
+  // then the description, then frames. Others get the description first.
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 5, 10ms);
+  auto stub = pb::ProbeStream::NewStub(
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials()));
+  for (const bool paced : {true, false}) {
+    SCOPED_TRACE(paced ? "paced" : "unpaced");
+    grpc::ClientContext ctx;
+    ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+    ctx.set_deadline(std::chrono::system_clock::now() + 10s);
+    auto stream = stub->Subscribe(&ctx);
+    pb::ClientMessage hello;
+    hello.mutable_hello()->set_protocol_version(4);
+    hello.mutable_hello()->set_acks_every_frame(paced);
+    ASSERT_TRUE(stream->Write(hello));
+    pb::ServerMessage msg;
+    ASSERT_TRUE(stream->Read(&msg));
+    if (paced) {
+      ASSERT_TRUE(msg.has_stats());
+      EXPECT_GT(msg.stats().heartbeat_ms(), 0u);
+      ASSERT_TRUE(stream->Read(&msg));
+    }
+    EXPECT_TRUE(msg.has_volume());
+    bool frame = false;
+    while (!frame && stream->Read(&msg)) {
+      EXPECT_FALSE(msg.has_volume()) << "a second description";
+      frame = msg.has_frame();
+    }
+    EXPECT_TRUE(frame);
+    ctx.TryCancel();
+    stream->Finish();
+  }
+}
+
 TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {
   ProbeHub hub(volumeConfig());
   auto server = std::make_unique<ProbeServer>(plaintextConfig(), hub);
