@@ -261,6 +261,7 @@ void addSubscribeCommand(CLI::App& app) {
   };
   auto so = std::make_shared<SubOptions>();
   so->connection.add(sub, "server address host:port (several comma-separated: edges to fail over between)", true, true);
+  so->connection.addLimits(sub);
   sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
   sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
   sub->add_option("--out", so->out, "write the received volume here (probe volume file)");
@@ -310,7 +311,7 @@ void addSubscribeCommand(CLI::App& app) {
       if (client.stats().fatal) break;
       if (so->snapshotEvery > 0 && tickOf(std::chrono::system_clock::now()) >= nextTick) {
         service::VolumeSnapshot held;
-        if (client.snapshot(held)) {
+        if (client.snapshot(held) && held.framesApplied > 0) {  // zeros are not the server's volume
           std::string error;
           orThrow(writeProbeFile(fmt::format("{}/{}.pcpv", so->snapshotDir, nextTick), held.volume, error), error);
           ++written;
@@ -323,6 +324,7 @@ void addSubscribeCommand(CLI::App& app) {
     const service::ClientStats st = client.stats();
     fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects{}\n", st.framesApplied,
                st.framesRejected, st.bytesReceived, st.connects, st.lastError.empty() ? "" : ", last error: " + st.lastError);
+    for (const std::string& line : service::refusalLines(st)) fmt::print("subscribe: refused: {}\n", line);
     if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
     if (st.statsReceived > 0) {
       fmt::print("subscribe: the server counted {} bytes sent, {} frames acked, frame → ack {:.1f} ms, {} bricks behind\n",
@@ -347,6 +349,9 @@ void addSubscribeCommand(CLI::App& app) {
     fmt::print("subscribe: volume checksum {:08x} ({} probes)\n", volumeChecksum(snap.volume), snap.volume.grid.count());
     if (!so->json.empty()) writeSubscribeJson(so->json, client, st, snap);
     if (!so->out.empty()) {
+      // A volume no frame was applied to is zeros, not the server's: nothing is written.
+      if (st.framesApplied == 0)
+        throw std::runtime_error("no frame applied from " + so->connection.connect + ": nothing written to " + so->out);
       std::string error;
       orThrow(writeProbeFile(so->out, snap.volume, error), error);
       fmt::print("wrote {}\n", so->out);

@@ -45,6 +45,7 @@ struct ViewOptions {
   uint64_t sceneMaxBytes = uint64_t{4} << 30;
   LiveWindowOptions window;
   std::string lookingGlass;  // a display's calibration (visual.json)
+  std::optional<service::SceneHash> streamScene;  // --connect: the scene drawn, which the stream must keep naming
   CLI::Option* viewsOption = nullptr;
   CLI::Option* sizeOption = nullptr;
 };
@@ -116,6 +117,11 @@ class StreamStatus {
   double rate_ = 0.0;
 };
 
+// What the client refused from the server, once per reason (wire text escaped).
+void printRefusals(const service::ClientStats& st) {
+  for (const std::string& line : service::refusalLines(st)) fmt::print("view: refused: {}\n", line);
+}
+
 struct Rendered {
   std::vector<renderer::Image> images;
   double viewsMs = 0.0, shadowMs = 0.0;
@@ -138,6 +144,7 @@ session::ViewerConfig streamViewerConfig(const ViewOptions& o, const std::string
   vc.raster = ro;
   vc.client = o.connection.client("probecast-view");
   vc.client.zh3PerPixel = true;
+  vc.client.scene = o.streamScene;
   if (o.repr != "float") vc.client.representation = session::parseRepresentationOrThrow(o.repr);  // transcoded
   if (o.areaLights.mode != "auto") vc.areaLights = o.areaLights.mode == "on";
   vc.sceneSpec = sceneSpec;  // direct light at the display clock, locked to the stream's
@@ -156,10 +163,15 @@ Rendered renderFromServer(const ViewOptions& o, renderer::VulkanContext& context
   const service::ClientStats st = viewer.clientStats();
   // A refused subscription (bad token, too many views) may have delivered part of a volume:
   // rendering it would pass a wrong picture off as the server's.
+  printRefusals(st);
   if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
   service::VolumeSnapshot held;
-  if (!viewer.snapshot(held))
-    throw std::runtime_error("no probe volume from " + o.connection.connect + ": " + st.lastError);
+  // A description without a frame applied is a volume of zeros: drawing it would pass darkness off
+  // as the server's light.
+  if (!viewer.snapshot(held) || st.framesApplied == 0)
+    throw std::runtime_error("no probe lighting from " + o.connection.connect + " in " +
+                             fmt::format("{:g}", o.waitSeconds) + " s" +
+                             (st.lastError.empty() ? std::string() : ": " + st.lastError));
   fmt::print("view: {} frames ({} bytes) from {}\n", st.framesApplied, st.bytesReceived, o.connection.connect);
   o.areaLights.follow(held.volume.areaLights, o.connection.connect);  // refused before anything is drawn
   viewer.render();
@@ -242,6 +254,7 @@ void windowFromServer(const ViewOptions& o, renderer::VulkanContext& context, co
                 glm::length(s.boundsMax - s.boundsMin), source, o.out, o.exposure, toneMapOf(o));
   viewer.stop();
   const service::ClientStats st = viewer.clientStats();
+  printRefusals(st);
   if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
 }
 
@@ -337,6 +350,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--probes", o->probes, "probe volume file, or 'live' to trace it now");
   cmd->add_option("--updates", o->updates, "live: updates to accumulate")->check(CLI::Range(1, 100000));
   o->connection.add(cmd, "take the probes from a probecast server (host:port) instead", false, false);
+  o->connection.addLimits(cmd);
   cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
       ->check(CLI::Range(0.1, 3600.0));
   o->viewsOption =
@@ -388,10 +402,13 @@ void addViewCommand(CLI::App& app) {
     std::string sceneSpec = o->tracing.scene.scene;
     double t = o->tracing.scene.t;
     std::shared_ptr<const renderer::Environment> environment;
+    session::ViewerScene streamed;
     if (!o->connection.connect.empty()) {
       if (o->tracing.scene.tOption->count() > 0)
         throw std::runtime_error("--time: a viewer of a stream draws at the stream's scene clock");
-      const session::ViewerScene vs = streamScene(*o);
+      streamed = streamScene(*o);
+      const session::ViewerScene& vs = streamed;
+      o->streamScene = vs.hash;
       sceneSpec = vs.spec;
       t = vs.time;
       environment = vs.environmentFile.empty() && vs.lighting.kind == service::SceneLighting::Kind::None
@@ -400,7 +417,7 @@ void addViewCommand(CLI::App& app) {
     } else {
       environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     }
-    const scene::Scene s = session::loadSceneOrThrow(sceneSpec, t);
+    const scene::Scene s = session::loadSceneOrThrow(sceneSpec, t, streamed.packaged ? &*streamed.packaged : nullptr);
     std::optional<renderer::LookingGlassCalibration> lg;
     if (!o->lookingGlass.empty()) {
       lg = renderer::loadLookingGlassCalibration(o->lookingGlass);

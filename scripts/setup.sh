@@ -11,7 +11,7 @@ PACKAGES=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   nats-server libnats-dev
   libglfw3-dev xvfb xauth xdotool libmeshoptimizer-dev
-  clang-14 libclang-rt-14-dev openssl libssl-dev
+  clang-14 libclang-rt-14-dev openssl libssl-dev strace
   python3-dev python3-numpy python3-pytest python3-matplotlib pybind11-dev python3-venv
   emscripten node-acorn nodejs chromium ffmpeg
 )

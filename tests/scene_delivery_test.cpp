@@ -164,6 +164,67 @@ TEST(ScenePackage, ManifestsAreCheckedBeforeAnythingIsTrusted) {
   EXPECT_NE(refusal(twice).find("twice"), std::string::npos) << twice;
 }
 
+TEST(ScenePackage, ManifestsAreCanonicalAndTheirSizesCannotWrap) {
+  const std::string hash(64, 'a');
+  const auto manifest = [&](const std::vector<std::pair<std::string, std::string>>& files) {
+    std::string f;
+    for (const auto& [path, bytes] : files)
+      f += (f.empty() ? "" : ",") + R"({"bytes":)" + bytes + R"(,"path":")" + path + R"(","sha256":")" + hash + R"("})";
+    return R"({"files":[)" + f + R"(],"format":1,"lighting":{},"scene":{"gltf":"s.gltf"}})";
+  };
+  ScenePackage p;
+  std::string error;
+  // 7630 + (2^64 - 1) + 2 wraps to 7631 in 64 bits.
+  EXPECT_FALSE(parseManifest(manifest({{"a.bin", "18446744073709551615"}, {"b.bin", "2"}, {"s.gltf", "7630"}}), p, error));
+  EXPECT_NE(error.find("add up to more than 1099511627776 bytes"), std::string::npos) << error;
+  EXPECT_FALSE(parseManifest(manifest({{"a.bin", "1099511627000"}, {"s.gltf", "1000"}}), p, error));
+  EXPECT_NE(error.find("add up to more than"), std::string::npos) << error;
+  const std::string good = manifest({{"a.bin", "1099511627000"}, {"s.gltf", "576"}});  // exactly 1 TiB
+  ASSERT_TRUE(parseManifest(good, p, error)) << error;
+  EXPECT_EQ(p.totalBytes(), kMaxPackageBytes);
+  // The same package spelled otherwise: whitespace, keys out of order, a key twice.
+  for (const std::string& other :
+       {std::string(" ") + good, good.substr(0, good.size() - 1) + " }",
+        R"({"format":1,"files":[],"lighting":{},"scene":{"builtin":"cornell"}})",
+        R"({"files":[],"format":1,"format":1,"lighting":{},"scene":{"builtin":"cornell"}})"}) {
+    EXPECT_FALSE(parseManifest(other, p, error)) << other;
+    EXPECT_NE(error.find("not canonical"), std::string::npos) << error;
+  }
+  EXPECT_FALSE(parseManifest("{\"files\":[],\"format\":1,\"lighting\":{},\"scene\":{\"builtin\":\"\xff\xfe\"}}", p, error));
+  EXPECT_NE(error.find("UTF-8"), std::string::npos) << error;
+  EXPECT_FALSE(parseManifest(R"({"files":[],"format":1,"lighting":{},"scene":{"builtin":"\u001b[2J"}})", p, error));
+  EXPECT_NE(error.find("is not a name"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\x1b'), std::string::npos) << error;
+}
+
+TEST(ScenePackage, WireTextIsPrintedWithoutEscapeSequences) {
+  EXPECT_EQ(printableText("plain text, ünïcode ✓"), "plain text, ünïcode ✓");
+  EXPECT_EQ(printableText("\x1b[2J\x07"), "\\x1b[2J\\x07");
+  EXPECT_EQ(printableText("a\xc2\x9b" "31m"), "a\\xc2\\x9b31m");  // C1 control: CSI
+  EXPECT_EQ(printableText("\xff\xc3"), "\\xff\\xc3");              // not UTF-8, cut short
+  EXPECT_EQ(printableText("\xed\xa0\x80"), "\\xed\\xa0\\x80");    // a surrogate
+  EXPECT_EQ(printableText(std::string(1000, 'a'), 10), "aaaaaaaaaa... (cut)");
+}
+
+TEST(ScenePackage, ACachedPackageReachedThroughALinkIsNotUsed) {
+  const fs::path src = freshDir("link-source"), cache = freshDir("link-cache");
+  const ScenePackage p = packageOf(writeScene(src));
+  const fs::path files = cache / hexOf(p.hash) / "files";
+  for (const PackageFile& f : p.files) writeBytes(files / f.path, std::string(f.bytes, 'x'));
+  writeBytes(cache / hexOf(p.hash) / "manifest.json", p.manifest);
+  ScenePackage out;
+  ASSERT_TRUE(findCachedPackage(cache, p.hash, out));  // sizes match: whole (hashes are checked on arrival)
+  fs::remove(files / "room.bin");
+  writeBytes(src / "outside.bin", std::string(16, 'y'));
+  fs::create_symlink(src / "outside.bin", files / "room.bin");
+  EXPECT_FALSE(findCachedPackage(cache, p.hash, out));
+  fs::remove(files / "room.bin");
+  writeBytes(files / "room.bin", std::string(16, 'x'));
+  fs::rename(files / "textures", cache / "textures");
+  fs::create_directory_symlink(cache / "textures", files / "textures");
+  EXPECT_FALSE(findCachedPackage(cache, p.hash, out));
+}
+
 TEST(ScenePackage, TheCacheHoldsOnlyWholeCheckedPackages) {
   const fs::path src = freshDir("cache-source"), cache = freshDir("cache");
   const ScenePackage p = packageOf(writeScene(src));

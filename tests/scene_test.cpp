@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include "gltf_test_files.h"
@@ -118,6 +119,69 @@ TEST(Scene, BrokenFilesFailWithClearMessages) {
       "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
   EXPECT_FALSE(loadGltf(shortBuffer, s, error));
   EXPECT_FALSE(error.empty());
+}
+
+// A one-triangle glTF in `dir` whose buffer is `bufferUri` (36 bytes) and, when given, whose base
+// colour texture is `imageUri`.
+std::string triangleGltf(const std::filesystem::path& dir, const std::string& bufferUri, const std::string& imageUri = "") {
+  std::filesystem::create_directories(dir);
+  std::string json = R"({"asset":{"version":"2.0"},"buffers":[{"uri":")" + bufferUri + R"(","byteLength":36}],)"
+                     R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                     R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",)"
+                     R"("min":[0,0,0],"max":[1,1,0]}],"materials":[{"pbrMetallicRoughness":{)";
+  if (!imageUri.empty()) json += R"("baseColorTexture":{"index":0})";
+  json += R"(}}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],)";
+  if (!imageUri.empty()) json += R"("images":[{"uri":")" + imageUri + R"("}],"textures":[{"source":0}],)";
+  json += R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0})";
+  const std::string path = (dir / "scene.gltf").string();
+  test::writeFile(path, json);
+  return path;
+}
+
+std::string triangleBytes() {
+  const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  return std::string(reinterpret_cast<const char*>(p), sizeof p);
+}
+
+TEST(Scene, AGltfReadsOnlyInsideItsFolderAndAPackagedOneOnlyItsListedFiles) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::path(PROBECAST_TEST_TMP) / "gltf_files";
+  fs::remove_all(root);
+  fs::create_directories(root / "pkg");
+  test::writeFile((root / "outside.bin").string(), triangleBytes());
+  test::writeFile((root / "pkg" / "tri.bin").string(), triangleBytes());
+  test::writeFile((root / "pkg" / "pixel.png").string(), test::pngFile(1, 1, 3, 8, {255, 0, 255}));
+  Scene s;
+  std::string error;
+  const auto refused = [&](const std::string& gltf, const PackagedFiles* packaged = nullptr) {
+    error.clear();
+    EXPECT_FALSE(loadGltf(gltf, s, error, 0.0, packaged)) << gltf;
+    return error;
+  };
+  // Outside the folder, however spelled: each refused by name, the file never read.
+  EXPECT_NE(refused(triangleGltf(root / "pkg", "../outside.bin")).find("leaves the glTF's folder"), std::string::npos) << error;
+  EXPECT_NE(refused(triangleGltf(root / "pkg", "%2E%2E/outside.bin")).find("leaves the glTF's folder"), std::string::npos) << error;
+  EXPECT_NE(refused(triangleGltf(root / "pkg", (root / "outside.bin").string())).find("refused to read"), std::string::npos) << error;
+  EXPECT_NE(refused(triangleGltf(root / "pkg", "file://" + (root / "outside.bin").string())).find("URI scheme"), std::string::npos) << error;
+  EXPECT_NE(refused(triangleGltf(root / "pkg", "tri.bin", "../../pixel.png")).find("leaves the glTF's folder"), std::string::npos) << error;
+  // Not in the folder: not looked for in the working folder either.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(root);
+  EXPECT_NE(refused(triangleGltf(root / "pkg", "outside.bin")).find("File not found"), std::string::npos) << error;
+  fs::current_path(cwd);
+  // Inside: loads, and a package's listed files load.
+  const std::string inside = triangleGltf(root / "pkg", "tri.bin", "pixel.png");
+  ASSERT_TRUE(loadGltf(inside, s, error)) << error;
+  PackagedFiles listed{{"tri.bin", "pixel.png"}};
+  ASSERT_TRUE(loadGltf(inside, s, error, 0.0, &listed)) << error;
+  PackagedFiles bufferOnly{{"tri.bin"}};
+  EXPECT_NE(refused(inside, &bufferOnly).find("'" + (root / "pkg" / "pixel.png").string() + "' is not a file of the scene's package"),
+            std::string::npos) << error;
+  // A listed file that is a link out of the package.
+  fs::remove(root / "pkg" / "tri.bin");
+  fs::create_symlink(root / "outside.bin", root / "pkg" / "tri.bin");
+  EXPECT_NE(refused(inside, &listed).find("is a symbolic link"), std::string::npos) << error;
+  EXPECT_TRUE(loadGltf(inside, s, error)) << error;  // a local scene's own link is its owner's choice
 }
 
 TEST(Scene, NanPositionsAreRejected) {

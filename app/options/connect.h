@@ -16,6 +16,15 @@ namespace probecast::app {
 // A client's connection to a server: --connect, --token (and --token-file), --tls-ca, --tls-name.
 struct ConnectOptions {
   std::string connect, token, tokenFile, tlsCa, tlsName;
+  uint64_t maxProbes = uint64_t{1} << 21;  // a 128³ volume: 226 MB as floats
+  // --max-probes, for commands that hold and write what a server describes.
+  void addLimits(CLI::App* cmd) {
+    cmd->add_option("--max-probes", maxProbes,
+                    "the largest probe volume accepted from a server (a description of more is refused before "
+                    "anything is set aside for it)")
+        ->check(CLI::Range(uint64_t{1}, uint64_t{kMaxProbes}))
+        ->capture_default_str();
+  }
   void add(CLI::App* cmd, const std::string& what, bool required, bool withTokenFile) {
     CLI::Option* c = cmd->add_option("--connect", connect, what);
     if (required) c->required();
@@ -38,6 +47,7 @@ struct ConnectOptions {
     cc.address = cc.addresses.front();
     cc.token = tokenFrom(token, tokenFile);
     cc.name = name;
+    cc.maxProbes = maxProbes;
     if (!tlsCa.empty()) {
       cc.tls = true;
       cc.rootCertPem = readTextFile(tlsCa);

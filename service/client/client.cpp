@@ -61,7 +61,71 @@ bool readDescription(const pb::VolumeDescription& v, StreamLayout& l, GridBounds
   return parseManifest(scene.manifest, named, why);
 }
 
+// A frame's own counts of keyframe and delta sections (Frame.keyframes, deltas) against its
+// payload: a frame holding that many sections (the decoder checks the rest). The kinds are the
+// server's account: a delta in another representation than the brick's last travels as a keyframe.
+bool countsMatch(const pb::Frame& f, std::string& why) {
+  FrameHeader header;
+  const CodecStatus st = verifyFrame(reinterpret_cast<const uint8_t*>(f.payload().data()), f.payload().size(), &header);
+  if (st != CodecStatus::Ok) return why = std::string("its payload is no frame: ") + codecStatusName(st), false;
+  if (uint64_t{f.keyframes()} + f.deltas() != header.sectionCount)
+    return why = "it claims " + std::to_string(f.keyframes()) + " keyframes and " + std::to_string(f.deltas()) +
+                 " deltas, its payload holds " + std::to_string(header.sectionCount) + " sections", false;
+  return true;
+}
+
+// Cancels a call that makes no progress for `stallMs`: a server that stops sending mid-transfer
+// cannot hold the caller. progress() after every message; stalled() tells whether it cancelled.
+class StallGuard {
+ public:
+  StallGuard(grpc::ClientContext& ctx, int stallMs) : thread_([this, &ctx, stallMs] { watch(ctx, stallMs); }) {}
+  ~StallGuard() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  StallGuard(const StallGuard&) = delete;
+  StallGuard& operator=(const StallGuard&) = delete;
+  void progress() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++progress_;
+    wake_.notify_all();
+  }
+  bool stalled() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return stalled_;
+  }
+
+ private:
+  void watch(grpc::ClientContext& ctx, int stallMs) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!done_) {
+      const uint64_t seen = progress_;
+      if (!wake_.wait_for(lock, std::chrono::milliseconds(stallMs), [&] { return done_ || progress_ != seen; })) {
+        stalled_ = true;
+        ctx.TryCancel();
+        return;
+      }
+    }
+  }
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  uint64_t progress_ = 0;
+  bool done_ = false, stalled_ = false;
+  std::thread thread_;  // last: it starts once the members above are made
+};
+
 }  // namespace
+
+std::vector<std::string> refusalLines(const ClientStats& stats) {
+  std::vector<std::string> lines;
+  for (const Refusal& r : stats.refusals)
+    lines.push_back(r.count == 1 ? r.reason : r.reason + " (" + std::to_string(r.count) + " times)");
+  return lines;
+}
 
 struct ProbeClient::Impl {
   ClientConfig config;
@@ -122,7 +186,25 @@ struct ProbeClient::Impl {
 
   std::shared_ptr<grpc::Channel> channel(const std::string& address) const { return makeChannel(config, address); }
 
-  // False for a description the client cannot use: the connection is dropped and retried later.
+  // Counts `reason` (mutex held) and keeps it as the last error, escaped for printing.
+  void refuse(const std::string& reason) {
+    stats.lastError = printableText(reason);
+    for (Refusal& r : stats.refusals)
+      if (r.reason == stats.lastError) return void(r.count += 1);
+    if (stats.refusals.size() < 32) stats.refusals.push_back({stats.lastError, 1});
+    else stats.refusals.back().count += 1;
+  }
+
+  // A description this client will never use (another scene than the one it draws, a volume
+  // beyond its limit): it stops (fatal) instead of asking again.
+  bool refuseForGood(const std::string& reason) {
+    refuse(reason);
+    stats.fatal = true;
+    return false;
+  }
+
+  // False for a description the client cannot use: the connection is dropped and retried later
+  // (or, refuseForGood, never).
   bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
     StreamLayout l;
     GridBounds b;
@@ -131,15 +213,18 @@ struct ProbeClient::Impl {
     SceneStamp sc;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
-    if (!readDescription(v, l, b, o, r, sc, why)) {
-      stats.lastError = "bad volume description: " + why;
-      return false;
-    }
-    if (config.representation && l.repr != *config.representation) {
-      stats.lastError = std::string("the server streams ") + representationName(l.repr) + ", not the " +
-                        representationName(*config.representation) + " asked for";
-      return false;
-    }
+    if (!readDescription(v, l, b, o, r, sc, why)) return refuse("bad volume description: " + why), false;
+    const uint64_t probes = uint64_t{l.grid[0]} * l.grid[1] * l.grid[2];
+    if (probes > config.maxProbes)
+      return refuseForGood("the volume description holds " + std::to_string(probes) + " probes, more than the " +
+                           std::to_string(config.maxProbes) + " this client accepts");
+    if (config.scene && (!sc.known() || sc.hash != *config.scene))
+      return refuseForGood("the stream names scene " + (sc.known() ? shortHex(sc.hash) : std::string("(none)")) +
+                           ", not the scene " + shortHex(*config.scene) + " its description named before; "
+                           "this viewer draws that one and stops");
+    if (config.representation && l.repr != *config.representation)
+      return refuse(std::string("the server streams ") + representationName(l.repr) + ", not the " +
+                    representationName(*config.representation) + " asked for"), false;
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
     if (!same || v.stream_epoch() != epoch || !(r == areaLights) || sc.hash != scene.hash) {  // nothing held is valid
@@ -162,22 +247,20 @@ struct ProbeClient::Impl {
   // Returns false when the connection should be dropped (the server and we disagree on state).
   bool onFrame(const pb::Frame& f) {
     std::lock_guard<std::mutex> lock(mutex);
-    if (!decoder) {
-      stats.lastError = "frame before volume description";
-      return false;
-    }
+    if (!decoder) return refuse("frame before volume description"), false;
     bus::SceneState frameState;
     std::string why;
-    if (f.has_scene_state() && !stateFromWire(f.scene_state(), frameState, why)) {
+    if ((f.has_scene_state() && !stateFromWire(f.scene_state(), frameState, why)) ||
+        !countsMatch(f, why)) {
       stats.framesRejected += 1;
-      stats.lastError = "frame refused: " + why;
+      refuse("frame refused: " + why);
       return false;
     }
     const auto* data = reinterpret_cast<const uint8_t*>(f.payload().data());
     const CodecStatus st = decoder->apply(data, f.payload().size());
     if (st != CodecStatus::Ok) {
       stats.framesRejected += 1;
-      stats.lastError = std::string("frame rejected: ") + codecStatusName(st);
+      refuse(std::string("frame rejected: ") + codecStatusName(st));
       return st != CodecStatus::BaseVersionMismatch;  // resubscribe to tell the server what we hold
     }
     stats.framesApplied += 1;
@@ -315,10 +398,11 @@ struct ProbeClient::Impl {
         wasSilenced = silenced;
         silenced = false;
         if (wasSilenced)
-          stats.lastError = servers[at] + ": the connection went silent (the server promised a message every " +
-                            std::to_string(heartbeatMs) + " ms): connecting afresh";
+          refuse(servers[at] + ": the connection went silent (the server promised a message every " +
+                 std::to_string(heartbeatMs) + " ms): connecting afresh");
         else if (!status.ok() && !stopping && !dropped)
-          stats.lastError = servers[at] + ": " + status.error_message();
+          refuse(servers[at] + ": " + status.error_message());
+        if (stats.fatal) return;  // a description refused for good
         if (code == grpc::StatusCode::UNAUTHENTICATED || code == grpc::StatusCode::INVALID_ARGUMENT ||
             code == grpc::StatusCode::PERMISSION_DENIED) {
           stats.fatal = true;
@@ -470,10 +554,11 @@ bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& err
     std::vector<float> o;
     AreaLightRule r;
     std::string why;
-    if (!readDescription(v, l, b, o, r, out, why)) return error = server + ": bad volume description: " + why, false;
+    if (!readDescription(v, l, b, o, r, out, why))
+      return error = printableText(server + ": bad volume description: " + why, 2048), false;
     return true;
   }
-  return error = "no server described its stream: " + errors, false;
+  return error = printableText("no server described its stream: " + errors, 2048), false;
 }
 
 bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::filesystem::path& cache,
@@ -511,15 +596,19 @@ bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::
     PackageWriter writer(cache, named);
     pb::SceneChunk chunk;
     bool ok = writer.begin(error);  // false: a local failure, the call is cancelled
+    StallGuard guard(ctx, config.sceneStallMs);
     const bool answered = ok && reader->Read(&chunk);
     if (answered && chunk.manifest() != scene.manifest) ok = false, error = "it sent another manifest than its description";
     uint64_t bytes = 0;
     while (ok && answered && reader->Read(&chunk)) {
+      guard.progress();
       ok = writer.write(chunk.path(), chunk.offset(), chunk.data(), error);
       bytes += chunk.data().size();
     }
     if (!ok) ctx.TryCancel();
     const grpc::Status status = reader->Finish();
+    if (guard.stalled())
+      ok = false, error = "it sent nothing for " + std::to_string(config.sceneStallMs) + " ms";
     if (ok && answered && status.ok() && writer.finish(out, error)) {
       fetch.bytes = bytes;
       fetch.ms = elapsedMs();
@@ -529,7 +618,7 @@ bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::
     errors += (errors.empty() ? "" : "; ") + server + ": " + (ok && !status.ok() ? status.error_message() : error);
     if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) break;
   }
-  return error = "cannot fetch the scene: " + errors, false;
+  return error = printableText("cannot fetch the scene: " + errors, 2048), false;
 }
 
 }  // namespace probecast::service

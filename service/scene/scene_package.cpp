@@ -91,6 +91,9 @@ bool gltfUris(const fs::path& path, const json& gltf, std::vector<std::string>& 
       if (uri.rfind("data:", 0) == 0) continue;
       std::string decoded;
       if (!percentDecode(uri, decoded)) return error = path.string() + ": malformed uri '" + uri + "'", false;
+      if (decoded.substr(0, decoded.find('/')).find(':') != std::string::npos)
+        return error = path.string() + ": uri '" + uri + "' names a URI scheme; a scene that is delivered keeps its "
+                                        "files beside it", false;
       if (!isSafePackagePath(decoded))
         return error = path.string() + ": uri '" + uri + "' leaves the glTF's folder (or is absolute); a scene "
                                         "that is delivered keeps its files beside it", false;
@@ -160,7 +163,7 @@ bool parseLighting(const json& l, ScenePackage& p, std::string& error) {
     out.file = e["file"].get<std::string>();
     bool listed = false;
     for (const PackageFile& f : p.files) listed |= f.path == out.file;
-    if (!listed) return error = "manifest environment file '" + out.file + "' is not among its files", false;
+    if (!listed) return error = "manifest environment file '" + printableText(out.file) + "' is not among its files", false;
   } else if (l.contains("sky")) {
     const json& s = l["sky"];
     if (!s.is_array() || s.size() != 3) return error = "manifest sky is not 3 numbers", false;
@@ -177,6 +180,7 @@ bool parseFiles(const json& files, ScenePackage& p, std::string& error) {
   if (!files.is_array() || files.size() > kMaxPackageFiles)
     return error = "manifest files is not an array of at most " + std::to_string(kMaxPackageFiles), false;
   std::set<std::string> seen;
+  uint64_t total = 0;  // each file at most kMaxPackageBytes, so the sum of 4096 cannot wrap
   for (const json& f : files) {
     if (!f.is_object() || f.size() != 3 || !f.contains("path") || !f["path"].is_string() || !f.contains("bytes") ||
         !f["bytes"].is_number_unsigned() || !f.contains("sha256") || !f["sha256"].is_string())
@@ -184,12 +188,27 @@ bool parseFiles(const json& files, ScenePackage& p, std::string& error) {
     PackageFile pf;
     pf.path = f["path"].get<std::string>();
     pf.bytes = f["bytes"].get<uint64_t>();
-    if (!isSafePackagePath(pf.path)) return error = "manifest names an unsafe path '" + pf.path + "'", false;
-    if (!seen.insert(pf.path).second) return error = "manifest names '" + pf.path + "' twice", false;
-    if (!parseHex(f["sha256"].get<std::string>(), pf.sha256)) return error = "manifest sha256 of '" + pf.path + "' is not 64 hex digits", false;
+    if (!isSafePackagePath(pf.path))
+      return error = "manifest names an unsafe path '" + printableText(pf.path) + "'", false;
+    if (pf.bytes > kMaxPackageBytes || kMaxPackageBytes - pf.bytes < total)
+      return error = "manifest files add up to more than " + std::to_string(kMaxPackageBytes) + " bytes", false;
+    total += pf.bytes;
+    if (!seen.insert(pf.path).second) return error = "manifest names '" + printableText(pf.path) + "' twice", false;
+    if (!parseHex(f["sha256"].get<std::string>(), pf.sha256)) return error = "manifest sha256 of '" + printableText(pf.path) + "' is not 64 hex digits", false;
     p.files.push_back(std::move(pf));
   }
   return true;
+}
+
+// Whether `inside` below `root` is a regular file reached without a symbolic link.
+bool isPlainFileBelow(const fs::path& root, const std::string& inside) {
+  std::error_code ec;
+  fs::path at = root;
+  for (const fs::path& part : fs::path(inside)) {
+    at /= part;
+    if (fs::is_symlink(fs::symlink_status(at, ec))) return false;
+  }
+  return fs::is_regular_file(fs::symlink_status(at, ec));
 }
 
 }  // namespace
@@ -253,9 +272,48 @@ bool isSafePackagePath(std::string_view path) {
   return true;
 }
 
+namespace {
+
+// The length of the UTF-8 sequence at `s` (1 to 4), or 0 when it is not one (overlong, surrogate,
+// beyond U+10FFFF, cut short).
+size_t utf8Length(std::string_view s) {
+  const auto b = [&](size_t i) { return static_cast<unsigned char>(s[i]); };
+  const size_t n = b(0) < 0x80 ? 1 : b(0) >= 0xC2 && b(0) <= 0xDF ? 2 : b(0) >= 0xE0 && b(0) <= 0xEF ? 3
+                                 : b(0) >= 0xF0 && b(0) <= 0xF4 ? 4 : 0;
+  if (n == 0 || n > s.size()) return 0;
+  for (size_t i = 1; i < n; ++i)
+    if ((b(i) & 0xC0) != 0x80) return 0;
+  if (n == 3 && ((b(0) == 0xE0 && b(1) < 0xA0) || (b(0) == 0xED && b(1) >= 0xA0))) return 0;
+  if (n == 4 && ((b(0) == 0xF0 && b(1) < 0x90) || (b(0) == 0xF4 && b(1) >= 0x90))) return 0;
+  return n;
+}
+
+}  // namespace
+
+std::string printableText(std::string_view text, size_t limit) {
+  std::string out;
+  size_t i = 0;
+  while (i < text.size() && out.size() < limit) {
+    const size_t n = utf8Length(text.substr(i));
+    const auto c = static_cast<unsigned char>(text[i]);
+    const bool control = n == 1 ? (c < 0x20 || c == 0x7F) : n == 2 && c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0;
+    if (n == 0 || control) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+      i += 1;
+      continue;
+    }
+    out.append(text.substr(i, n));
+    i += n;
+  }
+  if (i < text.size()) out += "... (cut)";
+  return out;
+}
+
 uint64_t ScenePackage::totalBytes() const {
   uint64_t n = 0;
-  for (const PackageFile& f : files) n += f.bytes;
+  for (const PackageFile& f : files) n = f.bytes > UINT64_MAX - n ? UINT64_MAX : n + f.bytes;  // saturates
   return n;
 }
 
@@ -281,7 +339,7 @@ fs::path ScenePackage::localEnvironmentFile() const {
 }
 
 std::string ScenePackage::describe() const {
-  std::string s = scene;
+  std::string s = printableText(scene);
   if (!files.empty()) {
     char size[64];
     std::snprintf(size, sizeof size, " (%zu files, %.1f MB)", files.size(), static_cast<double>(totalBytes()) / 1e6);
@@ -336,7 +394,10 @@ bool parseManifest(std::string_view text, ScenePackage& out, std::string& error)
     return error = "scene manifest of " + std::to_string(text.size()) + " bytes (at most " +
                    std::to_string(kMaxManifestBytes) + ")", false;
   const json m = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (m.is_discarded() || !m.is_object()) return error = "scene manifest is not a JSON object", false;
+  if (m.is_discarded() || !m.is_object()) return error = "scene manifest is not a JSON object (in UTF-8)", false;
+  // One package, one text: a manifest is hashed as it is, so it must be the canonical one (keys
+  // sorted, once each, no whitespace), or two texts would name one package under two hashes.
+  if (m.dump() != text) return error = "scene manifest is not canonical JSON (keys sorted and once each, no whitespace)", false;
   if (!m.contains("format") || m["format"] != kSceneManifestFormat)
     return error = "scene manifest format is not " + std::to_string(kSceneManifestFormat), false;
   if (m.size() != 4 || !m.contains("files") || !m.contains("lighting") || !m.contains("scene"))
@@ -346,11 +407,15 @@ bool parseManifest(std::string_view text, ScenePackage& out, std::string& error)
   const json& s = m["scene"];
   if (s.is_object() && s.size() == 1 && s.contains("builtin") && s["builtin"].is_string()) {
     p.scene = "builtin:" + s["builtin"].get<std::string>();
+    const std::string name = p.scene.substr(8);
+    if (name.empty() || name.size() > 64 ||
+        name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos)
+      return error = "manifest builtin scene '" + printableText(name) + "' is not a name (a-z, 0-9, - and _)", false;
   } else if (s.is_object() && s.size() == 1 && s.contains("gltf") && s["gltf"].is_string()) {
     p.scene = s["gltf"].get<std::string>();
     bool listed = false;
     for (const PackageFile& f : p.files) listed |= f.path == p.scene;
-    if (!listed) return error = "manifest scene '" + p.scene + "' is not among its files", false;
+    if (!listed) return error = "manifest scene '" + printableText(p.scene) + "' is not among its files", false;
   } else {
     return error = "manifest scene is neither {\"builtin\": NAME} nor {\"gltf\": PATH}", false;
   }
@@ -375,9 +440,10 @@ bool findCachedPackage(const fs::path& cache, const SceneHash& hash, ScenePackag
   if (!fs::is_regular_file(dir / "manifest.json", ec) || !readFile(dir / "manifest.json", text, error)) return false;
   ScenePackage p;
   if (!parseManifest(text, p, error) || p.hash != hash) return false;
+  if (fs::is_symlink(fs::symlink_status(dir, ec)) || fs::is_symlink(fs::symlink_status(dir / "files", ec))) return false;
   for (PackageFile& f : p.files) {
     f.source = dir / "files" / f.path;
-    if (fs::file_size(f.source, ec) != f.bytes || ec) return false;
+    if (!isPlainFileBelow(dir / "files", f.path) || fs::file_size(f.source, ec) != f.bytes || ec) return false;
   }
   out = std::move(p);
   return true;
@@ -414,16 +480,16 @@ bool PackageWriter::write(std::string_view path, uint64_t offset, std::string_vi
     const PackageFile& f = package_.files[i];
     if (f.path != path) continue;
     if (offset != written_[i] || data.size() > f.bytes - written_[i])
-      return error = "scene file " + f.path + ": a piece at " + std::to_string(offset) + " of " +
+      return error = "scene file " + printableText(f.path) + ": a piece at " + std::to_string(offset) + " of " +
                      std::to_string(data.size()) + " bytes does not follow the " + std::to_string(written_[i]) +
                      " bytes held (the file has " + std::to_string(f.bytes) + ")", false;
     std::ofstream out(staging_ / "files" / f.path, std::ios::binary | std::ios::app);
     out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    if (!out) return error = "scene cache: cannot write " + f.path, false;
+    if (!out) return error = "scene cache: cannot write " + printableText(f.path), false;
     written_[i] += data.size();
     return true;
   }
-  return error = "the server sent a file the manifest does not name: " + std::string(path), false;
+  return error = "the server sent a file the manifest does not name: " + printableText(path), false;
 }
 
 bool PackageWriter::finish(ScenePackage& out, std::string& error) {
@@ -434,7 +500,7 @@ bool PackageWriter::finish(ScenePackage& out, std::string& error) {
     uint64_t bytes = 0;
     if (!sha256File(f.source, h, bytes, error)) return false;
     if (bytes != f.bytes || h != f.sha256)
-      return error = "scene file " + f.path + " arrived as " + std::to_string(bytes) + " bytes with another SHA-256 "
+      return error = "scene file " + printableText(f.path) + " arrived as " + std::to_string(bytes) + " bytes with another SHA-256 "
                      "than its manifest's (" + std::to_string(f.bytes) + " bytes)", false;
   }
   const fs::path dir = cache_ / hexOf(package_.hash);

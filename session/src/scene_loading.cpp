@@ -6,10 +6,10 @@
 
 namespace probecast::session {
 
-scene::Scene loadSceneOrThrow(const std::string& spec, double seconds) {
+scene::Scene loadSceneOrThrow(const std::string& spec, double seconds, const scene::PackagedFiles* packaged) {
   scene::Scene s;
   std::string error;
-  if (!scene::loadScene(spec, seconds, s, error)) throw std::runtime_error(error);
+  if (!scene::loadScene(spec, seconds, s, error, packaged)) throw std::runtime_error(error);
   return s;
 }
 

@@ -70,9 +70,20 @@ float animationT(double sceneTime) {
 
 namespace {
 
+// The files a package's glTF may read: the package's, relative to the glTF's folder.
+scene::PackagedFiles packagedFiles(const service::ScenePackage& p) {
+  scene::PackagedFiles files;
+  const size_t slash = p.scene.rfind('/');
+  const std::string folder = slash == std::string::npos ? std::string() : p.scene.substr(0, slash + 1);
+  for (const service::PackageFile& f : p.files)
+    if (f.path != p.scene && f.path.rfind(folder, 0) == 0) files.listed.push_back(f.path.substr(folder.size()));
+  return files;
+}
+
 ViewerScene fromPackage(const service::ScenePackage& p, bool checked, std::string note) {
   ViewerScene v;
   v.spec = p.localSceneSpec();
+  if (!p.builtin()) v.packaged = packagedFiles(p);
   v.environmentFile = p.localEnvironmentFile();
   v.lighting = p.lighting;
   v.checked = checked;
@@ -93,8 +104,10 @@ std::string fetchNote(const service::ScenePackage& p, const service::SceneFetch&
 
 }  // namespace
 
-ViewerScene resolveViewerScene(const SceneStamp& stamp, const SceneChoice& choice,
-                               const service::ClientConfig& client, service::SceneFetch& fetch) {
+namespace {
+
+ViewerScene resolve(const SceneStamp& stamp, const SceneChoice& choice, const service::ClientConfig& client,
+                    service::SceneFetch& fetch) {
   std::string error;
   if (!stamp.known()) {
     if (choice.localSpec.empty())
@@ -129,11 +142,14 @@ ViewerScene resolveViewerScene(const SceneStamp& stamp, const SceneChoice& choic
       throw std::runtime_error("--environment/--sky light the scene otherwise than the server does: yours " +
                                local.describe() + ", the stream's " + stream.describe() +
                                "; leave them out to use the server's");
-    return fromPackage(local, true, "scene " + local.describe() + " as given, matching the stream's");
+    ViewerScene v = fromPackage(local, true, "scene " + local.describe() + " as given, matching the stream's");
+    v.packaged.reset();  // the viewer's own files
+    return v;
   }
   if (stream.lighting.kind != service::SceneLighting::Kind::Environment) {
     ViewerScene v = fromPackage(local, true, "scene " + local.scene + " as given, matching the stream's (" +
                                                  stream.describe() + ")");
+    v.packaged.reset();  // the viewer's own files
     v.lighting = stream.lighting;
     return v;
   }
@@ -141,7 +157,17 @@ ViewerScene resolveViewerScene(const SceneStamp& stamp, const SceneChoice& choic
   if (!service::fetchScene(client, stamp, choice.cache, choice.maxBytes, p, fetch, error))
     throw std::runtime_error(error);
   ViewerScene v = fromPackage(p, true, fetchNote(p, fetch));
-  v.spec = local.localSceneSpec();
+  v.spec = local.localSceneSpec();  // the viewer's own files: not a package's
+  v.packaged.reset();
+  return v;
+}
+
+}  // namespace
+
+ViewerScene resolveViewerScene(const SceneStamp& stamp, const SceneChoice& choice,
+                               const service::ClientConfig& client, service::SceneFetch& fetch) {
+  ViewerScene v = resolve(stamp, choice, client, fetch);
+  if (stamp.known()) v.hash = stamp.hash;
   return v;
 }
 

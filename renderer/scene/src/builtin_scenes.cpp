@@ -151,14 +151,15 @@ bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::strin
   return true;
 }
 
-bool loadScene(const std::string& spec, double seconds, Scene& scene, std::string& error) {
+bool loadScene(const std::string& spec, double seconds, Scene& scene, std::string& error,
+               const PackagedFiles* packaged) {
   const std::string prefix = "builtin:";
   if (spec.rfind(prefix, 0) == 0) {
     double t = std::isfinite(seconds) ? seconds - std::floor(seconds) : 0.0;
     if (t >= 1.0) t = 0.0;
     return makeBuiltinScene(spec.substr(prefix.size()), static_cast<float>(t), scene, error);
   }
-  return loadGltf(spec, scene, error, seconds);
+  return loadGltf(spec, scene, error, seconds, packaged);
 }
 
 }  // namespace probecast::scene

@@ -686,9 +686,73 @@ std::vector<double> poseTimes(const Rig& rig, int uniform) {
   return {times.begin(), times.end()};
 }
 
+// What a glTF may read: itself, and files inside its folder (PackagedFiles: only those listed, and
+// no symbolic link on the way). tinygltf joins each URI, already percent-decoded, to the glTF's
+// folder and then to "." (the working folder); every path is judged here before it is opened.
+struct FileRules {
+  std::filesystem::path gltf;  // absolute, lexically normal
+  std::string folder;          // the glTF's folder with a trailing '/'
+  const PackagedFiles* packaged = nullptr;
+  std::string refused;         // the first path refused, with the reason
+
+  // The path inside the folder `file` names, or why it may not be read.
+  bool inside(const std::string& file, std::string& relative, std::string& why) const {
+    if (file.rfind(folder, 0) != 0) return why = "is not inside the glTF's folder", false;
+    relative = file.substr(folder.size());
+    const size_t slash = relative.find('/');
+    if (relative.substr(0, slash).find(':') != std::string::npos) return why = "names a URI scheme", false;
+    if (relative.empty() || relative.front() == '/') return why = "is absolute", false;
+    for (size_t start = 0; start <= relative.size();) {
+      const size_t end = std::min(relative.find('/', start), relative.size());
+      const std::string part = relative.substr(start, end - start);
+      if (part.empty() || part == "." || part == "..") return why = "leaves the glTF's folder", false;
+      for (char c : part)
+        if (c == '\\' || static_cast<unsigned char>(c) < 0x20) return why = "holds a backslash or a control character", false;
+      start = end + 1;
+    }
+    if (!packaged) return true;
+    if (std::find(packaged->listed.begin(), packaged->listed.end(), relative) == packaged->listed.end())
+      return why = "is not a file of the scene's package", false;
+    std::filesystem::path at = std::filesystem::path(folder);
+    std::error_code ec;
+    for (const auto& part : std::filesystem::path(relative)) {
+      at /= part;
+      if (std::filesystem::is_symlink(std::filesystem::symlink_status(at, ec))) return why = "is a symbolic link", false;
+    }
+    return true;
+  }
+
+  bool allowed(const std::string& file) {
+    if (file == gltf.string()) return true;
+    if (file.rfind("./", 0) == 0) return false;  // the working folder: never searched
+    std::string relative, why;
+    if (inside(file, relative, why)) return true;
+    if (refused.empty()) refused = "'" + file + "' " + why;
+    return false;
+  }
+};
+
+tinygltf::FsCallbacks fileCallbacks(FileRules& rules) {
+  tinygltf::FsCallbacks fs;
+  fs.FileExists = [](const std::string& file, void* user) {
+    return static_cast<FileRules*>(user)->allowed(file) && tinygltf::FileExists(file, nullptr);
+  };
+  fs.ExpandFilePath = [](const std::string& file, void*) { return file; };  // no ~ or $VARIABLE expansion
+  fs.ReadWholeFile = [](std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
+    if (!static_cast<FileRules*>(user)->allowed(file)) return *err = "refused: " + file, false;
+    return tinygltf::ReadWholeFile(out, err, file, nullptr);
+  };
+  fs.WriteWholeFile = [](std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    return *err = "writing is not allowed", false;
+  };
+  fs.user_data = &rules;
+  return fs;
+}
+
 }  // namespace
 
-bool loadGltf(const std::string& path, Scene& scene, std::string& error, double seconds) {
+bool loadGltf(const std::string& path, Scene& scene, std::string& error, double seconds,
+              const PackagedFiles* packaged) {
   scene = Scene{};
   scene.name = std::filesystem::path(path).filename().string();
   const auto fail = [&](const std::string& why) {
@@ -697,12 +761,22 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error, double 
   };
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return fail("no such file");
+  FileRules rules;
+  rules.gltf = std::filesystem::absolute(path, ec).lexically_normal();
+  rules.folder = rules.gltf.parent_path().string();
+  if (rules.folder.empty() || rules.folder.back() != '/') rules.folder += '/';
+  rules.packaged = packaged;
+  if (packaged && std::filesystem::is_symlink(std::filesystem::symlink_status(rules.gltf, ec)))
+    return fail("a scene package's glTF may not be a symbolic link");
   tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks(fileCallbacks(rules));
   tinygltf::Model model;
   std::string err, warn;
-  const bool binary = std::filesystem::path(path).extension() == ".glb";
-  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                         : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  const bool binary = rules.gltf.extension() == ".glb";
+  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, rules.gltf.string())
+                         : loader.LoadASCIIFromFile(&model, &err, &warn, rules.gltf.string());
+  // A refused image is only a warning to tinygltf: it is an error here, as a refused buffer is.
+  if (!rules.refused.empty()) return fail("refused to read " + rules.refused);
   if (!ok) return fail(err.empty() ? "cannot parse glTF" : err);
   for (const std::string& ext : model.extensionsRequired)
     if (!kSupportedRequired.count(ext)) return fail("requires unsupported extension " + ext);

@@ -9,7 +9,7 @@ namespace probecast::session {
 
 // The scene `spec` (glTF path or builtin:NAME) at scene time `seconds`; throws
 // std::runtime_error with the loader's message when it cannot be loaded.
-scene::Scene loadSceneOrThrow(const std::string& spec, double seconds);
+scene::Scene loadSceneOrThrow(const std::string& spec, double seconds, const scene::PackagedFiles* packaged = nullptr);
 
 // Whether `scene` (loaded from `spec`) changes with the scene time: the built-ins move their light,
 // glTF files with animation move nodes, skins and morph targets (scene/animation.h).

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ float animationT(double sceneTime);
 // What a viewer knows of the scene it draws for a stream.
 struct ViewerScene {
   std::string spec;      // for loadScene: builtin:NAME or a glTF path on this machine
+  // A delivered or cached package's glTF: the only files it may read (loadScene's `packaged`);
+  // empty for a built-in or the viewer's own --scene.
+  std::optional<scene::PackagedFiles> packaged;
+  std::optional<service::SceneHash> hash;  // the stream's scene (ClientConfig::scene); none when it names none
   std::filesystem::path environmentFile;  // the stream's environment map here (empty: none)
   service::SceneLighting lighting;        // the stream's lighting (or the viewer's own)
   bool checked = false;  // the stream named its scene and it matched (or was delivered)

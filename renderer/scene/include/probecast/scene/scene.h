@@ -132,9 +132,20 @@ std::vector<uint8_t> movingTriangles(const Scene& scene);
 // Length of the leading run of triangles of class < `cls` (the whole scene when not finalized).
 uint32_t leadingTrianglesBelowClass(const Scene& scene, uint32_t cls);
 
+// The files a glTF from a scene package may read besides itself: the package's files, as paths
+// relative to the glTF's folder ('/'-separated, no '.' or '..' parts). A package's folder holds
+// nothing else a server could name, and nothing in it may be a symbolic link.
+struct PackagedFiles {
+  std::vector<std::string> listed;
+};
+
 // Loads a .gltf or .glb file posed at scene time `seconds` (animation.h). On failure returns false
-// and `error` names the file and the problem.
-bool loadGltf(const std::string& path, Scene& scene, std::string& error, double seconds = 0.0);
+// and `error` names the file and the problem. Buffers and images are read only from inside the
+// glTF's own folder: a URI that is absolute, has a scheme other than data:, or climbs out with '..'
+// (percent-encoded or not) is refused, and nothing is looked up in the working folder. With
+// `packaged`, a URI must also name one of its files, reached without a symbolic link.
+bool loadGltf(const std::string& path, Scene& scene, std::string& error, double seconds = 0.0,
+              const PackagedFiles* packaged = nullptr);
 
 // Built-in scenes, generated in code. `t` in [0, 1) is the animation parameter.
 //   cornell     Cornell box (open front), ceiling panel + a point light circling under the ceiling
@@ -143,8 +154,10 @@ bool loadGltf(const std::string& path, Scene& scene, std::string& error, double 
 std::vector<std::string> builtinSceneNames();
 bool makeBuiltinScene(const std::string& name, float t, Scene& scene, std::string& error);
 
-// "builtin:NAME" or a glTF path, at scene time `seconds` (built-ins: t = seconds mod 1).
-bool loadScene(const std::string& spec, double seconds, Scene& scene, std::string& error);
+// "builtin:NAME" or a glTF path, at scene time `seconds` (built-ins: t = seconds mod 1); a glTF
+// from a scene package with `packaged` (loadGltf).
+bool loadScene(const std::string& spec, double seconds, Scene& scene, std::string& error,
+               const PackagedFiles* packaged = nullptr);
 
 // Recomputes the bounds and reorders triangles by the Morton code of their centroids, so BVH
 // builders that split at the index midpoint get spatially coherent halves. Triangles come in three

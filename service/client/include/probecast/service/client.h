@@ -59,6 +59,22 @@ struct ClientConfig {
   // 0: wait for TCP and the keepalive.
   int silenceMs = 3000;
   int reconnectSilenceMs = 2000;
+  // The scene this client draws for (the hash describeScene returned, whose package it loaded): a
+  // volume description that names another scene is refused and the client stops (fatal), for
+  // what it would draw is not what the probes were traced in. Empty: any scene.
+  std::optional<SceneHash> scene;
+  // The most probes a volume description may hold: one of more is refused before any memory is set
+  // aside for it, and the client stops (fatal). At most kMaxProbes (the protocol's limit).
+  uint64_t maxProbes = kMaxProbes;
+  // fetchScene: a server that sends no piece of the scene for this long is given up on (the next
+  // server, or an error), so a stalled transfer cannot hold a viewer forever.
+  int sceneStallMs = 15000;
+};
+
+// What a client refused from its servers, one entry per reason (in the order first seen).
+struct Refusal {
+  std::string reason;  // printable (wire text escaped)
+  uint32_t count = 0;
 };
 
 struct VolumeSnapshot {
@@ -142,7 +158,13 @@ struct ClientStats {
   uint64_t serverLinkInFlight = 0;   // unacknowledged bytes on the way
   uint32_t serverLinkWaits = 0;      // frames that waited for the window
   uint32_t silences = 0;             // connections dropped for silence (ClientConfig::silenceMs)
+  // Every description and frame refused, and every failed call, counted by reason (at most 32
+  // reasons; later ones count under the last).
+  std::vector<Refusal> refusals;
 };
+
+// The refusals as lines for a user: "REASON" or "REASON (N times)", one per reason.
+std::vector<std::string> refusalLines(const ClientStats& stats);
 
 // One frame the client applied (ProbeClient::appliedFrames).
 struct AppliedFrame {

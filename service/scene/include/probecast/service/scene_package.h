@@ -30,6 +30,9 @@ using SceneHash = std::array<uint8_t, 32>;
 constexpr uint32_t kSceneManifestFormat = 1;
 constexpr size_t kMaxManifestBytes = 256 * 1024;
 constexpr size_t kMaxPackageFiles = 4096;
+// The most bytes a package's files may add up to (1 TiB): sizes are checked against it one by one,
+// so no sum of a manifest's sizes can wrap around.
+constexpr uint64_t kMaxPackageBytes = uint64_t{1} << 40;
 
 std::string hexOf(const SceneHash& hash);
 // The first 12 hex digits, for messages.
@@ -87,16 +90,21 @@ struct ScenePackage {
 // reading its JSON, data: URIs stay inside it) lit as asked. False with `error` naming the file and
 // the problem (missing, unreadable, a URI outside the glTF's folder, a malformed glTF).
 bool makeScenePackage(const std::string& spec, const LightingRequest& lighting, ScenePackage& out, std::string& error);
-// Checks a manifest as received (size, JSON, format, every field, path and size) and fills `out`
-// from it (sources empty, hash computed).
+// Checks a manifest as received (size, canonical JSON, format, every field, path and size, the
+// sizes' sum at most kMaxPackageBytes) and fills `out` from it (sources empty, hash computed).
 bool parseManifest(std::string_view text, ScenePackage& out, std::string& error);
 // Whether `path` may name a file inside a package (see the header comment).
 bool isSafePackagePath(std::string_view path);
 
+// Text from the wire (a server's message, a name in a manifest) as it may be printed on a terminal:
+// control characters (C0, DEL and C1, so no escape sequence) and bytes that are not UTF-8 become
+// \xNN; anything beyond `limit` bytes is cut and marked.
+std::string printableText(std::string_view text, size_t limit = 512);
+
 // $PROBECAST_SCENE_CACHE, else $XDG_CACHE_HOME/probecast/scenes, else $HOME/.cache/probecast/scenes.
 std::filesystem::path defaultSceneCache();
-// The package of `hash` held whole in `cache` (its manifest and every file of its size), sources
-// set; false when it is not there.
+// The package of `hash` held whole in `cache` (its manifest and every file of its size, each a
+// regular file reached without a symbolic link), sources set; false when it is not there.
 bool findCachedPackage(const std::filesystem::path& cache, const SceneHash& hash, ScenePackage& out);
 
 // Writes a package into a cache as its bytes arrive: files in any order, each in pieces in order.
