@@ -1,6 +1,8 @@
 // libFuzzer target: arbitrary bytes as a scene manifest (scene_package.h), as a viewer receives
-// one in a volume description. An accepted manifest must name only safe paths, list the file its
-// scene and environment name, and hash to the SHA-256 of its bytes.
+// one in a volume description. An accepted manifest must be canonical, name only safe paths whose
+// sizes add up to at most kMaxPackageBytes, list the file its scene and environment name, and hash
+// to the SHA-256 of its bytes. Whatever is printed of it (refusals, describe()) holds no control
+// character and no byte that is not UTF-8.
 #include <cstdlib>
 #include <string_view>
 
@@ -26,10 +28,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   ScenePackage p;
   std::string error;
+  const auto printable = [](const std::string& s) {
+    for (unsigned char c : s)
+      if (c < 0x20 || c == 0x7f || c == 0xff) return false;
+    return s.find("\xc2\x9b") == std::string::npos;
+  };
+  require(printable(printableText(text, size + 1)));
   if (!parseManifest(text, p, error)) {
-    require(!error.empty());
+    require(!error.empty() && printable(error));
     return 0;
   }
+  require(p.manifest == text && p.totalBytes() <= kMaxPackageBytes);
+  require(printable(p.describe()));
   require(p.hash == sha256(text));
   require(p.files.size() <= kMaxPackageFiles);
   for (const PackageFile& f : p.files) require(isSafePackagePath(f.path) && f.source.empty());

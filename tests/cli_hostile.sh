@@ -4,13 +4,17 @@
 # strace in a folder of its own. The viewer must end in time with the exit code and message the
 # attack calls for, never open a decoy (files outside the package a server could name), and write
 # nothing outside its work folder.
-#   cli_hostile.sh PROBECAST HOSTILE_SERVER BASE ATTACK   (BASE/v.pcpv from the fixture)
+#   cli_hostile.sh PROBECAST HOSTILE_SERVER BASE ATTACK   (BASE/v.pcpv from the fixture: ATTACK setup)
 set -euo pipefail
 probecast=$1
 hostile=$2
 base=$3
 attack=$4
 work=$base/$attack
+if [ "$attack" = setup ]; then  # the fixture: the probes every attack's serve relays
+  mkdir -p "$base"
+  exec "$probecast" bake --scene builtin:cornell --grid 4,4,4 --spp 8 --updates 1 --out "$base/v.pcpv"
+fi
 rm -rf "$work"
 mkdir -p "$work/cwd" "$work/home" "$work/cache"
 fail() { echo "FAIL ($attack): $*"; exit 1; }
@@ -44,7 +48,7 @@ case $attack in
   gltf-unlisted|image-unlisted) cmd=("${view[@]}") code=1 say="refused to read '.*decoy.*' is not a file of the scene's package" ;;
   size-overflow) cmd=("${view[@]}" --scene-max-bytes 1000000) code=1 say="manifest files add up to more than" ;;
   noncanonical) cmd=("${view[@]}") code=1 say="not canonical JSON" ;;
-  bad-utf8) cmd=("${subscribe[@]}") code=1 say="refused: .*(UTF-8|parse|description)" ;;
+  bad-utf8) cmd=(subscribe --connect "127.0.0.1:$port" --token t --seconds 4 --out "$work/sub.pcpv") code=1 say="refused: .*broke off without an end \(a message that does not parse\)" ;;
   scene-switch) cmd=("${view[@]}") code=1 say="the stream names scene [0-9a-f]+, not the scene [0-9a-f]+" ;;
   scene-stall) cmd=("${view[@]}") code=1 say="it sent nothing for 15000 ms" ;;
   garbage-frames|huge-frames) cmd=("${view[@]}") code=1 say="refused: frame refused: its payload is no frame" ;;
@@ -66,10 +70,11 @@ grep -Eq "$say" "$work/out.log" || fail "no /$say/ in: $(tail -8 "$work/out.log"
 if LC_ALL=C grep -q $'\x1b' "$work/out.log"; then fail "an escape byte from the wire reached the terminal"; fi
 
 # The filesystem: no decoy opened (they sit in the working folder and are named by absolute and
-# relative paths), nothing made, renamed or removed outside the work folder (devices aside).
+# relative paths), nothing made, renamed or removed outside the work folder (devices aside). A
+# relative name is inside it: the working folder is, and *at calls name folders opened inside it.
 ! grep -q "decoy" "$work/trace" || fail "a decoy was opened: $(grep decoy "$work/trace" | head -3)"
 outside=$(grep -E 'O_WRONLY|O_RDWR|O_CREAT|creat\(|mkdir|rename|unlink|symlink|link\(|truncate' "$work/trace" |
-  grep -v ' = -1 ' | grep -oE '"[^"]*"' | tr -d '"' | grep -vE "^($work|/dev/|/proc/self/)" | sort -u || true)
+  grep -v ' = -1 ' | grep -oE '"/[^"]*"' | tr -d '"' | grep -vE "^($work|/dev/|/proc/self/)" | sort -u || true)
 [ -z "$outside" ] || fail "written outside the work folder: $outside"
 cached=$(du -sb "$work/cache" | cut -f1)
 [ "$cached" -lt 1000000 ] || fail "the scene cache holds $cached bytes"

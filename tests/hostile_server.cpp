@@ -255,7 +255,7 @@ int main(int argc, char** argv) {
   grpc::ServerBuilder builder;
   builder.AddListeningPort(argv[2], grpc::InsecureServerCredentials());
   builder.RegisterService(&service);
-  builder.SetMaxSendMessageSize(64 << 20);
+  builder.SetMaxSendMessageSize(128 << 20);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server) {
     std::fprintf(stderr, "hostile: cannot listen on %s\n", argv[2]);

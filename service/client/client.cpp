@@ -157,13 +157,23 @@ struct ProbeClient::Impl {
   std::chrono::steady_clock::time_point callStarted, lastMessage;
   uint32_t heartbeatMs = 0;
   bool silenced = false;
+  bool finishing = false, finishCut = false;  // in Finish since finishStarted; cut by the watchdog
+  std::chrono::steady_clock::time_point finishStarted;
 
   void watch() {
     std::unique_lock<std::mutex> lock(mutex);
     while (!stopping) {
       wakeup.wait_for(lock, std::chrono::milliseconds(100), [&] { return stopping.load(); });
-      if (stopping || !context || heartbeatMs == 0 || silenced) continue;
+      if (stopping || !context) continue;
       const auto now = std::chrono::steady_clock::now();
+      // A stream whose reads ended without its end (a message that did not parse leaves the call
+      // open): Finish would wait for the server, so the call is cut.
+      if (finishing && !finishCut && now - finishStarted > std::chrono::milliseconds(1000)) {
+        finishCut = true;
+        context->TryCancel();
+        continue;
+      }
+      if (heartbeatMs == 0 || silenced || finishing) continue;
       const bool heard = lastMessage > callStarted;
       const int limit = heard ? config.silenceMs : config.reconnectSilenceMs;
       if (limit <= 0 || now - (heard ? lastMessage : callStarted) < std::chrono::milliseconds(limit)) continue;
@@ -387,9 +397,18 @@ struct ProbeClient::Impl {
         std::lock_guard<std::mutex> w(writeMutex);  // no writer may hold the stream past this point
         std::lock_guard<std::mutex> lock(mutex);
         stream = nullptr;
-        context = nullptr;
+        finishing = true;
+        finishCut = false;
+        finishStarted = std::chrono::steady_clock::now();
       }
       const grpc::Status status = rw->Finish();
+      bool wasCut = false;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        context = nullptr;
+        finishing = false;
+        wasCut = finishCut;
+      }
       const auto code = status.error_code();
       bool wasSilenced = false;
       {
@@ -397,7 +416,9 @@ struct ProbeClient::Impl {
         stats.connected = false;
         wasSilenced = silenced;
         silenced = false;
-        if (wasSilenced)
+        if (wasCut && !dropped)
+          refuse(servers[at] + ": the stream broke off without an end (a message that does not parse): connecting afresh");
+        else if (wasSilenced)
           refuse(servers[at] + ": the connection went silent (the server promised a message every " +
                  std::to_string(heartbeatMs) + " ms): connecting afresh");
         else if (!status.ok() && !stopping && !dropped)

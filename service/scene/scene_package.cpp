@@ -266,7 +266,7 @@ bool isSafePackagePath(std::string_view path) {
     const std::string_view part = path.substr(start, end - start);
     if (part.empty() || part == "." || part == "..") return false;
     for (char c : part)
-      if (c == '\\' || c == '\0' || static_cast<unsigned char>(c) < 0x20) return false;
+      if (c == '\\' || c == '\0' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return false;
     start = end + 1;
   }
   return true;
@@ -345,7 +345,7 @@ std::string ScenePackage::describe() const {
     std::snprintf(size, sizeof size, " (%zu files, %.1f MB)", files.size(), static_cast<double>(totalBytes()) / 1e6);
     s += size;
   }
-  if (lighting.kind == SceneLighting::Kind::Environment) s += ", environment " + lighting.file;
+  if (lighting.kind == SceneLighting::Kind::Environment) s += ", environment " + printableText(lighting.file);
   if (lighting.kind == SceneLighting::Kind::Sky) s += ", uniform sky";
   return s + ", scene " + shortHex(hash);
 }
