@@ -4,7 +4,7 @@
 #   scripts/dev.sh test          build, then run the whole test suite (ctest)
 #   scripts/dev.sh core-test     the Vulkan-free build (codec, imaging, service, their tests) in build-core, and its tests
 #   scripts/dev.sh memsafe       sanitizer build (ASan + UBSan) and the codec and bus-format tests under it
-#   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec, the bus decoder, scene manifests, glTF scenes, Looking Glass calibrations and the browser's decoder
+#   scripts/dev.sh fuzz [SECS]   libFuzzer build (clang-14) and a bounded fuzz run of the codec, the bus decoder, scene manifests, the client's checks of a server, glTF scenes, Looking Glass calibrations and the browser's decoder
 #   scripts/dev.sh python        `pip install ./python` into build-python/venv, and the Python tests against it
 set -euo pipefail
 
@@ -60,11 +60,12 @@ case "$cmd" in
       ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L 'codec|bus' "$@"
     ;;
   fuzz)
-    # Six targets share the time: the codec's decoders (half), the probe bus decoder, scene
-    # manifests, glTF scenes, Looking Glass calibrations and the browser's decoder (a tenth each).
+    # Seven targets share the time: the codec's decoders (half), the probe bus decoder, scene
+    # manifests, the client's checks of what a server sends, glTF scenes, Looking Glass
+    # calibrations and the browser's decoder (a tenth each).
     secs=${1:-60}
     configure_and_build build-fuzz -DPROBECAST_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14
-    for target in codec bus manifest gltf calibration web; do
+    for target in codec bus manifest client gltf calibration web; do
       if [ "$target" = codec ]; then
         seeds=build-fuzz/seeds corpus=build-fuzz/corpus share=$(( (secs + 1) / 2 ))
       else

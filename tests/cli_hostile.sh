@@ -78,6 +78,10 @@ outside=$(grep -E 'O_WRONLY|O_RDWR|O_CREAT|creat\(|mkdir|rename|unlink|symlink|l
 [ -z "$outside" ] || fail "written outside the work folder: $outside"
 cached=$(du -sb "$work/cache" | cut -f1)
 [ "$cached" -lt 1000000 ] || fail "the scene cache holds $cached bytes"
+# Sizes that wrap: refused before the first byte is asked for.
+if [ "$attack" = size-overflow ] && grep -q "GetScene asked" "$work/hostile.log"; then
+  fail "the viewer asked for a scene whose sizes wrap around"
+fi
 if [ "$code" -ne 0 ]; then
   [ ! -e "$work/sub.pcpv" ] || fail "a volume was written although the client refused the stream"
   [ ! -e "$work/out/quilt.png" ] || fail "a picture was drawn although the viewer refused the stream"

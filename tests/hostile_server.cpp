@@ -168,10 +168,9 @@ class Hostile final : public pb::ProbeStream::Service {
       stream->WritesDone();
     });
     pb::ServerMessage m;
-    uint32_t frames = 0;
     while (!ctx->IsCancelled() && stream->Read(&m)) {
       if (m.has_volume()) describe(*m.mutable_volume(), /*subscribe=*/true);
-      if (m.has_frame()) attackFrame(*m.mutable_frame(), frames++);
+      if (m.has_frame()) attackFrame(*m.mutable_frame());
       if (!down->Write(m)) break;
     }
     ctx->TryCancel();  // ends the relay's read
@@ -182,6 +181,8 @@ class Hostile final : public pb::ProbeStream::Service {
 
   grpc::Status GetScene(grpc::ServerContext* ctx, const pb::GetSceneRequest* request,
                         grpc::ServerWriter<pb::SceneChunk>* writer) override {
+    std::printf("hostile: GetScene asked\n");
+    std::fflush(stdout);
     if (!package_ || request->scene_hash() != package_->hash) return {grpc::StatusCode::NOT_FOUND, "no such scene"};
     pb::SceneChunk first;
     first.set_manifest(package_->manifest);
@@ -190,21 +191,19 @@ class Hostile final : public pb::ProbeStream::Service {
       while (!ctx->IsCancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
       return grpc::Status::OK;
     }
-    // Every file as the manifest has it; a file the manifest says is larger is padded on and on
-    // (the overflow attack's 2^64 - 1 bytes), 1 MiB at a time, until the viewer hangs up.
+    // Every file as the manifest has it. The overflow attack's a.bin (said to hold 2^64 - 1 bytes)
+    // goes on with 1 MiB pieces, up to 64 MiB: what a viewer that trusted the sum would write.
     for (const auto& [path, bytes] : package_->files) {
       pb::SceneChunk c;
       c.set_path(path);
       c.set_data(bytes);
       if (!writer->Write(c)) return grpc::Status::OK;
-    }
-    if (attack_ == "size-overflow") {
-      pb::SceneChunk c;
-      c.set_path("a.bin");
-      for (uint64_t offset = 36; !ctx->IsCancelled() && offset < (uint64_t{64} << 30); offset += c.data().size()) {
+      for (uint64_t offset = bytes.size(); attack_ == "size-overflow" && path == "a.bin" && !ctx->IsCancelled() &&
+                                           offset < (uint64_t{64} << 20);
+           offset += c.data().size()) {
         c.set_offset(offset);
         c.mutable_data()->assign(1 << 20, 'x');
-        if (!writer->Write(c)) break;
+        if (!writer->Write(c)) return grpc::Status::OK;
       }
     }
     return grpc::Status::OK;
@@ -225,7 +224,7 @@ class Hostile final : public pb::ProbeStream::Service {
     }
   }
 
-  void attackFrame(pb::Frame& f, uint32_t index) const {
+  void attackFrame(pb::Frame& f) const {
     if (attack_ == "garbage-frames") f.set_payload(std::string(f.payload().size(), '\x5a'));
     if (attack_ == "huge-frames") f.set_payload(std::string(64 << 20, '\x5a'));
     if (attack_ == "nan-time" && f.has_scene_state()) f.mutable_scene_state()->set_time_s(std::nan(""));
@@ -235,7 +234,6 @@ class Hostile final : public pb::ProbeStream::Service {
       f.set_keyframes(UINT32_MAX);
       f.set_deltas(UINT32_MAX);
     }
-    (void)index;
   }
 
   std::unique_ptr<pb::ProbeStream::Stub> stub_;
@@ -256,6 +254,10 @@ int main(int argc, char** argv) {
   builder.AddListeningPort(argv[2], grpc::InsecureServerCredentials());
   builder.RegisterService(&service);
   builder.SetMaxSendMessageSize(128 << 20);
+  // The viewer's keepalive pings are welcome: a stalled transfer must stall, not end in GOAWAY.
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 1000);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PING_STRIKES, 0);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server) {
     std::fprintf(stderr, "hostile: cannot listen on %s\n", argv[2]);

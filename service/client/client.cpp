@@ -10,6 +10,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "probecast.grpc.pb.h"
+#include "stream_checks.h"
 #include "wire_convert.h"
 
 namespace probecast::service {
@@ -49,29 +50,6 @@ std::vector<std::string> serversOf(const ClientConfig& config) {
 // A call's context with the config's bearer token.
 void authorize(const ClientConfig& config, grpc::ClientContext& ctx) {
   if (!config.token.empty()) ctx.AddMetadata("authorization", "Bearer " + config.token);
-}
-
-// volumeFromWire, and a scene the description names checked: its manifest hashes to its hash and parses.
-bool readDescription(const pb::VolumeDescription& v, StreamLayout& l, GridBounds& b, std::vector<float>& o,
-                     AreaLightRule& r, SceneStamp& scene, std::string& why) {
-  ScenePackage named;
-  if (!volumeFromWire(v, l, b, o, r, scene, why)) return false;
-  if (!scene.known()) return true;
-  if (sha256(scene.manifest) != scene.hash) return why = "its scene manifest does not match its hash", false;
-  return parseManifest(scene.manifest, named, why);
-}
-
-// A frame's own counts of keyframe and delta sections (Frame.keyframes, deltas) against its
-// payload: a frame holding that many sections (the decoder checks the rest). The kinds are the
-// server's account: a delta in another representation than the brick's last travels as a keyframe.
-bool countsMatch(const pb::Frame& f, std::string& why) {
-  FrameHeader header;
-  const CodecStatus st = verifyFrame(reinterpret_cast<const uint8_t*>(f.payload().data()), f.payload().size(), &header);
-  if (st != CodecStatus::Ok) return why = std::string("its payload is no frame: ") + codecStatusName(st), false;
-  if (uint64_t{f.keyframes()} + f.deltas() != header.sectionCount)
-    return why = "it claims " + std::to_string(f.keyframes()) + " keyframes and " + std::to_string(f.deltas()) +
-                 " deltas, its payload holds " + std::to_string(header.sectionCount) + " sections", false;
-  return true;
 }
 
 // Cancels a call that makes no progress for `stallMs`: a server that stops sending mid-transfer
@@ -216,25 +194,17 @@ struct ProbeClient::Impl {
   // False for a description the client cannot use: the connection is dropped and retried later
   // (or, refuseForGood, never).
   bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
-    StreamLayout l;
-    GridBounds b;
-    std::vector<float> o;
-    AreaLightRule r;
-    SceneStamp sc;
+    Description d;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
-    if (!readDescription(v, l, b, o, r, sc, why)) return refuse("bad volume description: " + why), false;
-    const uint64_t probes = uint64_t{l.grid[0]} * l.grid[1] * l.grid[2];
-    if (probes > config.maxProbes)
-      return refuseForGood("the volume description holds " + std::to_string(probes) + " probes, more than the " +
-                           std::to_string(config.maxProbes) + " this client accepts");
-    if (config.scene && (!sc.known() || sc.hash != *config.scene))
-      return refuseForGood("the stream names scene " + (sc.known() ? shortHex(sc.hash) : std::string("(none)")) +
-                           ", not the scene " + shortHex(*config.scene) + " its description named before; "
-                           "this viewer draws that one and stops");
-    if (config.representation && l.repr != *config.representation)
-      return refuse(std::string("the server streams ") + representationName(l.repr) + ", not the " +
-                    representationName(*config.representation) + " asked for"), false;
+    switch (checkDescription(v, config, d, why)) {
+      case Verdict::Accept: break;
+      case Verdict::Retry: return refuse(why), false;
+      case Verdict::ForGood: return refuseForGood(why);
+    }
+    const StreamLayout& l = d.layout;
+    const AreaLightRule& r = d.areaLights;
+    SceneStamp& sc = d.scene;
     const bool same = decoder && l.grid[0] == layout.grid[0] && l.grid[1] == layout.grid[1] &&
                       l.grid[2] == layout.grid[2] && l.brickDim == layout.brickDim && l.repr == layout.repr;
     if (!same || v.stream_epoch() != epoch || !(r == areaLights) || sc.hash != scene.hash) {  // nothing held is valid
@@ -242,8 +212,8 @@ struct ProbeClient::Impl {
       decoder->setZh3PerPixel(config.zh3PerPixel);
     }
     layout = l;
-    bounds = b;
-    offsets = std::move(o);
+    bounds = d.bounds;
+    offsets = std::move(d.offsets);
     areaLights = r;
     if (sc.hash != scene.hash) hasState = false;
     scene = std::move(sc);
@@ -260,10 +230,9 @@ struct ProbeClient::Impl {
     if (!decoder) return refuse("frame before volume description"), false;
     bus::SceneState frameState;
     std::string why;
-    if ((f.has_scene_state() && !stateFromWire(f.scene_state(), frameState, why)) ||
-        !countsMatch(f, why)) {
+    if (!checkFrame(f, frameState, why)) {
       stats.framesRejected += 1;
-      refuse("frame refused: " + why);
+      refuse(why);
       return false;
     }
     const auto* data = reinterpret_cast<const uint8_t*>(f.payload().data());
@@ -570,13 +539,13 @@ bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& err
       if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) break;
       continue;
     }
-    StreamLayout l;
-    GridBounds b;
-    std::vector<float> o;
-    AreaLightRule r;
+    ClientConfig any = config;  // the stream as described; what is asked for comes with Subscribe
+    any.representation.reset();
+    any.scene.reset();
+    Description d;
     std::string why;
-    if (!readDescription(v, l, b, o, r, out, why))
-      return error = printableText(server + ": bad volume description: " + why, 2048), false;
+    if (checkDescription(v, any, d, why) != Verdict::Accept) return error = printableText(server + ": " + why, 2048), false;
+    out = std::move(d.scene);
     return true;
   }
   return error = printableText("no server described its stream: " + errors, 2048), false;

@@ -15,6 +15,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { connect, DeliverPolicy } from 'nats.ws';
 import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
+import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
 
 const params = new URLSearchParams(location.search);
 const fragment = new URLSearchParams(location.hash.slice(1));
@@ -191,52 +192,16 @@ function median(values) {
 }
 
 // ---- the scene the stream names ------------------------------------------------------------
-async function sha256Hex(bytes) {
-  const d = new Uint8Array(await crypto.subtle.digest('SHA-256', bytes));
-  return Array.from(d, (b) => b.toString(16).padStart(2, '0')).join('');
-}
-
-// What a bus may name: the rules the native viewer holds to (docs/ARCHITECTURE.md, "A viewer's
-// trust model"). A path is relative, '/'-separated, without empty, '.' or '..' parts, control
-// characters, backslashes or a scheme; sizes are whole numbers whose sum stays under the limit.
-const kMaxManifestBytes = 256 * 1024, kMaxPackageFiles = 4096, kMaxSceneBytes = 2 ** 30;
-function safePath(p) {
-  if (typeof p !== 'string' || !p.length || p.length > 1024 || p.startsWith('/')) return false;
-  if (p.split('/')[0].includes(':')) return false;
-  return p.split('/').every((part) => part !== '' && part !== '.' && part !== '..' && !/[\\\x00-\x1f\x7f]/.test(part));
-}
-function printable(text) {
-  return String(text).slice(0, 200).replace(/[\x00-\x1f\x7f-\x9f]/g, (c) => '\\x' + c.charCodeAt(0).toString(16).padStart(2, '0'));
-}
-async function checkedManifest(manifestText, hash) {
-  if (manifestText.length > kMaxManifestBytes) throw new Error(`the stream's scene manifest is over ${kMaxManifestBytes} bytes`);
-  if ((await sha256Hex(new TextEncoder().encode(manifestText))) !== hash)
-    throw new Error('the stream\'s scene manifest does not match its hash');
-  const manifest = JSON.parse(manifestText);
-  if (!Array.isArray(manifest.files) || manifest.files.length > kMaxPackageFiles) throw new Error('the stream\'s scene manifest lists no files array');
-  let total = 0;
-  for (const f of manifest.files) {
-    if (!safePath(f.path)) throw new Error(`the stream's scene names an unsafe path '${printable(f.path)}'`);
-    if (!Number.isSafeInteger(f.bytes) || f.bytes < 0) throw new Error(`the stream's scene gives '${printable(f.path)}' no size`);
-    total += f.bytes;
-    if (total > kMaxSceneBytes) throw new Error(`the stream's scene is over ${kMaxSceneBytes} bytes`);
-  }
-  return manifest;
-}
-
 async function loadScene(manifestText, hash) {
   const manifest = await checkedManifest(manifestText, hash);
-  if (!manifest.scene || !manifest.scene.gltf) throw new Error('the stream names a built-in scene, which the browser does not have: serve a glTF scene');
-  if (!manifest.files.some((f) => f.path === manifest.scene.gltf)) throw new Error('the stream\'s scene is not among its files');
+  if (!manifest.scene.gltf) throw new Error('the stream names a built-in scene, which the browser does not have: serve a glTF scene');
   if (!config.scene) throw new Error('no scene folder given (scene=URL)');
   // Every file the manifest lists, fetched from inside the scene folder (each part encoded, so
   // "%2e%2e" stays a name) and checked against its size and SHA-256.
   const files = new Map();
   const folder = new URL(config.scene.endsWith('/') ? config.scene : config.scene + '/', location.href);
   for (const f of manifest.files) {
-    const url = new URL(f.path.split('/').map(encodeURIComponent).join('/'), folder);
-    if (!url.href.startsWith(folder.href)) throw new Error(`scene file ${printable(f.path)} is outside the scene folder`);
-    const r = await fetch(url);
+    const r = await fetch(sceneFileUrl(f.path, folder));
     if (!r.ok) throw new Error(`scene file ${f.path}: HTTP ${r.status}`);
     const bytes = new Uint8Array(await r.arrayBuffer());
     if (bytes.length !== f.bytes || (await sha256Hex(bytes)) !== f.sha256)
