@@ -186,7 +186,7 @@ void addBenchRaster(CLI::App* bench) {
                      "the viewers default to 4)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  addMsaaOption(raster, ro->bench.raster.msaaSamples);
+  addRasterFilterOptions(raster, ro->bench.raster.msaaSamples, ro->bench.raster.anisotropy);
   addVisibilityOption(raster, ro->bench.raster.visibility);
   ro->areaLights.add(raster);
   addJsonOption(raster, ro->json);
@@ -234,7 +234,7 @@ void addBenchScene(CLI::App* bench) {
                   "N × N raster samples per pixel, averaged (as the reference averages each pixel's area)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  addMsaaOption(cmd, so->bench.raster.msaaSamples);
+  addRasterFilterOptions(cmd, so->bench.raster.msaaSamples, so->bench.raster.anisotropy);
   addVisibilityOption(cmd, so->bench.raster.visibility);
   so->areaLights.add(cmd);  // the reference sees every emitter either way, so the cached one still serves
   cmd->add_option("--reference-bounces", so->bench.referenceBounces, "surface interactions per reference path")

@@ -41,7 +41,7 @@ void addDemoCommand(CLI::App& app) {
                    "the viewers' N × N raster samples per pixel, averaged (as the references average each pixel)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  addMsaaOption(demo, o->msaa);
+  addRasterFilterOptions(demo, o->msaa, o->anisotropy);
   o->areaLights.add(demo);
   o->device.add(demo);
   demo->add_flag("--skip-suites", o->skipSuites, "leave the pipeline benchmark and the stability suite out");

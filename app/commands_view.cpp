@@ -190,7 +190,7 @@ void addViewCommand(CLI::App& app) {
                   "one sample at the pixel's centre, about N² times faster)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  addMsaaOption(cmd, o->msaa);
+  addRasterFilterOptions(cmd, o->msaa, o->anisotropy);
   cmd->add_option("--out", o->out, "output folder");
   cmd->add_option("--exposure", o->exposure, "scale for the PNG only")->check(CLI::Range(1e-6f, 1e6f));
   cmd->add_flag("--exr", o->exr, "also write every view as a linear EXR");
@@ -269,6 +269,7 @@ void addViewCommand(CLI::App& app) {
     ro.environment = environment;
     ro.samplesPerSide = o->supersample;
     ro.msaaSamples = o->msaa;
+    ro.anisotropy = o->anisotropy;
     renderer::checkRasterSize(o->size[0], o->size[1], ro);  // before any tracing or connecting
     if (o->window.enabled) {
       if (o->connection.connect.empty())

@@ -48,6 +48,7 @@ struct DemoOptions {
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)
   uint32_t supersample = renderer::RasterOptions{}.samplesPerSide;  // the viewers' raster samples per pixel side
   uint32_t msaa = renderer::RasterOptions{}.msaaSamples;            // and their MSAA samples
+  uint32_t anisotropy = renderer::RasterOptions{}.anisotropy;       // and texture taps along a footprint
   AreaLightCli areaLights;               // the server's rule; the viewers follow what the stream says
   DeviceOptions device;                     // --device: the server's and the viewers' Vulkan device
 };

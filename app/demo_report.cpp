@@ -382,6 +382,7 @@ void writeDemoReport(const DemoOptions& o, DemoRun& run) {
   report["spp_per_update"] = o.spp;
   report["raster_samples_per_pixel"] = o.supersample * o.supersample;
   report["raster_msaa_samples"] = o.msaa;
+  report["raster_texture_anisotropy"] = o.anisotropy;
   report["stream_seconds"] = run.streamSeconds;
   report["updates"] = producer.updates;
   report["update_ms_median"] = session::median(producer.updateMs);

@@ -93,6 +93,7 @@ void startViewers(const DemoOptions& o, const service::ServerConfig& server, Dem
     vc.raster.visibility = o.visibility;
     vc.raster.samplesPerSide = o.supersample;
     vc.raster.msaaSamples = o.msaa;
+    vc.raster.anisotropy = o.anisotropy;
     vc.client.address = server.listen;
     vc.client.token = server.token;
     vc.client.name = v.name;

@@ -32,6 +32,7 @@ struct ViewOptions {
   uint32_t updates = 4;
   uint32_t supersample = renderer::RasterOptions{}.samplesPerSide;  // raster samples per pixel side
   uint32_t msaa = renderer::RasterOptions{}.msaaSamples;
+  uint32_t anisotropy = renderer::RasterOptions{}.anisotropy;  // texture taps along a footprint
   float exposure = 1.0f;
   bool exr = false;
   bool visibility = true;

@@ -199,6 +199,7 @@ nlohmann::json rasterJson(const RasterBenchOptions& o, const std::string& device
   json["shadow_cascades"] = o.raster.shadowCascades;
   json["supersample"] = o.raster.samplesPerSide;  // ms per view are for the supersampled size
   json["msaa_samples"] = o.raster.msaaSamples;
+  json["texture_anisotropy"] = o.raster.anisotropy;
   json["area_lights"] = o.raster.areaLights.enabled;
   json["metric"] = "PSNR (RGB) and SSIM (luminance) after plain gamma 2.2 on both images, no clamping first";
   if (!m.quality.empty()) json["shadow_ms"] = m.firstShadowMs;

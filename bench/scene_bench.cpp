@@ -150,6 +150,7 @@ nlohmann::json sceneJson(const SceneSetup& s, const std::string& cacheDir, const
   json["size"] = {o.width, o.height};
   json["supersample"] = o.raster.samplesPerSide;  // raster ms per view are for the supersampled size
   json["msaa_samples"] = o.raster.msaaSamples;
+  json["texture_anisotropy"] = o.raster.anisotropy;
   json["views"] = o.views;
   json["view_count"] = s.views.size();
   json["grid"] = {o.grid.dims[0], o.grid.dims[1], o.grid.dims[2]};

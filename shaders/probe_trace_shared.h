@@ -88,7 +88,7 @@ struct PtTexture {
   uint offset;              // first texel in PT_BINDING_TEXELS
   uint width;
   uint height;
-  uint pad;
+  uint levels;              // mip levels, each after the one before, halving each side (texture_mips.h)
 };
 
 struct PtLight {

@@ -259,6 +259,10 @@ vec3 probeGlossy(float c[28], vec3 r, float roughness, float nv, vec3 f0) {
 }
 
 void main() {
+  // Texture footprints from the screen derivatives, taken before any discard (material.glsl).
+  materialUvDx = dFdx(texcoord);
+  materialUvDy = dFdy(texcoord);
+  materialMaxAnisotropy = float(pc.maxAnisotropy);
   vec3 wo = normalize(views[pc.viewBase + gl_ViewIndex].eye.xyz - worldPosition);
   // The geometric normal from the position's screen derivatives (before any discard), on the
   // viewer's side; the shading normal then follows the rule of material.glsl, as in the tracers.

@@ -84,6 +84,10 @@ struct RsPushConstants {
   uint visibility;     // 1: interpolate 8 probes weighted by visibility; 0: hardware trilinear
   uint areaLightCount; // client area lights (RS_BINDING_AREA_LIGHTS)
   uint areaShadowMapSize;  // texels per side of each area-light shadow layer
+  uint maxAnisotropy;  // texture taps along a pixel footprint's long axis (RasterOptions::anisotropy)
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 struct RsAreaLight {
@@ -110,7 +114,7 @@ struct RsShadowPush {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RsPushConstants) == 112);
+static_assert(sizeof(RsPushConstants) == 128);  // the least maxPushConstantsSize Vulkan allows
 static_assert(sizeof(RsShadowPush) == 80);
 static_assert(sizeof(RsView) == 80);
 static_assert(sizeof(RsShadowLight) == 16);

@@ -68,16 +68,7 @@ double channelMean(const Image& img, int c) {
   return sum / static_cast<double>(img.rgb.size() / 3);
 }
 
-// The camera at the origin looking down −Z with a 90° square view: a square of half-size 1 at
-// z = −1 fills the image, and pixel (x, y) sees texture coordinates ((x + ½)/W, (y + ½)/H).
-CameraView frontCamera() {
-  CameraView c;
-  c.position = glm::vec3(0.0f);
-  c.forward = {0, 0, -1};
-  c.up = {0, 1, 0};
-  c.yfov = 1.5707963f;
-  return c;
-}
+using test::frontCamera;
 
 Image referenceImage(VulkanContext& context, const Scene& s, const CameraView& cam, uint32_t size, uint32_t spp) {
   ReferenceOptions o;

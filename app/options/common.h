@@ -56,6 +56,22 @@ inline CLI::Option* addMsaaOption(CLI::App* cmd, uint32_t& samples) {
       ->capture_default_str();
 }
 
+// --anisotropy 1..16: texture taps along a pixel footprint's long axis (RasterOptions::anisotropy).
+inline CLI::Option* addAnisotropyOption(CLI::App* cmd, uint32_t& taps) {
+  return cmd
+      ->add_option("--anisotropy", taps,
+                   "raster client: textures are read from their mip levels over each pixel's footprint, with up to "
+                   "this many taps along its long axis (1: isotropic)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+}
+
+// --msaa and --anisotropy: how the raster client anti-aliases edges and filters textures.
+inline void addRasterFilterOptions(CLI::App* cmd, uint32_t& msaaSamples, uint32_t& anisotropy) {
+  addMsaaOption(cmd, msaaSamples);
+  addAnisotropyOption(cmd, anisotropy);
+}
+
 // --json FILE, required by every benchmark.
 inline CLI::Option* addJsonOption(CLI::App* cmd, std::string& json) {
   return cmd->add_option("--json", json, "write the results as JSON here")->required();

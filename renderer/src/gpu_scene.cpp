@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "probe_trace_shared.h"
+#include "texture_mips.h"
 
 namespace probecast::renderer {
 
@@ -141,11 +143,13 @@ void uploadGpuSurfaces(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
   g.texcoords = createBufferWithData(d, uvs.data(), uvs.size() * sizeof(glm::vec4), kVertex);
   std::vector<uint32_t> texels;
   std::vector<shaders::PtTexture> infos;
-  for (const scene::Texture& t : s.textures) {
-    infos.push_back({static_cast<uint32_t>(texels.size()), t.width, t.height, 0});
-    for (size_t i = 0; i < static_cast<size_t>(t.width) * t.height; ++i)
-      texels.push_back(static_cast<uint32_t>(t.rgba[i * 4]) | (static_cast<uint32_t>(t.rgba[i * 4 + 1]) << 8) |
-                       (static_cast<uint32_t>(t.rgba[i * 4 + 2]) << 16) | (static_cast<uint32_t>(t.rgba[i * 4 + 3]) << 24));
+  const std::vector<bool> colour = colourTextures(s);
+  for (size_t k = 0; k < s.textures.size(); ++k) {
+    const scene::Texture& t = s.textures[k];
+    const auto offset = static_cast<uint32_t>(texels.size());
+    const uint32_t levels = appendMipChain(t, colour[k], texels);
+    if (texels.size() > UINT32_MAX) throw std::runtime_error("the scene's textures exceed 2^32 texels");
+    infos.push_back({offset, t.width, t.height, levels});
   }
   g.texels = createBufferWithData(d, texels.data(), texels.size() * 4, kStorage);
   g.textures = createBufferWithData(d, infos.data(), infos.size() * sizeof(shaders::PtTexture), kStorage);

@@ -481,6 +481,8 @@ void checkRasterSize(uint32_t width, uint32_t height, const RasterOptions& optio
     throw std::invalid_argument("raster samples per pixel side must be 1..16");
   if (options.msaaSamples != 1 && options.msaaSamples != 2 && options.msaaSamples != 4 && options.msaaSamples != 8)
     throw std::invalid_argument("MSAA samples must be 1, 2, 4 or 8");
+  if (options.anisotropy < 1 || options.anisotropy > 16)
+    throw std::invalid_argument("texture anisotropy must be 1..16 taps");
   if (std::max(width, height) > 16384u / options.samplesPerSide)
     throw std::invalid_argument("a " + std::to_string(width) + "x" + std::to_string(height) + " view at " +
                                 std::to_string(options.samplesPerSide) +
@@ -612,6 +614,7 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.shadedMaterials = scene.materials;
   s.push.shadowMapSize = options.shadowMapSize;
   s.push.areaShadowMapSize = options.areaShadowMapSize;
+  s.push.maxAnisotropy = options.anisotropy;
   s.push.lightCount = s.gpu.lightCount;
   // No volume yet: a 1³ black one keeps every descriptor valid (and writes them all).
   ProbeGrid one;

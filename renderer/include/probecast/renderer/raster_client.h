@@ -67,6 +67,10 @@ struct RasterOptions {
   // samplesPerSide. 4 by default, the measured best: within 0.1 dB of 4 × 4 supersampling against
   // a path-traced reference at a tenth of its cost (docs/MEASUREMENTS.md, "Anti-aliasing").
   uint32_t msaaSamples = 4;
+  // Textures are read over each pixel's footprint from their mip levels (trilinear); a footprint
+  // stretched along one axis takes up to this many taps along it (1..16; 1: isotropic, blurred
+  // where surfaces are seen at a grazing angle).
+  uint32_t anisotropy = 8;
 };
 
 struct RasterTimings {
@@ -82,8 +86,8 @@ struct RasterTimings {
 };
 
 // Throws std::invalid_argument unless views of width × height at options.samplesPerSide fit a
-// raster target (1..16 samples per side, at most 16384 pixels a side) and msaaSamples is 1, 2, 4
-// or 8: to refuse before slow work.
+// raster target (1..16 samples per side, at most 16384 pixels a side), msaaSamples is 1, 2, 4 or 8
+// and anisotropy 1..16: to refuse before slow work.
 void checkRasterSize(uint32_t width, uint32_t height, const RasterOptions& options);
 
 // Replaces inactive probes by the mean of their active neighbours, growing outwards until every
