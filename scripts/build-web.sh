@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # Builds the browser viewer: the probe codec and the bus format compiled to WebAssembly with
 # emscripten (zstd included, from Debian's own source package), and the page's JavaScript
-# dependencies from web/package-lock.json. Output: build/web/ (served as static files).
+# dependencies from web/package-lock.json. Output: build/web/ (served as static files: only the page,
+# its code and licences); intermediate files go beside it, in build/web-work/.
 #   scripts/build-web.sh [OUT]      (OUT defaults to build/web)
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 OUT=$(realpath -m "${1:-$ROOT/build/web}")
-mkdir -p "$OUT"
+WORK="$OUT-work"
+mkdir -p "$OUT" "$WORK"
+rm -rf "$OUT/obj" "$OUT/zstd" "$OUT/apt"  # where older builds kept them, inside the served folder
 
 command -v emcc >/dev/null || { echo "build-web: emcc not found (apt install emscripten)" >&2; exit 1; }
 # Debian's emscripten runs its JavaScript tools with the node on PATH; Debian's acorn lives here.
@@ -15,10 +18,10 @@ export NODE_PATH=/usr/share/nodejs${NODE_PATH:+:$NODE_PATH}
 
 # zstd's sources: Debian's source package of the libzstd the native build links, fetched with
 # apt's own signature and hash checks into a private apt state (the machine's sources untouched).
-ZSTD="$OUT/zstd"
+ZSTD="$WORK/zstd"
 if [ ! -f "$ZSTD/lib/zstd.h" ]; then
   echo "build-web: fetching Debian's zstd source package"
-  APT="$OUT/apt"
+  APT="$WORK/apt"
   rm -rf "$APT" "$ZSTD"
   mkdir -p "$APT/sources" "$APT/lists/partial" "$APT/cache/archives/partial" "$APT/get"
   uri="http://deb.debian.org/debian"
@@ -47,13 +50,13 @@ mapfile -t CODEC < <(sed -n '/^add_library(probecast_codec/,/^)/p' "$ROOT/codec/
 ZSRC=("$ZSTD"/lib/common/*.c "$ZSTD"/lib/compress/*.c "$ZSTD"/lib/decompress/*.c)
 
 echo "build-web: emcc ($(emcc --version | head -1))"
-OBJ="$OUT/obj"
+OBJ="$WORK/obj"
 mkdir -p "$OBJ"
 objs=()
 compile() {  # SOURCE FLAGS...
   local src=$1 obj
   shift
-  obj="$OBJ/$(echo "$src" | sed "s|^$ROOT/||; s|^$OUT/||; s|/|_|g").o"
+  obj="$OBJ/$(echo "$src" | sed "s|^$ROOT/||; s|^$WORK/||; s|/|_|g").o"
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ]; then
     emcc -c "$src" -o "$obj" "$@"
   fi
@@ -89,4 +92,5 @@ mkdir -p "$OUT/licenses"
 cp "$NM/three/LICENSE" "$OUT/licenses/three.LICENSE"
 cp "$NM/nats.ws/LICENSE" "$OUT/licenses/nats.ws.LICENSE"
 cp "$NM/iwer/LICENSE" "$OUT/licenses/iwer.LICENSE"
+cp "$ZSTD/LICENSE" "$OUT/licenses/zstd.LICENSE"  # compiled into the codec's WebAssembly
 echo "build-web: page in $OUT (index.html)"

@@ -18,12 +18,22 @@ import { ProbeLighting } from './probe_lighting.js';
 import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
 
 const params = new URLSearchParams(location.search);
-const fragment = new URLSearchParams(location.hash.slice(1));
+// The fragment's token=…, percent-decoded but with '+' kept (a base64 token holds '+', which
+// form decoding would turn into a space).
+function fragmentValue(name) {
+  for (const part of location.hash.slice(1).split('&')) {
+    const eq = part.indexOf('=');
+    if (eq > 0 && part.slice(0, eq) === name) {
+      try { return decodeURIComponent(part.slice(eq + 1)); } catch { return part.slice(eq + 1); }
+    }
+  }
+  return null;
+}
 const config = {
   nats: params.get('nats'),
-  stream: params.get('stream') || 'default',
+  stream: params.get('stream') || 'probes',  // serve --stream's default
   scene: params.get('scene'),
-  token: fragment.get('token') || params.get('token') || '',
+  token: fragmentValue('token') || params.get('token') || '',
   camera: params.get('camera'),
 };
 
@@ -50,9 +60,25 @@ window.probecast = state;
 const statusEl = document.getElementById('status');
 const canvas = document.getElementById('view');
 
+// A failure the page cannot get past (a wrong address or token: the address must change).
+let fatal = '';
 function fail(message) {
-  state.error = message;
-  statusEl.classList.add('error');
+  fatal = message;
+  showErrors();
+}
+
+// Failures the page recovers from by itself (the bus, the stream, the scene's files): shown by
+// name while they last, gone once put right.
+const problems = new Map();
+function problem(key, message) {
+  if (message) problems.set(key, message);
+  else problems.delete(key);
+  showErrors();
+}
+
+function showErrors() {
+  state.error = [fatal, ...problems.values()].filter(Boolean).join('\n');
+  statusEl.classList.toggle('error', state.error !== '');
 }
 
 if (!/^[A-Za-z0-9_-]+$/.test(config.stream)) fail(`stream name "${config.stream}" is not letters, digits, - and _`);
@@ -201,8 +227,11 @@ async function loadScene(manifestText, hash) {
   const files = new Map();
   const folder = new URL(config.scene.endsWith('/') ? config.scene : config.scene + '/', location.href);
   for (const f of manifest.files) {
-    const r = await fetch(sceneFileUrl(f.path, folder));
-    if (!r.ok) throw new Error(`scene file ${f.path}: HTTP ${r.status}`);
+    const url = sceneFileUrl(f.path, folder);
+    const r = await fetch(url).catch((e) => {
+      throw new Error(`scene file ${f.path}: ${url.href} could not be fetched (${e.message}): is scene= the folder a web server serves?`);
+    });
+    if (!r.ok) throw new Error(`scene file ${f.path}: HTTP ${r.status} from ${url.href}`);
     const bytes = new Uint8Array(await r.arrayBuffer());
     if (bytes.length !== f.bytes || (await sha256Hex(bytes)) !== f.sha256)
       throw new Error(`scene file ${f.path} is not the stream's (size or SHA-256 differs): the scene does not match the stream ${hash.slice(0, 12)}`);
@@ -222,6 +251,9 @@ async function loadScene(manifestText, hash) {
       const mats = Array.isArray(o.material) ? o.material : [o.material];
       for (const m of mats) {
         m.side = THREE.DoubleSide;  // scenes are two-sided, as in the tracers
+        // Mip-mapped (three's default) with the native client's anisotropic taps (RasterOptions).
+        for (const t of [m.map, m.emissiveMap, m.metalnessMap, m.roughnessMap, m.aoMap])
+          if (t) t.anisotropy = Math.min(8, renderer.capabilities.getMaxAnisotropy());
         if (m.isMeshStandardMaterial) lighting.apply(m);
       }
     }
@@ -230,6 +262,8 @@ async function loadScene(manifestText, hash) {
       if (o.shadow) o.shadow.mapSize.set(1024, 1024);
     }
   });
+  fitSunShadows(gltf.scene);
+  state.emitters = countEmitters(gltf.scene);
   camera = pickCamera(gltf);
   // The scene's animation, every clip at once, looped over the longest (as the native viewers).
   animation = null;
@@ -245,6 +279,78 @@ async function loadScene(manifestText, hash) {
     animation = { mixer, actions, length: Math.max(...gltf.animations.map((c) => c.duration)) };
   }
   state.sceneLoaded = true;
+  state.sceneHash = hash;
+}
+
+// Loads the scene the stream names, and tries again every few seconds while it fails (files
+// missing or not yet the stream's: put right, the page picks them up by itself).
+let sceneTriedAt = 0, sceneTried = '';
+function ensureScene() {
+  if (!codec || !codec.hasVolume() || loadingScene) return;
+  const hash = codec.sceneHash();
+  if (!hash || hash === state.sceneHash) return;
+  if (hash === sceneTried && performance.now() - sceneTriedAt < 3000) return;
+  sceneTried = hash;
+  sceneTriedAt = performance.now();
+  loadingScene = loadScene(codec.sceneManifest(), hash)
+    .then(() => problem('scene', ''))
+    .catch((e) => problem('scene', e.message))
+    .finally(() => { loadingScene = null; });
+}
+setInterval(ensureScene, 500);
+
+// A directional light's shadow covers the whole scene (three.js's default box is 10 m wide around
+// the light's node): its orthographic camera is fitted to the scene's bounds seen from the light,
+// with a map large enough to keep the native client's texel size on scenes of a few tens of metres.
+function fitSunShadows(root) {
+  root.updateMatrixWorld(true);
+  const box = new THREE.Box3().setFromObject(root);
+  if (box.isEmpty()) return;
+  const corners = [];
+  for (let i = 0; i < 8; ++i)
+    corners.push(new THREE.Vector3(i & 1 ? box.max.x : box.min.x, i & 2 ? box.max.y : box.min.y, i & 4 ? box.max.z : box.min.z));
+  const size = Math.min(4096, renderer.capabilities.maxTextureSize);
+  root.traverse((o) => {
+    if (!o.isDirectionalLight || !o.shadow) return;
+    const lightPos = o.getWorldPosition(new THREE.Vector3());
+    const dir = o.target.getWorldPosition(new THREE.Vector3()).sub(lightPos).normalize();
+    const centre = box.getCenter(new THREE.Vector3()), radius = box.getSize(new THREE.Vector3()).length() / 2;
+    // The light's position only sets the shadow camera's place: put it outside the scene, up-beam,
+    // and its target (glTF lights carry it as a child) one metre down the beam from there.
+    const place = centre.clone().addScaledVector(dir, -2 * radius);
+    o.position.copy(o.parent ? o.parent.worldToLocal(place.clone()) : place);
+    o.updateMatrixWorld(true);
+    if (o.target.parent !== o) {
+      if (!o.target.parent) scene.add(o.target);
+      o.target.position.copy(o.target.parent.worldToLocal(place.clone().add(dir)));
+      o.target.updateMatrixWorld(true);
+    }
+    const cam = o.shadow.camera;
+    o.shadow.updateMatrices(o);
+    const bounds = new THREE.Box3();
+    for (const c of corners) bounds.expandByPoint(c.clone().applyMatrix4(cam.matrixWorldInverse));
+    cam.left = bounds.min.x;
+    cam.right = bounds.max.x;
+    cam.bottom = bounds.min.y;
+    cam.top = bounds.max.y;
+    cam.near = Math.max(0.01, -bounds.max.z - 0.01 * radius);
+    cam.far = -bounds.min.z + 0.01 * radius;
+    cam.updateProjectionMatrix();
+    o.shadow.mapSize.set(size, size);
+    o.shadow.bias = -0.0002;
+    o.shadow.normalBias = 1.5 * Math.max(bounds.max.x - bounds.min.x, bounds.max.y - bounds.min.y) / size;
+  });
+}
+
+// Meshes whose material emits: the only surfaces a stream's area-light rule can leave to the page.
+function countEmitters(root) {
+  let n = 0;
+  root.traverse((o) => {
+    if (!o.isMesh) return;
+    for (const m of Array.isArray(o.material) ? o.material : [o.material])
+      if (m.emissive && m.emissive.getHex() !== 0 && (m.emissiveIntensity ?? 1) > 0) n += 1;
+  });
+  return n;
 }
 
 function pickCamera(gltf) {
@@ -286,22 +392,23 @@ function onMessage(bytes) {
   }
   if (r === 1) {
     state.epochs += 1;
-    const hash = codec.sceneHash();
-    if (hash && hash !== state.sceneHash && !loadingScene) {
-      state.sceneHash = hash;
-      loadingScene = loadScene(codec.sceneManifest(), hash).catch((e) => fail(e.message)).finally(() => { loadingScene = null; });
-    }
+    ensureScene();
     state.representation = codec.representation();
-    // The page does not draw client area lights yet: say so rather than show a darker room silently.
-    state.warning = codec.areaLightRule() !== 0
-      ? 'this stream leaves its area lights to the viewer, and this page does not draw them yet: their direct light is missing'
-      : '';
   }
   if (r === 2) state.lastBrickAt = performance.now();
   volumeDirty = true;
 }
 
+// The page does not draw client area lights yet: where the stream leaves some to the viewer (its
+// rule is on and the scene has emitting surfaces), say so rather than show a darker room silently.
+function areaLightWarning() {
+  return codec.areaLightRule() !== 0 && state.sceneLoaded && state.emitters > 0
+    ? 'this stream leaves its area lights to the viewer, and this page does not draw them yet: their direct light is missing'
+    : '';
+}
+
 function refreshVolume() {
+  if (codec && codec.hasVolume()) state.warning = areaLightWarning();
   if (!volumeDirty || !codec.hasVolume()) return;
   volumeDirty = false;
   state.bricks = codec.bricks();
@@ -327,13 +434,19 @@ async function subscribe() {
         return;
       }
       state.connection = 'unreachable';
+      problem('bus', `the bus at ${config.nats} is unreachable (${text}); trying again`);
       await sleep(1000);
       continue;
     }
     (async () => {
       for await (const s of nc.status()) {
-        if (s.type === 'disconnect' || s.type === 'reconnecting') state.connection = 'reconnecting';
-        else if (s.type === 'reconnect') state.connection = 'connected';
+        if (s.type === 'disconnect' || s.type === 'reconnecting') {
+          state.connection = 'reconnecting';
+          problem('bus', `lost the bus at ${config.nats}; reconnecting`);
+        } else if (s.type === 'reconnect') {
+          state.connection = 'connected';
+          problem('bus', '');
+        }
       }
     })();
     try {
@@ -344,11 +457,18 @@ async function subscribe() {
         deliver_policy: DeliverPolicy.LastPerSubject,
       });
       state.connection = 'connected';
+      problem('bus', '');
+      problem('stream', '');
       const messages = await consumer.consume({ max_messages: 512 });
       for await (const m of messages) onMessage(m.data);
     } catch (e) {
       state.lastStreamError = String(e && e.message);
-      state.connection = /stream not found/i.test(state.lastStreamError) ? 'waiting for the producer' : 'reconnecting';
+      const missing = /stream not found/i.test(state.lastStreamError);
+      state.connection = missing ? 'waiting for the producer' : 'reconnecting';
+      problem('bus', '');
+      problem('stream', missing
+        ? `no stream "${config.stream}" on the bus: is a producer publishing it (serve --publish … --stream ${config.stream})?`
+        : `the stream "${config.stream}" stopped (${state.lastStreamError}); reconnecting`);
     }
     await nc.close().catch(() => {});
     await sleep(1000);

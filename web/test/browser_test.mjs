@@ -52,7 +52,8 @@ function check(ok, message) {
 
 const base = 20000 + Math.floor(Math.random() * 20000);
 const ports = { nats: base, ws: base + 1, grpc: base + 2, http: base + 3 };
-const busToken = 'bus-' + Math.random().toString(36).slice(2);
+// '+', '/' and '=' as a base64 token has them: the address carries it as it is.
+const busToken = 'bus+' + Math.random().toString(36).slice(2) + '/x=';
 
 // nats-server: JetStream, a token, and a WebSocket listener on loopback (plain ws: loopback only).
 writeFileSync(join(work, 'bus-token'), busToken + '\n');
@@ -260,7 +261,28 @@ try {
     return /does not match the stream/.test(v.error) ? v : null;
   }, 30);
   check(!mismatch.sceneLoaded, `a scene that is not the stream's is refused: "${mismatch.error}"`);
+  // Put right, the page picks the files up by itself and the message goes.
+  writeFileSync(join(work, 'altered', basename(sceneGltf)), readFileSync(sceneGltf));
+  const mended = await until('the mended scene to load', async () => {
+    const v = await altered.evaluate(() => ({ ...window.probecast }));
+    return v.sceneLoaded && !v.error ? v : null;
+  }, 30);
+  check(mended.sceneLoaded && !mended.error, 'once the scene folder is the stream\'s, the page loads it and the error goes');
   await altered.close();
+
+  // A stream no producer publishes, and a bus that is not there: each named on the page.
+  const named = async (address, what, pattern) => {
+    const p = await browser.newPage({ viewport: { width: 320, height: 240 } });
+    await p.goto(address);
+    const v = await until(what, async () => {
+      const s = await p.evaluate(() => ({ ...window.probecast, text: document.getElementById('status').textContent }));
+      return pattern.test(s.error) && s.text.includes(s.error) ? s : null;
+    }, 30);
+    check(true, `${what}: "${v.error}"`);
+    await p.close();
+  };
+  await named(url(busToken).replace('&stream=web', '&stream=nosuch'), 'a missing stream is named', /no stream "nosuch"/);
+  await named(url(busToken).replace(`ws://127.0.0.1:${ports.ws}`, 'ws://127.0.0.1:1'), 'an unreachable bus is named', /unreachable/);
 
   const weight = [...served].filter(([f]) => /\.(js|mjs|wasm|html)$/.test(f)).reduce((a, [, b]) => a + b, 0);
   const report = {
