@@ -70,6 +70,49 @@ class Mesh:
         self.quad([(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)], (-1, 0, 0))
 
 
+def pack_meshes(meshes):
+    """[(name, Mesh, material)] → the buffer's bytes, bufferViews, accessors and glTF meshes."""
+    blob, views, accessors = bytearray(), [], []
+
+    def add(data, fmt, count, kind, target, minmax=None):
+        while len(blob) % 4:
+            blob.append(0)
+        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
+        blob.extend(data)
+        acc = {"bufferView": len(views) - 1, "componentType": fmt, "count": count, "type": kind}
+        if minmax:
+            acc["min"], acc["max"] = minmax
+        accessors.append(acc)
+        return len(accessors) - 1
+
+    def flat(vs):
+        return b"".join(struct.pack("<%df" % len(v), *v) for v in vs)
+
+    gltf_meshes = []
+    for name, m, material in meshes:
+        lo = [min(p[i] for p in m.positions) for i in range(3)]
+        hi = [max(p[i] for p in m.positions) for i in range(3)]
+        attrs = {"POSITION": add(flat(m.positions), 5126, len(m.positions), "VEC3", 34962, (lo, hi)),
+                 "NORMAL": add(flat(m.normals), 5126, len(m.normals), "VEC3", 34962),
+                 "TEXCOORD_0": add(flat(m.uvs), 5126, len(m.uvs), "VEC2", 34962)}
+        idx = add(struct.pack("<%dI" % len(m.indices), *m.indices), 5125, len(m.indices), "SCALAR", 34963)
+        gltf_meshes.append({"name": name, "primitives": [{"attributes": attrs, "indices": idx, "material": material}]})
+    return blob, views, accessors, gltf_meshes
+
+
+def write_scene(out, name, doc, blob, images):
+    """OUT/NAME.gltf, OUT/NAME.bin and the images ({file name: PNG bytes})."""
+    with open(os.path.join(out, name + ".bin"), "wb") as f:
+        f.write(blob)
+    for file, data in images.items():
+        with open(os.path.join(out, file), "wb") as f:
+            f.write(data)
+    with open(os.path.join(out, name + ".gltf"), "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+    print("wrote", os.path.join(out, name + ".gltf"))
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "tests", "data", "scenes", "sun-court")
     os.makedirs(out, exist_ok=True)
@@ -85,30 +128,7 @@ def main():
     walls.box((-3, 0, -1), (3, 1.2, 1))
     meshes = [("floor", floor, 0), ("walls", walls, 1)]
 
-    blob, views, accessors = bytearray(), [], []
-
-    def add(data, fmt, count, kind, target, minmax=None):
-        while len(blob) % 4:
-            blob.append(0)
-        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
-        blob.extend(data)
-        acc = {"bufferView": len(views) - 1, "componentType": fmt, "count": count, "type": kind}
-        if minmax:
-            acc["min"], acc["max"] = minmax
-        accessors.append(acc)
-        return len(accessors) - 1
-
-    gltf_meshes = []
-    for name, m, material in meshes:
-        flat = lambda vs: b"".join(struct.pack("<%df" % len(v), *v) for v in vs)
-        lo = [min(p[i] for p in m.positions) for i in range(3)]
-        hi = [max(p[i] for p in m.positions) for i in range(3)]
-        pos = add(flat(m.positions), 5126, len(m.positions), "VEC3", 34962, (lo, hi))
-        nor = add(flat(m.normals), 5126, len(m.normals), "VEC3", 34962)
-        uv = add(flat(m.uvs), 5126, len(m.uvs), "VEC2", 34962)
-        idx = add(struct.pack("<%dI" % len(m.indices), *m.indices), 5125, len(m.indices), "SCALAR", 34963)
-        gltf_meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
-                                                          "indices": idx, "material": material}]})
+    blob, views, accessors, gltf_meshes = pack_meshes(meshes)
 
     # The sun: travelling down and across (−Y, +X, +Z, about 50° above the horizon); the camera in
     # the −X, +Z corner at eye height, looking across the court.
@@ -132,20 +152,11 @@ def main():
         "samplers": [{"wrapS": 10497, "wrapT": 10497, "magFilter": 9729, "minFilter": 9987}],
         "images": [{"uri": "floor.png"}],
         "extensions": {"KHR_lights_punctual": {"lights": [{"name": "sun", "type": "directional", "color": [1.0, 0.96, 0.9], "intensity": 3.0}]}},
-        "buffers": [{"uri": "sun-court.bin", "byteLength": 0}],
+        "buffers": [{"uri": "sun-court.bin", "byteLength": len(blob)}],
         "bufferViews": views,
         "accessors": accessors,
     }
-    doc["buffers"][0]["byteLength"] = len(blob)
-    with open(os.path.join(out, "sun-court.bin"), "wb") as f:
-        f.write(blob)
-    with open(os.path.join(out, "floor.png"), "wb") as f:
-        f.write(checker())
-    with open(os.path.join(out, "sun-court.gltf"), "w") as f:
-        json.dump(doc, f, indent=1)
-        f.write("\n")
-    print("wrote", os.path.join(out, "sun-court.gltf"))
-
+    write_scene(out, "sun-court", doc, blob, {"floor.png": checker()})
 
 if __name__ == "__main__":
     main()

@@ -102,6 +102,37 @@ float materialOcclusion(PtMaterial m, vec4 uvs) {
   return 1.0 + m.dataFactors.x * (r - 1.0);
 }
 
+// The normal texture applied to `n`, the interpolated normal (any length, its file's side; 0 when
+// absent): the tangent frame is the triangle's, ∂p/∂u and ∂p/∂v solved from two position
+// differences across it (e1, e2) and the texture coordinates' differences over them (d1, d2:
+// TEXCOORD_0 in xy, TEXCOORD_1 in zw) through the texture's transform — a triangle's edges in the
+// tracers, a pixel's screen derivatives in the raster client, the same frame. +X follows +u, +Y
+// goes up the image (glTF's v runs down it), +Z along n. Returns n unchanged without a texture
+// or a usable frame; the shading-normal rule comes after.
+vec3 materialNormal(PtMaterial m, vec4 uvs, vec3 n, vec3 e1, vec3 e2, vec4 d1, vec4 d2) {
+  float len = length(n);
+  if (m.dataTextures.z < 0 || !(len > 1e-6)) return n;
+  n /= len;
+  vec4 r0 = m.normalTransform0, r1 = m.normalTransform1;
+  vec2 a = r0.w > 0.5 ? d1.zw : d1.xy, b = r0.w > 0.5 ? d2.zw : d2.xy;
+  a = vec2(dot(r0.xy, a), dot(r1.xy, a));
+  b = vec2(dot(r0.xy, b), dot(r1.xy, b));
+  float det = a.x * b.y - b.x * a.y;
+  if (!(abs(det) > 1e-30)) return n;
+  vec3 dpdu = (e1 * b.y - e2 * a.y) / det, dpdv = (e2 * a.x - e1 * b.x) / det;
+  vec3 t = dpdu - n * dot(n, dpdu);
+  if (!(dot(t, t) > 1e-30)) return n;
+  t = normalize(t);
+  vec3 up = -(dpdv - n * dot(n, dpdv) - t * dot(t, dpdv));
+  if (!(dot(up, up) > 1e-30)) return n;
+  up = normalize(up);
+  vec3 c = sampleMaterialTexture(m.dataTextures.z, r0, r1, uvs, false).xyz * 2.0 - 1.0;
+  c.xy *= m.dataFactors.y;
+  vec3 p = t * c.x + up * c.y + n * c.z;
+  float pl = length(p);
+  return pl > 1e-6 ? p / pl : n;
+}
+
 // Mask: the point is not there (rays pass, raster discards).
 bool materialCutAway(PtMaterial m, float coverage) {
   return m.textures.z == PT_ALPHA_MASK && coverage < m.alpha.y;

@@ -345,7 +345,10 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     }
     // Reflection (probability 1 − τ, weight (1 − τ) / (1 − τ) = 1).
     segment = 0.0;
-    vec3 n = shadingNormal(vertexNormal(i0) * bary.x + vertexNormal(i1) * bary.y + vertexNormal(i2) * bary.z, ngf, -dir);
+    vec3 ns = vertexNormal(i0) * bary.x + vertexNormal(i1) * bary.y + vertexNormal(i2) * bary.z;
+    ns = materialNormal(m, uvs, ns, p1 - p0, p2 - p0, vertexTexcoords(i1) - vertexTexcoords(i0),
+                        vertexTexcoords(i2) - vertexTexcoords(i0));
+    vec3 n = shadingNormal(ns, ngf, -dir);
     vec3 wo = -dir;
     vec2 metalRough = materialMetallicRoughness(m, uvs);
     float metallic = metalRough.x;

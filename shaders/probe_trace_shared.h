@@ -76,12 +76,14 @@ struct PtMaterial {
   vec4 baseTransform1;
   vec4 emissiveTransform0;
   vec4 emissiveTransform1;
-  ivec4 dataTextures;       // x metallic-roughness texture (B metallic, G roughness), y occlusion (R); -1 = none; read linearly
-  vec4 dataFactors;         // x occlusion strength
+  ivec4 dataTextures;       // x metallic-roughness texture (B metallic, G roughness), y occlusion (R), z normal (RGB); -1 = none; read linearly
+  vec4 dataFactors;         // x occlusion strength, y normal scale
   vec4 metallicRoughnessTransform0;
   vec4 metallicRoughnessTransform1;
   vec4 occlusionTransform0;
   vec4 occlusionTransform1;
+  vec4 normalTransform0;
+  vec4 normalTransform1;
 };
 
 struct PtTexture {
@@ -167,7 +169,7 @@ struct PtCameraPushConstants {
 #ifdef __cplusplus
 static_assert(sizeof(PtCameraPushConstants) == 112);
 static_assert(sizeof(PtEmitter) == 16);
-static_assert(sizeof(PtMaterial) == 224);
+static_assert(sizeof(PtMaterial) == 256);
 static_assert(sizeof(PtTexture) == 16);
 static_assert(sizeof(PtLight) == 64);
 static_assert(sizeof(PtPushConstants) == 112);

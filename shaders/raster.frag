@@ -262,11 +262,12 @@ void main() {
   // Texture footprints from the screen derivatives, taken before any discard (material.glsl).
   materialUvDx = dFdx(texcoord);
   materialUvDy = dFdy(texcoord);
+  vec3 positionDx = dFdx(worldPosition), positionDy = dFdy(worldPosition);
   materialMaxAnisotropy = float(pc.maxAnisotropy);
   vec3 wo = normalize(views[pc.viewBase + gl_ViewIndex].eye.xyz - worldPosition);
   // The geometric normal from the position's screen derivatives (before any discard), on the
   // viewer's side; the shading normal then follows the rule of material.glsl, as in the tracers.
-  vec3 ng = cross(dFdx(worldPosition), dFdy(worldPosition));
+  vec3 ng = cross(positionDx, positionDy);
   float ngLen = length(ng);
   vec3 ngf = ngLen > 1e-20 ? ng / ngLen : wo;
   if (dot(ngf, wo) < 0.0) ngf = -ngf;
@@ -283,7 +284,8 @@ void main() {
   float metallic = metalRough.x, roughness = metalRough.y;
   float alpha = max(roughness * roughness, 1e-3);
   vec3 emission = materialEmission(m, texcoord);
-  vec3 n = shadingNormal(worldNormal, ngf, wo);
+  vec3 n = shadingNormal(materialNormal(m, texcoord, worldNormal, positionDx, positionDy, materialUvDx, materialUvDy),
+                         ngf, wo);
   vec3 direct = vec3(0.0);
   for (uint i = 0u; i < pc.lightCount; ++i) {
     PtLight l = lights[i];

@@ -35,10 +35,12 @@ void uploadGpuShading(VulkanDevice& d, const scene::Scene& s, GpuScene& g) {
     pm.alpha = {m.alpha, m.alphaCutoff, m.transmission, 0.0f};
     rows(m.baseColorTransform, pm.baseTransform0, pm.baseTransform1);
     rows(m.emissiveTransform, pm.emissiveTransform0, pm.emissiveTransform1);
-    pm.dataTextures = {textureIndex(m.metallicRoughnessTexture), textureIndex(m.occlusionTexture), -1, 0};
-    pm.dataFactors = {m.occlusionStrength, 0.0f, 0.0f, 0.0f};
+    pm.dataTextures = {textureIndex(m.metallicRoughnessTexture), textureIndex(m.occlusionTexture),
+                       textureIndex(m.normalTexture), 0};
+    pm.dataFactors = {m.occlusionStrength, m.normalScale, 0.0f, 0.0f};
     rows(m.metallicRoughnessTransform, pm.metallicRoughnessTransform0, pm.metallicRoughnessTransform1);
     rows(m.occlusionTransform, pm.occlusionTransform0, pm.occlusionTransform1);
+    rows(m.normalTransform, pm.normalTransform0, pm.normalTransform1);
     mats.push_back(pm);
   }
   static_assert(PT_ALPHA_OPAQUE == static_cast<int>(scene::AlphaMode::Opaque) &&

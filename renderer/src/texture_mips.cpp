@@ -54,7 +54,7 @@ uint32_t appendMipChain(const scene::Texture& t, bool srgb, std::vector<uint32_t
 std::vector<bool> colourTextures(const scene::Scene& s) {
   std::vector<bool> colour(s.textures.size(), false);
   for (const scene::Material& m : s.materials)
-    for (int32_t index : {m.baseColorTexture, m.emissiveTexture})
+    for (int32_t index : {m.baseColorTexture, m.emissiveTexture})  // the rest (data, normals) are linear
       if (index >= 0 && static_cast<size_t>(index) < colour.size()) colour[static_cast<size_t>(index)] = true;
   return colour;
 }

@@ -234,6 +234,11 @@ void convertMaterials(const tinygltf::Model& model, Scene& scene) {
         textureTransform(pbr.metallicRoughnessTexture.extensions, pbr.metallicRoughnessTexture.texCoord);
     out.occlusionTexture = convertTexture(model, m.occlusionTexture.index, imageToTexture, scene);
     out.occlusionTransform = textureTransform(m.occlusionTexture.extensions, m.occlusionTexture.texCoord);
+    out.normalTexture = convertTexture(model, m.normalTexture.index, imageToTexture, scene);
+    out.normalTransform = textureTransform(m.normalTexture.extensions, m.normalTexture.texCoord);
+    out.normalScale = std::isfinite(m.normalTexture.scale)
+                          ? std::clamp(static_cast<float>(m.normalTexture.scale), -16.0f, 16.0f)
+                          : 1.0f;
     out.occlusionStrength = std::isfinite(m.occlusionTexture.strength)
                                 ? std::clamp(static_cast<float>(m.occlusionTexture.strength), 0.0f, 1.0f)
                                 : 1.0f;

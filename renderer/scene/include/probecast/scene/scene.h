@@ -47,6 +47,13 @@ struct Material {
   float occlusionStrength = 1.0f;
   TextureTransform metallicRoughnessTransform;
   TextureTransform occlusionTransform;
+  // Tangent-space normal texture (linear; RGB = XYZ in [−1, 1], +X along +u, +Y up the image,
+  // i.e. along −v, +Z out of the surface), its XY scaled by normalScale. Every renderer takes the
+  // tangent frame of each triangle from its positions and texture coordinates (the file's
+  // TANGENT attribute is not read).
+  int32_t normalTexture = -1;
+  float normalScale = 1.0f;
+  TextureTransform normalTransform;
   // Coverage: a = alpha (baseColorFactor.a) × the base colour texture's alpha.
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alpha = 1.0f;
