@@ -35,6 +35,7 @@ struct ServeOptions {
   float errorBound = 0.0f;
   uint32_t confirmations = 0;
   double hz = 10.0, seconds = 0.0, animate = 0.05, holdAfter = 0.0;
+  CLI::Option* animateOption = nullptr;
 };
 
 // The scene package a probe file's viewers are sent: the one it names, with its files from
@@ -162,9 +163,14 @@ void addServeCommand(CLI::App& app) {
                     "publish no new lighting after this many seconds (0 = never): subscribers are still served and "
                     "settle on the last volume, to be compared bit for bit")
       ->check(CLI::Range(0.0, 1e9));
-  serve->add_option("--animate", o->animate, "live: scene seconds per second (the scene clock's rate; 0: still)")
-      ->check(CLI::Range(0.0, 10.0));
+  o->animateOption =
+      serve->add_option("--animate", o->animate,
+                        "live: scene seconds per second (the scene clock's rate; 0: still); 0.05 by default, 0 when "
+                        "--time names a moment")
+          ->check(CLI::Range(0.0, 10.0));
   serve->callback([o] {
+    // --time alone traces that moment: the clock runs only when --animate says so.
+    if (o->tracing.scene.tOption->count() > 0 && o->animateOption->count() == 0) o->animate = 0.0;
     service::ServerConfig sc = o->server.config();
     service::BusConfig bus;
     bus.url = o->publish;

@@ -50,4 +50,22 @@ shown, traced = float(m.group(1)), float(m.group(2))
 assert shown > 0.5 and traced > 0.5, (shown, traced)
 print("live animation: drawn at %.3f s, probes of %.3f s" % (shown, traced))
 PY
+# --time alone names a moment: the producer traces it and its clock stands still there.
+still=$((base + 2))
+"$probecast" serve --scene "$scene" --time 0.3 --grid 4,4,4 --spp 32 --listen "127.0.0.1:$still" --plaintext \
+  --token t0k --seconds 30 >"$work/still.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do grep -q "on port" "$work/still.log" && break; sleep 0.1; done
+sleep 2
+"$probecast" view --connect "127.0.0.1:$still" --token t0k --wait 1 --views mono --size 32x32 \
+  --out "$work/still-view" | tee "$work/still-view.log"
+python3 - "$work/still-view.log" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+m = re.search(r"drawn at scene time ([0-9.]+) \(display clock\); probes traced at ([0-9.]+)", text)
+assert m, text
+shown, traced = float(m.group(1)), float(m.group(2))
+assert abs(shown - 0.3) < 1e-3 and abs(traced - 0.3) < 1e-3, ("serve --time 0.3 did not stay at 0.3 s", shown, traced)
+print("serve --time 0.3: drawn at %.3f s, probes of %.3f s" % (shown, traced))
+PY
 echo "animated scene round trip ok"
