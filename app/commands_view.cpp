@@ -171,12 +171,14 @@ void addViewCommand(CLI::App& app) {
   o->tracing.add(cmd);
   cmd->add_option("--probes", o->probes, "probe volume file, or 'live' to trace it now");
   cmd->add_option("--updates", o->updates, "live: updates to accumulate")->check(CLI::Range(1, 100000));
-  o->connection.add(cmd, "take the probes from a probecast server (host:port) instead", false, false);
+  o->connection.add(cmd, "take the probes from a probecast server (host:port) instead", false, true);
   o->connection.addLimits(cmd);
   cmd->add_option("--wait", o->waitSeconds, "--connect: seconds to receive the stream before rendering")
       ->check(CLI::Range(0.1, 3600.0));
   o->viewsOption =
-      cmd->add_option("--views", o->views, "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt)");
+      cmd->add_option("--views", o->views,
+                      "mono, stereo, lf:NxM (full parallax) or lfh:NxM (horizontal, Looking Glass quilt); default "
+                      "lf:5x5, mono in a --window");
   o->sizeOption = addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
   cmd->add_option("--looking-glass", o->lookingGlass,
                   "a Looking Glass display's calibration (visual.json): render its view set (8x6 on portrait "
@@ -218,6 +220,7 @@ void addViewCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tonemap", o->toneMap, "PNG tone map: filmic or gamma")->check(CLI::IsMember({"filmic", "gamma"}));
   cmd->callback([o] {
+    if (o->window.enabled && o->viewsOption->count() == 0) o->views = "mono";  // a window: one view unless asked
     renderer::ViewSetSpec spec;
     std::string error;
     orThrow(renderer::parseViewSet(o->views, spec, error), error);
@@ -229,13 +232,12 @@ void addViewCommand(CLI::App& app) {
       if (o->tracing.scene.tOption->count() > 0)
         throw std::runtime_error("--time: a viewer of a stream draws at the stream's scene clock");
       streamed = streamScene(*o);
-      const session::ViewerScene& vs = streamed;
-      o->streamScene = vs.hash;
-      sceneSpec = vs.spec;
-      t = vs.time;
-      environment = vs.environmentFile.empty() && vs.lighting.kind == service::SceneLighting::Kind::None
+      o->streamScene = streamed.hash;
+      sceneSpec = streamed.spec;
+      t = streamed.time;
+      environment = streamed.environmentFile.empty() && streamed.lighting.kind == service::SceneLighting::Kind::None
                         ? o->tracing.scene.environment.load()
-                        : loadLighting(vs.lighting, vs.environmentFile);
+                        : loadLighting(streamed.lighting, streamed.environmentFile);
     } else {
       environment = o->tracing.scene.environment.load();  // background, and the light of live probes
     }

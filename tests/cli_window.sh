@@ -4,7 +4,7 @@
 # 1. Local probes: a screenshot of the window is the offscreen render of the same camera, bit for
 #    bit (EXR), and what was presented (read back from the swapchain) is its tone-mapped PNG below
 #    the status line.
-# 2. A server's stream: a key press (xdotool) writes a screenshot equal to the remote offscreen
+# 2. A server's stream (its token from a file): a key press (xdotool) writes a screenshot equal to the remote offscreen
 #    render; the server is killed and the window keeps presenting frames and says it is
 #    reconnecting; the server returns and the window is connected again.
 set -euo pipefail
@@ -52,6 +52,11 @@ assert frames >= 2, frames
 print("local window: %d frames, screenshot equals the offscreen render" % frames)
 PY
 
+# A window without --views opens one view of --size (not view's default set of 25).
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --size 160x96 --supersample 1 --window \
+  --window-seconds 1 --out "$work/one-view" >"$work/one-view.log"
+grep -q "window: 160x96 on" "$work/one-view.log" || { cat "$work/one-view.log"; exit 1; }
+
 # 2. A server's stream, stopped and started again.
 port=$((20000 + RANDOM % 20000))
 serve() {
@@ -63,7 +68,8 @@ serve() {
 }
 serve 1
 "$probecast" view --connect "127.0.0.1:$port" --token t0k "${view[@]}" --exr --wait 1 --out "$work/remote-off" >/dev/null
-"$probecast" view --connect "127.0.0.1:$port" --token t0k "${view[@]}" --window --window-seconds 90 \
+printf 't0k\n' >"$work/token"
+"$probecast" view --connect "127.0.0.1:$port" --token-file "$work/token" "${view[@]}" --window --window-seconds 90 \
   --out "$work/remote-window" >"$work/remote-window.log" 2>&1 &
 viewer=$!
 pids+=($viewer)
