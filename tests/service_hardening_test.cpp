@@ -72,6 +72,29 @@ grpc::Status rawSubscribe(int port, const std::vector<std::string>& messages,
   return status;
 }
 
+// One request of raw bytes to `method` (unary or server-streaming: the server's status either way).
+grpc::Status rawRequest(int port, const std::string& method, const std::string& bytes) {
+  grpc::GenericStub stub(grpc::CreateChannel(address(port), grpc::InsecureChannelCredentials()));
+  grpc::CompletionQueue cq;
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  ctx.set_deadline(std::chrono::system_clock::now() + 5s);
+  grpc::Slice slice(bytes);
+  const grpc::ByteBuffer request(&slice, 1);
+  std::unique_ptr<grpc::GenericClientAsyncResponseReader> call = stub.PrepareUnaryCall(&ctx, method, request, &cq);
+  call->StartCall();
+  grpc::ByteBuffer response;
+  grpc::Status status;
+  call->Finish(&response, &status, nullptr);
+  void* tag = nullptr;
+  bool ok = false;
+  cq.Next(&tag, &ok);
+  cq.Shutdown();
+  while (cq.Next(&tag, &ok)) {
+  }
+  return status;
+}
+
 // A view like viewAt's looking down −z from an eye at `eye` (finite, however far).
 View viewFrom(double x, double y, double z) {
   View v{};
@@ -94,6 +117,23 @@ std::vector<View> lightField(int columns, int rows) {
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < columns; ++c) views.push_back(viewFrom(-0.25 + 0.05 * c, 0.5 + 0.05 * r, 20.0));
   return views;
+}
+
+// Bytes that are no GetVolumeRequest or GetSceneRequest: INVALID_ARGUMENT naming the message
+// (gRPC's typed handlers answered UNIMPLEMENTED, as if the method did not exist).
+TEST(ServiceHardening, UnparsableVolumeAndSceneRequestsAreInvalidArgument) {
+  ProbeHub hub(volumeConfig());
+  ProbeServer server(plaintextConfig(), hub);
+  const std::string truncated("\x0a\x05" "ab", 4);  // field 1 claims 5 bytes, 2 follow
+  for (const char* name : {"GetVolume", "GetScene"}) {
+    const grpc::Status st = rawRequest(server.port(), std::string("/probecast.v1.ProbeStream/") + name, truncated);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << name << ": " << st.error_message();
+    EXPECT_NE(st.error_message().find(std::string("not a valid probecast.v1.") + name + "Request"), std::string::npos)
+        << st.error_message();
+  }
+  // A well-formed empty GetVolumeRequest still gets past parsing (here: no volume yet, or the volume).
+  EXPECT_NE(rawRequest(server.port(), "/probecast.v1.ProbeStream/GetVolume", "").error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
 }
 
 // Defect 1: bytes that are no ClientMessage used to end the stream with OK, unlogged.

@@ -56,16 +56,38 @@ bool authorized(grpc::CallbackServerContext* ctx, const std::string& token, bool
 }
 
 // Sends a scene package: the manifest, then every file in pieces, one write in flight.
-class RefusedSceneReactor : public grpc::ServerWriteReactor<pb::SceneChunk> {
+// The unary and server-streaming calls take raw bytes, so that a request that does not parse is
+// answered INVALID_ARGUMENT (gRPC's typed handlers answer UNIMPLEMENTED) with the message's name.
+template <class T>
+bool parseRequest(const grpc::ByteBuffer* bytes, T& out) {
+  grpc::ByteBuffer copy(*bytes);
+  return grpc::SerializationTraits<T>::Deserialize(&copy, &out).ok();
+}
+
+template <class T>
+grpc::Status notA(const grpc::ByteBuffer* bytes) {
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "a request of " + std::to_string(bytes->Length()) +
+                                                              " bytes is not a valid " + T::descriptor()->full_name());
+}
+
+template <class T>
+grpc::ByteBuffer serialized(const T& message) {
+  grpc::ByteBuffer out;
+  bool own = false;
+  grpc::SerializationTraits<T>::Serialize(message, &out, &own);
+  return out;
+}
+
+class RefusedSceneReactor : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
   void OnDone() override { delete this; }
 };
 
-class SceneReactor : public grpc::ServerWriteReactor<pb::SceneChunk> {
+class SceneReactor : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
  public:
   SceneReactor(std::shared_ptr<const ScenePackage> package, size_t chunkBytes)
       : package_(std::move(package)), buffer_(chunkBytes) {
     chunk_.set_manifest(package_->manifest);
-    StartWrite(&chunk_);
+    write();
   }
   void OnWriteDone(bool ok) override {
     if (!ok) return Finish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "write failed"));
@@ -94,9 +116,13 @@ class SceneReactor : public grpc::ServerWriteReactor<pb::SceneChunk> {
       chunk_.set_offset(offset_);
       chunk_.set_data(buffer_.data(), static_cast<size_t>(n));
       offset_ += static_cast<uint64_t>(n);
-      return StartWrite(&chunk_);
+      return write();
     }
     Finish(grpc::Status::OK);
+  }
+  void write() {
+    out_ = serialized(chunk_);
+    StartWrite(&out_);
   }
   void changed(const PackageFile& f) {
     fmt::print(stderr, "probecast server: the scene file {} cannot be read as it was packaged\n", f.source.string());
@@ -107,6 +133,7 @@ class SceneReactor : public grpc::ServerWriteReactor<pb::SceneChunk> {
   std::shared_ptr<const ScenePackage> package_;
   std::vector<char> buffer_;
   pb::SceneChunk chunk_;
+  grpc::ByteBuffer out_;
   size_t file_ = 0;
   uint64_t offset_ = 0;
   std::ifstream in_;
@@ -435,8 +462,8 @@ class SubscribeReactor : public RawReactor {
   std::optional<grpc::Status> pendingFinish_;
 };
 
-using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<pb::ProbeStream::WithCallbackMethod_GetVolume<
-    pb::ProbeStream::WithCallbackMethod_GetScene<pb::ProbeStream::Service>>>;
+using RawSubscribeService = pb::ProbeStream::WithRawCallbackMethod_Subscribe<pb::ProbeStream::WithRawCallbackMethod_GetVolume<
+    pb::ProbeStream::WithRawCallbackMethod_GetScene<pb::ProbeStream::Service>>>;
 
 constexpr uint32_t kDefaultSceneChunk = 1u << 20, kMaxSceneChunk = 4u << 20;
 
@@ -459,24 +486,31 @@ class Service final : public RawSubscribeService {
     return new SubscribeReactor(hub_, config_, subscribers_, writeTimes_, ctx->peer());
   }
 
-  grpc::ServerUnaryReactor* GetVolume(grpc::CallbackServerContext* ctx, const pb::GetVolumeRequest*,
-                                      pb::VolumeDescription* response) override {
+  grpc::ServerUnaryReactor* GetVolume(grpc::CallbackServerContext* ctx, const grpc::ByteBuffer* requestBytes,
+                                      grpc::ByteBuffer* responseBytes) override {
     grpc::ServerUnaryReactor* reactor = ctx->DefaultReactor();
     if (!authorized(ctx, config_.token, config_.noAuth)) {
       reactor->Finish(grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"));
+      return reactor;
+    }
+    pb::GetVolumeRequest request;
+    if (!parseRequest(requestBytes, request)) {
+      reactor->Finish(notA<pb::GetVolumeRequest>(requestBytes));
       return reactor;
     }
     if (!hub_.ready()) {
       reactor->Finish(notReady());
       return reactor;
     }
-    volumeToWire(hub_.volume(), *response);
+    pb::VolumeDescription response;
+    volumeToWire(hub_.volume(), response);
+    *responseBytes = serialized(response);
     reactor->Finish(grpc::Status::OK);
     return reactor;
   }
 
-  grpc::ServerWriteReactor<pb::SceneChunk>* GetScene(grpc::CallbackServerContext* ctx,
-                                                     const pb::GetSceneRequest* request) override {
+  grpc::ServerWriteReactor<grpc::ByteBuffer>* GetScene(grpc::CallbackServerContext* ctx,
+                                                       const grpc::ByteBuffer* requestBytes) override {
     const auto refuse = [](grpc::StatusCode code, const std::string& why) {
       auto* r = new RefusedSceneReactor();
       r->Finish(grpc::Status(code, why));
@@ -484,6 +518,12 @@ class Service final : public RawSubscribeService {
     };
     if (!authorized(ctx, config_.token, config_.noAuth))
       return refuse(grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token");
+    pb::GetSceneRequest parsed;
+    if (!parseRequest(requestBytes, parsed)) {
+      const grpc::Status why = notA<pb::GetSceneRequest>(requestBytes);
+      return refuse(why.error_code(), why.error_message());
+    }
+    const pb::GetSceneRequest* request = &parsed;
     if (request->scene_hash().size() != 32)
       return refuse(grpc::StatusCode::INVALID_ARGUMENT,
                     "scene_hash of " + std::to_string(request->scene_hash().size()) + " bytes (a SHA-256 has 32)");
