@@ -21,9 +21,17 @@ layout(push_constant) uniform Push {
   int views;     // columns · rows
   uint flags;    // bit 0 invView, bit 1 flipImageX, bit 2 flipImageY
   uvec4 phase;   // 0.32 fixed point: x per pixel right, y per pixel up, z per subpixel, w at pixel (0, 0)
+  // This pass's share (bounded buffers: renderer/src/looking_glass.cpp): the quilt's tile rows
+  // [bandTop, bandTop + bandRows) counted from its top are in Quilt, and the panel's pixel rows
+  // [panelTop, panelTop + panelRows) in Panel; subpixels whose view lies elsewhere are left.
+  int bandTop;
+  int bandRows;
+  int panelTop;
+  int panelRows;
 } pc;
 
-// Both buffers hold RGB floats, row-major from the top, three floats per pixel.
+// Both buffers hold RGB floats, row-major from the top, three floats per pixel: a band of the
+// quilt's tile rows, and a band of the panel's rows.
 layout(std430, set = 0, binding = 0) readonly buffer Quilt { float quilt[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Panel { float panel[]; };
 
@@ -33,7 +41,8 @@ const uint kFlipY = 4u;
 
 float quiltTexel(ivec2 origin, ivec2 t, int channel) {
   const uint quiltWidth = uint(pc.columns * pc.tile.x);
-  const uint index = (uint(origin.y + t.y) * quiltWidth + uint(origin.x + t.x)) * 3u + uint(channel);
+  const uint index = (uint(origin.y + t.y - pc.bandTop * pc.tile.y) * quiltWidth + uint(origin.x + t.x)) * 3u +
+                     uint(channel);
   return quilt[index];
 }
 
@@ -60,15 +69,15 @@ float sampleView(uint view, vec2 uv, int channel) {
 }
 
 void main() {
-  const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-  if (pixel.x >= pc.screen.x || pixel.y >= pc.screen.y) return;
+  const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, pc.panelTop);
+  if (pixel.x >= pc.screen.x || pixel.y >= min(pc.screen.y, pc.panelTop + pc.panelRows)) return;
   const uint yUp = uint(pc.screen.y - 1 - pixel.y);  // the output is stored from the top
   vec2 uv = (vec2(float(pixel.x), float(yUp)) + 0.5) / vec2(pc.screen);
   if ((pc.flags & kFlipX) != 0u) uv.x = 1.0 - uv.x;
   if ((pc.flags & kFlipY) != 0u) uv.y = 1.0 - uv.y;
 
   const uint base = uint(pixel.x) * pc.phase.x + yUp * pc.phase.y + pc.phase.w;
-  const uint out0 = (uint(pixel.y) * uint(pc.screen.x) + uint(pixel.x)) * 3u;
+  const uint out0 = (uint(pixel.y - pc.panelTop) * uint(pc.screen.x) + uint(pixel.x)) * 3u;
   for (int i = 0; i < 3; ++i) {
     uint a = base + uint(i) * pc.phase.z;  // the fractional phase, wrapped by uint arithmetic
     // 1 − a in 0.32 fixed point (one unit off, which only moves exact view boundaries).
@@ -76,6 +85,8 @@ void main() {
     // view = floor(a · views): the high word of the 64-bit product.
     uint view, low;
     umulExtended(a, uint(pc.views), view, low);
+    const int tileRow = pc.rows - 1 - int(view) / pc.columns;  // from the quilt's top
+    if (tileRow < pc.bandTop || tileRow >= pc.bandTop + pc.bandRows) continue;
     panel[out0 + uint(i)] = sampleView(view, uv, i);
   }
 }

@@ -176,6 +176,26 @@ TEST(LookingGlass, UnflippedGradientQuiltSamplesEachViewUpright) {
   checkAgainstReference(portraitCalibration(), 8, 6, 12, 16, /*gradient=*/true);
 }
 
+// Bounded memory: with buffers of at most 40,000 bytes the quilt goes up 2 of its 6 tile rows at a
+// time and the panel comes back 34 rows at a time (12 passes); the panel is the one made in a
+// single pass, bit for bit. A single row of tiles over the limit is refused by name.
+TEST(LookingGlass, BandsWithinABufferLimitGiveThePanelOfOnePass) {
+  VulkanContext context(test::validatedContext());
+  const LookingGlassCalibration cal = portraitCalibration();
+  const Image quilt = makeQuilt(8, 6, 16, 12, /*gradient=*/true);
+  const Image whole = interleaveQuilt(context, quilt, 8, 6, cal);
+  const Image banded = interleaveQuilt(context, quilt, 8, 6, cal, 40000);
+  ASSERT_EQ(banded.rgb.size(), whole.rgb.size());
+  EXPECT_TRUE(banded.rgb == whole.rgb);
+  try {
+    interleaveQuilt(context, quilt, 8, 6, cal, 10000);  // a row of tiles is 18,432 bytes
+    ADD_FAILURE() << "a limit below one row of tiles was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("one row of quilt tiles (18432 bytes) exceeds"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
 TEST(LookingGlass, InterleaverRefusesQuiltsThatDoNotSplitIntoTiles) {
   VulkanContext context(test::validatedContext());
   const LookingGlassCalibration cal = portraitCalibration();
@@ -211,10 +231,10 @@ const char* kPortraitVisualJson = R"({
 
 TEST(LookingGlass, ParsesAFullVisualJson) {
   const LookingGlassCalibration c = parseLookingGlassCalibration(kPortraitVisualJson);
-  EXPECT_FLOAT_EQ(c.pitch, 52.58737564086914f);
-  EXPECT_FLOAT_EQ(c.slope, -7.196136474609375f);
-  EXPECT_FLOAT_EQ(c.center, 0.4321881234645844f);
-  EXPECT_FLOAT_EQ(c.dpi, 324.0f);
+  EXPECT_DOUBLE_EQ(c.pitch, 52.58737564086914);  // as stated, not rounded to float
+  EXPECT_DOUBLE_EQ(c.slope, -7.196136474609375);
+  EXPECT_DOUBLE_EQ(c.center, 0.4321881234645844);
+  EXPECT_DOUBLE_EQ(c.dpi, 324.0);
   EXPECT_FLOAT_EQ(c.viewCone, 40.0f);
   EXPECT_FLOAT_EQ(c.verticalAngle, 0.0f);
   EXPECT_EQ(c.screenW, 1536);
@@ -233,10 +253,10 @@ TEST(LookingGlass, AcceptsPlainNumbersAndDefaultsTheOptionalFields) {
   const LookingGlassCalibration c = parseLookingGlassCalibration(
       R"({"pitch": 49.8, "slope": 5.04, "center": -0.25, "DPI": 283, "screenW": 3840, "screenH": 2160,
           "flipImageX": {"value": 1}, "flipSubp": true, "someFutureField": {"value": 3}})");
-  EXPECT_FLOAT_EQ(c.pitch, 49.8f);
-  EXPECT_FLOAT_EQ(c.slope, 5.04f);
-  EXPECT_FLOAT_EQ(c.center, -0.25f);
-  EXPECT_FLOAT_EQ(c.dpi, 283.0f);
+  EXPECT_DOUBLE_EQ(c.pitch, 49.8);
+  EXPECT_DOUBLE_EQ(c.slope, 5.04);
+  EXPECT_DOUBLE_EQ(c.center, -0.25);
+  EXPECT_DOUBLE_EQ(c.dpi, 283.0);
   EXPECT_EQ(c.screenW, 3840);
   EXPECT_EQ(c.screenH, 2160);
   EXPECT_FLOAT_EQ(c.viewCone, 40.0f);
@@ -284,7 +304,7 @@ TEST(LookingGlass, RefusesBadValuesWithMessagesNamingTheField) {
       {"screenW", 1536.5, "\"screenW\" must be a whole number"},
       {"DPI", {{"value", -1}}, "\"DPI\" must be a finite number > 0"},
       {"pitch", 0, "\"pitch\" must be a finite number > 0"},
-      {"pitch", 1e300, "\"pitch\" must be a finite number > 0"},  // overflows a float
+      {"pitch", 1e300, "\"pitch\" must be a finite number > 0 and at most 100000"},  // absurd but finite
       {"slope", 0, "\"slope\" must be finite with |slope| in"},
       {"slope", -1e6, "\"slope\" must be finite with |slope| in"},
       {"invView", {{"value", 2}}, "\"invView\" must be 0 or 1"},

@@ -88,7 +88,7 @@ std::string textField(const json& root, const char* field) {
 }
 }  // namespace
 
-// The checks both the parser and the interleaver rely on, on the values as stored (floats).
+// The checks both the parser and the interleaver rely on, on the values as stored.
 void checkLookingGlassCalibration(const LookingGlassCalibration& c, const std::string& where) {
   const auto field = [&](const char* name, const std::string& rule, double got) {
     throw std::invalid_argument(where + "field " + quoted(name) + " " + rule + " (got " + show(got) + ")");
@@ -97,8 +97,12 @@ void checkLookingGlassCalibration(const LookingGlassCalibration& c, const std::s
     field("screenW", "must be in 1.." + std::to_string(kMaxScreenSide), c.screenW);
   if (c.screenH < 1 || c.screenH > kMaxScreenSide)
     field("screenH", "must be in 1.." + std::to_string(kMaxScreenSide), c.screenH);
-  if (!std::isfinite(c.dpi) || c.dpi <= 0) field("DPI", "must be a finite number > 0", c.dpi);
-  if (!std::isfinite(c.pitch) || c.pitch <= 0) field("pitch", "must be a finite number > 0", c.pitch);
+  // Real panels: a few hundred pixels and some tens of lenticules per inch.
+  constexpr double kMaxPerInch = 1e5;
+  if (!std::isfinite(c.dpi) || c.dpi <= 0 || c.dpi > kMaxPerInch)
+    field("DPI", "must be a finite number > 0 and at most " + show(kMaxPerInch), c.dpi);
+  if (!std::isfinite(c.pitch) || c.pitch <= 0 || c.pitch > kMaxPerInch)
+    field("pitch", "must be a finite number > 0 and at most " + show(kMaxPerInch), c.pitch);
   if (!std::isfinite(c.slope) || std::fabs(c.slope) < kMinAbsSlope || std::fabs(c.slope) > kMaxAbsSlope)
     field("slope", "must be finite with |slope| in [" + show(kMinAbsSlope) + ", " + show(kMaxAbsSlope) + "]",
           c.slope);
@@ -122,10 +126,10 @@ LookingGlassCalibration parseLookingGlassCalibration(const std::string& jsonText
   if (!root.is_object()) throw std::invalid_argument(where + "expected a JSON object, got " + showJson(root));
 
   LookingGlassCalibration c;
-  c.pitch = static_cast<float>(numberField(root, "pitch", true, 0.0, where));
-  c.slope = static_cast<float>(numberField(root, "slope", true, 0.0, where));
-  c.center = static_cast<float>(numberField(root, "center", true, 0.0, where));
-  c.dpi = static_cast<float>(numberField(root, "DPI", true, 0.0, where));
+  c.pitch = numberField(root, "pitch", true, 0.0, where);
+  c.slope = numberField(root, "slope", true, 0.0, where);
+  c.center = numberField(root, "center", true, 0.0, where);
+  c.dpi = numberField(root, "DPI", true, 0.0, where);
   c.screenW = pixelsField(root, "screenW", where);
   c.screenH = pixelsField(root, "screenH", where);
   c.viewCone = static_cast<float>(numberField(root, "viewCone", false, 40.0, where));

@@ -32,6 +32,7 @@
 // its tile's texel centres, so neighbouring tiles never bleed into it.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "probecast/renderer/reference_camera.h"
@@ -41,10 +42,12 @@ namespace probecast::renderer {
 
 struct LookingGlassCalibration {
   // Required in visual.json.
-  float pitch = 0.0f;   // lenticules per inch
-  float slope = 0.0f;   // lens slant: pixels down per pixel across along a lens line, signed
-  float center = 0.0f;  // phase of the lens sheet against the pixels
-  float dpi = 0.0f;     // the `DPI` field: pixels per inch
+  // Kept as the file states them (double): the lens phase reaches hundreds of lenticules across a
+  // panel, where float32 would move view boundaries by ~1e-4 of a lenticule.
+  double pitch = 0.0;   // lenticules per inch
+  double slope = 0.0;   // lens slant: pixels down per pixel across along a lens line, signed
+  double center = 0.0;  // phase of the lens sheet against the pixels
+  double dpi = 0.0;     // the `DPI` field: pixels per inch
   int screenW = 0;      // native panel size in pixels
   int screenH = 0;
   // Optional; defaults as listed.
@@ -89,9 +92,12 @@ LookingGlassCalibration loadLookingGlassCalibration(const std::string& path);
 // cal.screenW × cal.screenH pixels, linear RGB, rows from the top, on the GPU (a compute shader).
 // Throws std::invalid_argument when the quilt does not split into columns × rows tiles of at
 // least one pixel or its pixel data has the wrong size, or when the calibration fails the range
-// checks parseLookingGlassCalibration() applies; std::runtime_error when
-// the quilt or the panel image is larger than the device's storage-buffer limit.
+// checks parseLookingGlassCalibration() applies. Memory is bounded: the quilt is uploaded a band of
+// tile rows at a time and the panel read back a band of pixel rows at a time, each within the
+// device's storage-buffer range (or `bufferLimit` bytes when smaller and not 0), so any panel and
+// view set the calibration checks allow works on any device; std::runtime_error only when a
+// single row of tiles or of the panel is larger than that.
 Image interleaveQuilt(VulkanContext& context, const Image& quilt, int columns, int rows,
-                      const LookingGlassCalibration& cal);
+                      const LookingGlassCalibration& cal, uint64_t bufferLimit = 0);
 
 }  // namespace probecast::renderer
