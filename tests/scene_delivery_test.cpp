@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "probecast/service/scene_package.h"
 #include "service_test_support.h"
@@ -380,6 +381,44 @@ TEST(SceneDelivery, AServerWithoutTheScenesFilesSaysSo) {
   std::string error;
   EXPECT_FALSE(fetchScene(cc, stamp, freshDir("nofiles-cache"), 1 << 20, got, fetch, error));
   EXPECT_NE(error.find("no scene to deliver"), std::string::npos) << error;
+}
+
+// An edge that has just started names its producer's scene before it holds the files: it answers
+// UNAVAILABLE with a time to ask again, and fetchScene waits and asks again (a scene nobody
+// names is still NOT_FOUND, as above).
+TEST(SceneDelivery, AServerStillGettingTheSceneItNamesIsAskedAgain) {
+  const ScenePackage p = packageOf(writeScene(freshDir("later-source")));
+  SceneServer s(p);
+  s.server->setScene(nullptr);
+  SceneStamp stamp;
+  stamp.hash = p.hash;
+  stamp.manifest = p.manifest;
+  auto stub = pb::ProbeStream::NewStub(
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(s.server->port()), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  pb::GetSceneRequest request;
+  request.set_scene_hash(reinterpret_cast<const char*>(p.hash.data()), 32);
+  auto reader = stub->GetScene(&ctx, request);
+  pb::SceneChunk chunk;
+  EXPECT_FALSE(reader->Read(&chunk));
+  const grpc::Status st = reader->Finish();
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::UNAVAILABLE) << st.error_message();
+  EXPECT_NE(st.error_message().find("still getting the files"), std::string::npos) << st.error_message();
+  EXPECT_EQ(ctx.GetServerTrailingMetadata().count(kSceneRetryMetadata), 1u);
+
+  std::thread later([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    s.server->setScene(s.package);
+  });
+  ScenePackage got;
+  SceneFetch fetch;
+  std::string error;
+  const bool fetched = fetchScene(s.client(), stamp, freshDir("later-cache"), 1 << 20, got, fetch, error);
+  later.join();
+  ASSERT_TRUE(fetched) << error;
+  EXPECT_EQ(got.hash, p.hash);
+  EXPECT_GE(fetch.ms, 500.0);  // it waited for the files
 }
 
 bus::SceneState playingState() {

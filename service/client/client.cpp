@@ -5,6 +5,7 @@
 #include <cmath>
 #include <atomic>
 #include <condition_variable>
+#include <cstdlib>
 #include <thread>
 
 #include <grpcpp/grpcpp.h>
@@ -551,6 +552,53 @@ bool describeScene(const ClientConfig& config, SceneStamp& out, std::string& err
   return error = printableText("no server described its stream: " + errors, 2048), false;
 }
 
+namespace {
+
+struct SceneAttempt {
+  uint64_t bytes = 0;
+  std::string error;  // empty: fetched
+  grpc::StatusCode code = grpc::StatusCode::OK;
+  int retryMs = 0;  // > 0: the server asked to be asked again after this long
+};
+
+// One GetScene call to `server`, written into the cache as `named`; true with `out` filled.
+bool fetchSceneOnce(const ClientConfig& config, const std::string& server, const SceneStamp& scene,
+                    const std::filesystem::path& cache, const ScenePackage& named, ScenePackage& out, SceneAttempt& a) {
+  a = {};
+  grpc::ClientContext ctx;
+  authorize(config, ctx);
+  pb::GetSceneRequest request;
+  request.set_scene_hash(reinterpret_cast<const char*>(scene.hash.data()), scene.hash.size());
+  std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(makeChannel(config, server));
+  std::unique_ptr<grpc::ClientReader<pb::SceneChunk>> reader = stub->GetScene(&ctx, request);
+  PackageWriter writer(cache, named);
+  pb::SceneChunk chunk;
+  std::string error;
+  bool ok = writer.begin(error);  // false: a local failure, the call is cancelled
+  StallGuard guard(ctx, config.sceneStallMs);
+  const bool answered = ok && reader->Read(&chunk);
+  if (answered && chunk.manifest() != scene.manifest) ok = false, error = "it sent another manifest than its description";
+  while (ok && answered && reader->Read(&chunk)) {
+    guard.progress();
+    ok = writer.write(chunk.path(), chunk.offset(), chunk.data(), error);
+    a.bytes += chunk.data().size();
+  }
+  if (!ok) ctx.TryCancel();
+  const grpc::Status status = reader->Finish();
+  a.code = status.error_code();
+  if (guard.stalled()) ok = false, error = "it sent nothing for " + std::to_string(config.sceneStallMs) + " ms";
+  if (ok && answered && status.ok() && writer.finish(out, error)) return true;
+  if (ok && status.ok() && !answered) error = "it sent nothing";
+  a.error = ok && !status.ok() ? status.error_message() : error;
+  if (a.error.empty()) a.error = "it failed without a reason";
+  const auto retry = ctx.GetServerTrailingMetadata().find(kSceneRetryMetadata);
+  if (status.error_code() == grpc::StatusCode::UNAVAILABLE && retry != ctx.GetServerTrailingMetadata().end())
+    a.retryMs = std::clamp(std::atoi(std::string(retry->second.data(), retry->second.size()).c_str()), 10, 5000);
+  return false;
+}
+
+}  // namespace
+
 bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::filesystem::path& cache,
                 uint64_t maxBytes, ScenePackage& out, SceneFetch& fetch, std::string& error) {
   const auto start = std::chrono::steady_clock::now();
@@ -577,36 +625,19 @@ bool fetchScene(const ClientConfig& config, const SceneStamp& scene, const std::
   const std::vector<std::string> servers = serversOf(config);
   std::string errors;
   for (const std::string& server : servers) {
-    grpc::ClientContext ctx;
-    authorize(config, ctx);
-    pb::GetSceneRequest request;
-    request.set_scene_hash(reinterpret_cast<const char*>(scene.hash.data()), scene.hash.size());
-    std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(makeChannel(config, server));
-    std::unique_ptr<grpc::ClientReader<pb::SceneChunk>> reader = stub->GetScene(&ctx, request);
-    PackageWriter writer(cache, named);
-    pb::SceneChunk chunk;
-    bool ok = writer.begin(error);  // false: a local failure, the call is cancelled
-    StallGuard guard(ctx, config.sceneStallMs);
-    const bool answered = ok && reader->Read(&chunk);
-    if (answered && chunk.manifest() != scene.manifest) ok = false, error = "it sent another manifest than its description";
-    uint64_t bytes = 0;
-    while (ok && answered && reader->Read(&chunk)) {
-      guard.progress();
-      ok = writer.write(chunk.path(), chunk.offset(), chunk.data(), error);
-      bytes += chunk.data().size();
-    }
-    if (!ok) ctx.TryCancel();
-    const grpc::Status status = reader->Finish();
-    if (guard.stalled())
-      ok = false, error = "it sent nothing for " + std::to_string(config.sceneStallMs) + " ms";
-    if (ok && answered && status.ok() && writer.finish(out, error)) {
-      fetch.bytes = bytes;
+    // A server still getting the scene it names (an edge just started) says when to ask again.
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(config.sceneStallMs);
+    SceneAttempt a;
+    while (!fetchSceneOnce(config, server, scene, cache, named, out, a) && a.retryMs > 0 &&
+           std::chrono::steady_clock::now() + std::chrono::milliseconds(a.retryMs) < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(a.retryMs));
+    if (a.error.empty()) {
+      fetch.bytes = a.bytes;
       fetch.ms = elapsedMs();
       return true;
     }
-    if (ok && status.ok() && !answered) error = "it sent nothing";
-    errors += (errors.empty() ? "" : "; ") + server + ": " + (ok && !status.ok() ? status.error_message() : error);
-    if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) break;
+    errors += (errors.empty() ? "" : "; ") + server + ": " + a.error;
+    if (a.code == grpc::StatusCode::UNAUTHENTICATED) break;
   }
   return error = printableText("cannot fetch the scene: " + errors, 2048), false;
 }

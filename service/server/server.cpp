@@ -531,7 +531,14 @@ class Service final : public RawSubscribeService {
       return refuse(grpc::StatusCode::INVALID_ARGUMENT,
                     "chunk_bytes " + std::to_string(request->chunk_bytes()) + " is above the limit of 4 MiB");
     const std::shared_ptr<const ScenePackage> package = scene();
-    if (!package || std::memcmp(package->hash.data(), request->scene_hash().data(), 32) != 0)
+    const SceneStamp named = hub_.scene();
+    const bool mine = package && std::memcmp(package->hash.data(), request->scene_hash().data(), 32) == 0;
+    if (!mine && named.known() && std::memcmp(named.hash.data(), request->scene_hash().data(), 32) == 0) {
+      ctx->AddTrailingMetadata(kSceneRetryMetadata, "250");
+      return refuse(grpc::StatusCode::UNAVAILABLE, "this server is still getting the files of scene " +
+                                                      shortHex(named.hash) + ", which its stream names: ask again shortly");
+    }
+    if (!mine)
       return refuse(grpc::StatusCode::NOT_FOUND,
                     package ? "this server delivers scene " + shortHex(package->hash) + ", not the one asked for"
                             : "this server has no scene to deliver (start it with the scene's files)");

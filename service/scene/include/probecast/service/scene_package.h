@@ -25,6 +25,10 @@
 
 namespace probecast::service {
 
+// Trailing metadata of an UNAVAILABLE GetScene: the server names the scene in its stream but is
+// still getting its files (an edge just started); ask again after this many milliseconds.
+inline constexpr const char* kSceneRetryMetadata = "probecast-scene-retry-ms";
+
 using SceneHash = std::array<uint8_t, 32>;
 
 constexpr uint32_t kSceneManifestFormat = 1;
