@@ -311,7 +311,7 @@ void addBenchVideo(CLI::App* bench) {
       "video", "the probe stream's bytes against x265 and AV1 video of the same views at equal PSNR, per display and motion");
   auto vt = std::make_shared<TracingOptions>();
   struct VideoCli {
-    std::string json, chart, moverScene;
+    std::string json, chart, moverScene, headTrace;
     int deadzone = 1;
     double moverRate = 0.5;
     AreaLightCli areaLights;
@@ -332,6 +332,10 @@ void addBenchVideo(CLI::App* bench) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--mover-scene", vo->moverScene, "an animated glTF file measured too, as motion 'mover'")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--head-trace", vo->headTrace,
+                  "move every display's camera as a recorded head moved (timestamp viewpoint w x y z per line, x forward, "
+                  "z up; the MMSys'18 head-movement format), with a neck model; default: the camera is still")
       ->check(CLI::ExistingFile);
   cmd->add_option("--mover-rate", vo->moverRate, "the mover's clock rate, scene seconds per second")
       ->check(CLI::Range(0.0, 100.0))
@@ -398,6 +402,12 @@ void addBenchVideo(CLI::App* bench) {
     }
     const auto grid = vt->grid;
     o.grid = [grid](const scene::Scene& s) { return grid.resolve(s); };
+    if (!vo->headTrace.empty()) {
+      auto trace = std::make_shared<session::HeadTrace>();
+      std::string error;
+      if (!session::loadHeadTrace(vo->headTrace, *trace, error)) throw std::runtime_error("--head-trace " + error);
+      o.headTrace = trace;
+    }
     o.updater = vt->updater(vt->scene.environment.load());
     o.raster = bench::singleSampleRaster();
     o.raster.environment = o.updater.environment;

@@ -80,6 +80,8 @@ struct DisplayFrames {
   const VideoDisplay* display = nullptr;
   std::vector<renderer::ViewInfo> views;
   renderer::ViewSetSpec spec;
+  renderer::CameraView camera;         // the scene's, before any head motion
+  renderer::ViewSetOptions viewOptions;
   std::unique_ptr<renderer::RasterRenderer> floatRaster;
   std::vector<std::unique_ptr<renderer::RasterRenderer>> streamRasters;  // one per stream configuration
   uint32_t width = 0, height = 0;  // the quilt's
@@ -388,8 +390,9 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
       df.display = &o.displays[i];
       std::string error;
       if (!renderer::parseViewSet(df.display->viewSet, df.spec, error)) throw std::invalid_argument(error);
-      df.views = renderer::makeViewSet(renderer::CameraView::fromScene(current), df.spec,
-                                       session::viewSetOptions(current, df.display->width, df.display->height));
+      df.camera = renderer::CameraView::fromScene(current);
+      df.viewOptions = session::viewSetOptions(current, df.display->width, df.display->height);
+      df.views = renderer::makeViewSet(df.camera, df.spec, df.viewOptions);
       df.floatRaster = std::make_unique<renderer::RasterRenderer>(context, current, df.display->width,
                                                                   df.display->height, o.raster);
       for (size_t k = 0; k < streams.size(); ++k)
@@ -425,6 +428,8 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
           df.floatRaster->setShading(current);
           for (auto& r : df.streamRasters) r->setShading(current);
         }
+        if (o.headTrace)
+          df.views = renderer::makeViewSet(session::poseCamera(df.camera, *o.headTrace, t), df.spec, df.viewOptions);
         if (update) {
           df.floatRaster->setProbes(updater.volume());
           for (size_t k = 0; k < streams.size(); ++k) df.streamRasters[k]->setProbes(streams[k].decoded);
@@ -505,6 +510,9 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
             {"seconds", seconds},
             {"warmup_updates", o.warmup},
             {"gop", o.gop},
+            {"camera", o.headTrace ? fmt::format("a recorded head's motion ({:.1f} s trace), neck model {} m ahead, {} m up",
+                                                 o.headTrace->duration(), session::kNeckForward, session::kNeckUp)
+                                   : std::string("still")},
             {"x265", fmt::format("libx265, preset {}, tune zerolatency (no B-frames, no lookahead)", o.preset)},
             {"av1", "libaom-av1, realtime usage, cpu-used 6, no lag"},
             {"psnr", "8-bit RGB of every frame against the float-probe render's, from the summed squared error"},

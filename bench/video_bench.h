@@ -26,6 +26,7 @@
 #include "probecast/renderer/raster_client.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
+#include "probecast/session/head_trace.h"
 
 namespace probecast::bench {
 
@@ -78,6 +79,9 @@ struct VideoBenchOptions {
   uint32_t frames = 60;    // recorded frames per motion
   uint32_t warmup = 16;    // probe updates at scene time 0 before recording
   uint32_t gop = 30;       // video frames per keyframe interval
+  // Every display's camera turns as this head turned (session/head_trace.h), from its start, at
+  // the display clock; none: the camera is still.
+  std::shared_ptr<const session::HeadTrace> headTrace;
   std::string preset = "medium";  // x265's preset; AV1 (libaom, realtime) runs at cpu-used 6
   float exposure = 1.0f;
   std::string ffmpeg = "ffmpeg";

@@ -1,0 +1,64 @@
+// Head traces (session/head_trace.h): the recorded format read as it is written and refused line
+// by line when it is not, the dataset's axes mapped onto the project's, and a camera turned about
+// the neck's pivot.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "probecast/session/head_trace.h"
+
+namespace probecast::session {
+namespace {
+
+std::string failure(const std::string& text) {
+  HeadTrace t;
+  std::string error;
+  EXPECT_FALSE(parseHeadTrace(text, t, error)) << text;
+  return error;
+}
+
+TEST(HeadTrace, ReadsTheRecordedFormatAndRefusesWhatIsNotIt) {
+  HeadTrace t;
+  std::string error;
+  ASSERT_TRUE(parseHeadTrace("timestamp viewpoint w x y z\n0.0 0 1 0 0 0\n# a comment\n\n0.5 0 1 0 0 0\n", t, error))
+      << error;
+  EXPECT_EQ(t.seconds.size(), 2u);
+  EXPECT_DOUBLE_EQ(t.duration(), 0.5);
+  EXPECT_NE(failure("0 0 1 0 0\n1 0 1 0 0 0\n").find("line 1: expected 6 numbers"), std::string::npos);
+  EXPECT_NE(failure("0 0 1 0 0 0\n1 0 1 0 0 0 7\n").find("line 2: expected 6 numbers"), std::string::npos);
+  EXPECT_NE(failure("0 0 1 0 0 0\n1 0 nan 0 0 0\n").find("line 2: a number that is not finite"), std::string::npos);
+  EXPECT_NE(failure("0 0 1 0 0 0\n1 0 2 0 0 0\n").find("line 2: the quaternion's length is 2"), std::string::npos);
+  EXPECT_NE(failure("1 0 1 0 0 0\n0.5 0 1 0 0 0\n").find("line 2: time runs backwards"), std::string::npos);
+  EXPECT_NE(failure("0 0 1 0 0 0\n").find("fewer than two samples"), std::string::npos);
+  EXPECT_NE(failure("1 0 1 0 0 0\n1 0 1 0 0 0\n").find("the same time"), std::string::npos);
+  HeadTrace missing;
+  EXPECT_FALSE(loadHeadTrace("/nonexistent/trace.txt", missing, error));
+  EXPECT_NE(error.find("/nonexistent/trace.txt: cannot be read"), std::string::npos) << error;
+}
+
+// A turn of 90° about the dataset's z (up) over one second: the project's camera, looking down −Z
+// at the start, looks down −X after it (turning left, as z up and y left make a positive turn),
+// half-way at 0.5 s, and the eyes swing about the pivot behind them. The trace loops.
+TEST(HeadTrace, TurnsTheCameraAboutTheNeckAsTheHeadTurned) {
+  const double s = std::sqrt(0.5);
+  HeadTrace t;
+  std::string error;
+  ASSERT_TRUE(parseHeadTrace("0 0 1 0 0 0\n1 0 " + std::to_string(s) + " 0 0 " + std::to_string(s) + "\n", t, error))
+      << error;
+  renderer::CameraView c;
+  c.position = {0, 1.7f, 0};
+  c.forward = {0, 0, -1};
+  c.up = {0, 1, 0};
+  const renderer::CameraView end = poseCamera(c, t, 1.0), half = poseCamera(c, t, 0.5), start = poseCamera(c, t, 0.0);
+  EXPECT_NEAR(glm::length(end.forward - glm::vec3(-1, 0, 0)), 0.0f, 1e-4f);
+  EXPECT_NEAR(glm::length(end.up - glm::vec3(0, 1, 0)), 0.0f, 1e-4f);
+  EXPECT_NEAR(glm::length(half.forward - glm::normalize(glm::vec3(-1, 0, -1))), 0.0f, 1e-4f);
+  EXPECT_NEAR(glm::length(start.position - c.position), 0.0f, 1e-6f);
+  // The pivot sits kNeckForward behind the eyes: after the turn the eyes are ahead of it along −X.
+  const glm::vec3 pivot = c.position - glm::vec3(0, 0, -kNeckForward);
+  EXPECT_NEAR(glm::length(end.position - (pivot + glm::vec3(-kNeckForward, 0, 0))), 0.0f, 1e-5f);
+  EXPECT_NEAR(glm::length(poseCamera(c, t, 1.5).forward - half.forward), 0.0f, 1e-4f);  // 1.5 s: looped to 0.5
+}
+
+}  // namespace
+}  // namespace probecast::session
