@@ -31,7 +31,7 @@ struct HeadTrace {
   glm::quat rotationAt(double t) const;
 };
 
-inline constexpr float kNeckForward = 0.08f;  // metres from the neck's pivot to the eyes, ahead
+inline constexpr float kNeckForward = 0.10f;  // metres from the neck's pivot to the eyes, ahead
 inline constexpr float kNeckUp = 0.10f;       // and above
 
 // Reads a trace; false with a message naming the file and line on anything malformed (a bad
