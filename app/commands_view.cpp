@@ -24,25 +24,6 @@
 
 namespace probecast::app {
 
-// The picture a Looking Glass shows: the quilt interleaved by its calibration.
-renderer::Image interleaved(renderer::VulkanContext& context, const std::vector<renderer::Image>& images,
-                            const std::vector<renderer::ViewInfo>& views, const renderer::LookingGlassCalibration& lg) {
-  return renderer::interleaveQuilt(context, renderer::composeQuilt(images, views, lg.quiltColumns, lg.quiltRows),
-                                   lg.quiltColumns, lg.quiltRows, lg);
-}
-
-// A window shows the interleaved image at the panel's native size.
-void showOnLookingGlass(FrameSource& source, renderer::VulkanContext& context,
-                        const renderer::LookingGlassCalibration* lg) {
-  if (!lg) return;
-  source.compose = [&context, lg](const std::vector<renderer::Image>& images,
-                                  const std::vector<renderer::ViewInfo>& views) {
-    return interleaved(context, images, views, *lg);
-  };
-  source.displayWidth = static_cast<uint32_t>(lg->screenW);
-  source.displayHeight = static_cast<uint32_t>(lg->screenH);
-}
-
 imaging::ToneMap toneMapOf(const ViewOptions& o) {
   imaging::ToneMap toneMap = imaging::ToneMap::Filmic;
   imaging::parseToneMap(o.toneMap, toneMap);
@@ -181,10 +162,11 @@ void addViewCommand(CLI::App& app) {
                       "lf:5x5, mono in a --window");
   o->sizeOption = addSizeOption(cmd, o->size, "size of each view WxH", 1, 8192);
   cmd->add_option("--looking-glass", o->lookingGlass,
-                  "a Looking Glass display's calibration (visual.json): render its view set (8x6 on portrait "
-                  "displays, 5x9 on others, across its view cone; views 560 pixels high at its aspect unless --size) "
-                  "and interleave it for the panel: looking_glass.png/.exr beside the quilt, or the window (with "
-                  "--fullscreen on the display)")
+                  "a Looking Glass display's calibration (visual.json): render its model's view set (Portrait 8x6 "
+                  "views 560 pixels high, Go 11x6 of 682, 16\" and 32\" in both orientations...; unknown serials "
+                  "8x6 on portrait panels, 5x9 on others, 560 high) at the panel's aspect unless --size, across its "
+                  "view cone, and interleave it for the panel: looking_glass.png/.exr beside the quilt, or the "
+                  "window (with --fullscreen on the display)")
       ->check(CLI::ExistingFile)
       ->excludes(o->viewsOption);
   cmd->add_option("--supersample", o->supersample,
@@ -243,16 +225,7 @@ void addViewCommand(CLI::App& app) {
     }
     const scene::Scene s = session::loadSceneOrThrow(sceneSpec, t, streamed.packaged ? &*streamed.packaged : nullptr);
     std::optional<renderer::LookingGlassCalibration> lg;
-    if (!o->lookingGlass.empty()) {
-      lg = renderer::loadLookingGlassCalibration(o->lookingGlass);
-      spec = {renderer::ViewSetSpec::Kind::HorizontalLightField, lg->quiltColumns, lg->quiltRows};
-      o->views = fmt::format("lfh:{}x{}", lg->quiltColumns, lg->quiltRows);
-      if (o->sizeOption->count() == 0)  // each view has the panel's aspect
-        o->size = {std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(560.0 * lg->screenW / lg->screenH))), 560};
-      fmt::print("view: Looking Glass {} ({}x{}): {} views ({}x{} quilt) of {}x{} across {} degrees\n",
-                 lg->serial.empty() ? std::string("display") : lg->serial, lg->screenW, lg->screenH,
-                 spec.count(), spec.columns, spec.rows, o->size[0], o->size[1], lg->viewCone);
-    }
+    if (!o->lookingGlass.empty()) lg = lookingGlassViewSet(*o, spec);
     renderer::ViewSetOptions vso = session::viewSetOptions(s, o->size[0], o->size[1]);
     if (lg) vso.lfConeDeg = lg->viewCone;
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, vso);
@@ -283,15 +256,7 @@ void addViewCommand(CLI::App& app) {
     const Rendered r = o->connection.connect.empty() ? renderLocal(*o, context, s, views, ro)
                                                      : renderFromServer(*o, context, s, sceneSpec, views, ro);
     writeViews(*o, r, views, spec);
-    if (lg) {
-      const renderer::Image panel = interleaved(context, r.images, views, *lg);
-      const auto w = static_cast<int>(panel.width), h = static_cast<int>(panel.height);
-      orThrow(imaging::writePngPreview(o->out + "/looking_glass.png", panel.rgb, w, h, o->exposure, error,
-                                       toneMapOf(*o)) &&
-                  imaging::writeExr(o->out + "/looking_glass.exr", panel.rgb, w, h, error),
-              error);
-      fmt::print("view: wrote {}/looking_glass.png and .exr ({}x{}, interleaved for the panel)\n", o->out, w, h);
-    }
+    if (lg) writeLookingGlass(*o, context, r.images, views, *lg);
     fmt::print("view: {} {} views of {}x{} ({}² samples per pixel) on {}: {:.1f} ms per view, shadow maps {:.1f} ms; "
                "wrote {}/quilt.png and quilt.exr\n",
                o->views, views.size(), o->size[0], o->size[1], o->supersample, context.deviceName(),

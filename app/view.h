@@ -61,6 +61,15 @@ renderer::Image interleaved(renderer::VulkanContext& context, const std::vector<
 void showOnLookingGlass(FrameSource& source, renderer::VulkanContext& context,
                         const renderer::LookingGlassCalibration* lg);
 
+// --looking-glass: the display's calibration, its model's view set in `spec` and o.views, and its
+// view size in o.size unless --size was given; one line says which (view_looking_glass.cpp).
+renderer::LookingGlassCalibration lookingGlassViewSet(ViewOptions& o, renderer::ViewSetSpec& spec);
+
+// Writes looking_glass.png and .exr: the rendered views interleaved for the panel.
+void writeLookingGlass(const ViewOptions& o, renderer::VulkanContext& context,
+                       const std::vector<renderer::Image>& images, const std::vector<renderer::ViewInfo>& views,
+                       const renderer::LookingGlassCalibration& lg);
+
 imaging::ToneMap toneMapOf(const ViewOptions& o);
 
 // One line on the client area lights a viewer draws (as the probes say).

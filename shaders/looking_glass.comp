@@ -4,9 +4,11 @@
 // view's matching channel. The formula and the quilt layout are documented in
 // renderer/include/probecast/renderer/looking_glass.h.
 //
-// The lens phase a = (u + i·subp + v·tilt)·pitchEff − center is only needed modulo 1, and u, v
-// are affine in the integer pixel position, so the host hands over the per-pixel, per-row and
-// per-subpixel steps and the offset as unsigned 0.32 fixed-point fractions of a lenticule.
+// The lens phase a = (u + i·subp + v·tilt)·pitchEff − center (or, with subpixel cells, the
+// subpixel's own offset in place of i·subp) is only needed modulo 1, and u, v are affine in the
+// integer pixel position, so the host hands over the per-pixel and per-row steps, each cell's
+// per-subpixel offsets and the phase at pixel (0, 0) as unsigned 0.32 fixed-point fractions of a
+// lenticule.
 // Unsigned wrap-around is then exactly "mod 1", and the phase error stays below (x + y + 3)·2^-33
 // (under 4e-6 on a 16K panel), where a float phase of hundreds of lenticules would lose ~1e-4.
 
@@ -19,8 +21,9 @@ layout(push_constant) uniform Push {
   int columns;   // quilt tiles across
   int rows;      // quilt tiles down
   int views;     // columns · rows
-  uint flags;    // bit 0 invView, bit 1 flipImageX, bit 2 flipImageY
-  uvec4 phase;   // 0.32 fixed point: x per pixel right, y per pixel up, z per subpixel, w at pixel (0, 0)
+  uint flags;    // bit 0 invView, bit 1 flipImageX, bit 2 flipImageY, bits 3-5 the cell pattern,
+                 // bits 6-8 the number of cells (1..4)
+  uvec4 phase;   // 0.32 fixed point: x per pixel right, y per pixel up, (z unused), w at pixel (0, 0)
   // This pass's share (bounded buffers: renderer/src/looking_glass.cpp): the quilt's tile rows
   // [bandTop, bandTop + bandRows) counted from its top are in Quilt, and the panel's pixel rows
   // [panelTop, panelTop + panelRows) in Panel; subpixels whose view lies elsewhere are left.
@@ -28,6 +31,7 @@ layout(push_constant) uniform Push {
   int bandRows;
   int panelTop;
   int panelRows;
+  uint cellPhase[12];  // 0.32 fixed point: cell c's subpixel i at [3c + i], from the pixel's phase
 } pc;
 
 // Both buffers hold RGB floats, row-major from the top, three floats per pixel: a band of the
@@ -38,6 +42,18 @@ layout(std430, set = 0, binding = 1) writeonly buffer Panel { float panel[]; };
 const uint kInvView = 1u;
 const uint kFlipX = 2u;
 const uint kFlipY = 4u;
+
+// The cell of the pixel at column x, row y from the bottom (renderer::cellOfPixel).
+uint cellOf(uint x, uint y) {
+  const uint pattern = (pc.flags >> 3) & 7u;
+  const uint count = max((pc.flags >> 6) & 7u, 1u);
+  uint cell = 0u;
+  if (pattern == 1u) cell = (x + y) % 2u;
+  else if (pattern == 2u) cell = y % 4u;
+  else if (pattern == 3u) cell = (y + 2u * (x % 2u)) % 4u;
+  else if (pattern == 4u) cell = x % 2u;
+  return cell % count;
+}
 
 float quiltTexel(ivec2 origin, ivec2 t, int channel) {
   const uint quiltWidth = uint(pc.columns * pc.tile.x);
@@ -77,9 +93,10 @@ void main() {
   if ((pc.flags & kFlipY) != 0u) uv.y = 1.0 - uv.y;
 
   const uint base = uint(pixel.x) * pc.phase.x + yUp * pc.phase.y + pc.phase.w;
+  const uint cell = cellOf(uint(pixel.x), yUp);
   const uint out0 = (uint(pixel.y - pc.panelTop) * uint(pc.screen.x) + uint(pixel.x)) * 3u;
   for (int i = 0; i < 3; ++i) {
-    uint a = base + uint(i) * pc.phase.z;  // the fractional phase, wrapped by uint arithmetic
+    uint a = base + pc.cellPhase[cell * 3u + uint(i)];  // the fractional phase, wrapped by uint arithmetic
     // 1 − a in 0.32 fixed point (one unit off, which only moves exact view boundaries).
     if ((pc.flags & kInvView) != 0u) a = ~a;
     // view = floor(a · views): the high word of the 64-bit product.

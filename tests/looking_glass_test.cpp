@@ -34,14 +34,32 @@ struct ExpectedView {
   bool ambiguous = false;  // the phase lies within kBoundaryWindow of a view boundary
 };
 
+// The cell of a pixel, written out from the pattern descriptions (not renderer::cellOfPixel).
+int referenceCell(int mode, int cells, int x, int yUp) {
+  int cell = 0;
+  if (mode == 1) cell = (x % 2 == yUp % 2) ? 0 : 1;  // checkerboard, cell 0 at the bottom-left
+  if (mode == 2) cell = yUp % 4;
+  if (mode == 3) cell = (yUp + (x % 2 == 1 ? 2 : 0)) % 4;
+  if (mode == 4) cell = x % 2;
+  return cell % cells;
+}
+
 // Which view subpixel `channel` of the pixel at column x, row yUp (counted from the bottom) shows.
 ExpectedView expectedView(const LookingGlassCalibration& c, int views, int x, int yUp, int channel) {
   const double w = c.screenW, h = c.screenH, slope = c.slope;
   const double pitchEff = double(c.pitch) * w / double(c.dpi) * std::cos(std::atan(1.0 / slope));
   const double tilt = h / (w * slope);
   const double subp = (c.flipSubp ? -1.0 : 1.0) / (3.0 * w);
-  const double u = (x + 0.5) / w, v = (yUp + 0.5) / h;
-  double a = (u + channel * subp + v * tilt) * pitchEff - double(c.center);
+  double u = (x + 0.5) / w, v = (yUp + 0.5) / h;
+  if (c.subpixelCells.empty()) {
+    u += channel * subp;
+  } else {  // the subpixel's own place in its cell
+    const LookingGlassSubpixelCell& cell =
+        c.subpixelCells[referenceCell(c.cellPatternMode, static_cast<int>(c.subpixelCells.size()), x, yUp)];
+    u += cell.dx[channel] / w;
+    v += cell.dy[channel] / h;
+  }
+  double a = (u + v * tilt) * pitchEff - double(c.center);
   a -= std::floor(a);
   if (c.invView) a = 1.0 - a;
   ExpectedView e;
@@ -174,6 +192,83 @@ TEST(LookingGlass, FlipImageYSamplesViewsUpsideDown) {
 
 TEST(LookingGlass, UnflippedGradientQuiltSamplesEachViewUpright) {
   checkAgainstReference(portraitCalibration(), 8, 6, 12, 16, /*gradient=*/true);
+}
+
+// Cells as panels sold since 2024 have them: red and green on one row, blue on the other, the
+// pair mirrored from one cell to the next (offsets in pixels, y up); more cells shift further.
+std::vector<LookingGlassSubpixelCell> testCells(int count) {
+  std::vector<LookingGlassSubpixelCell> cells;
+  for (int k = 0; k < count; ++k) {
+    const double side = k % 2 == 0 ? -1.0 : 1.0;
+    LookingGlassSubpixelCell cell;
+    cell.dx[0] = -0.3 + 0.05 * k;
+    cell.dy[0] = 0.25 * side;
+    cell.dx[1] = 0.3 - 0.05 * k;
+    cell.dy[1] = 0.25 * side;
+    cell.dx[2] = 0.02 * k;
+    cell.dy[2] = -0.25 * side;
+    cells.push_back(cell);
+  }
+  return cells;
+}
+
+TEST(LookingGlass, EveryCellPatternInterleavesToTheKnownAnswer) {
+  for (int mode = 0; mode <= 4; ++mode) {
+    for (const int count : {2, 4, 6}) {  // six cells: the patterns reach only the first four
+      SCOPED_TRACE("CellPatternMode " + std::to_string(mode) + ", " + std::to_string(count) + " cells");
+      LookingGlassCalibration cal = portraitCalibration();
+      cal.subpixelCells = testCells(count);
+      cal.cellPatternMode = mode;
+      checkAgainstReference(cal, 11, 6, 8, 10, /*gradient=*/false);
+    }
+  }
+  // Cells replace the row of subpixels: flipSubp no longer applies, the mirrored image still does.
+  LookingGlassCalibration cal = portraitCalibration();
+  cal.subpixelCells = testCells(2);
+  cal.cellPatternMode = 4;
+  cal.flipSubp = true;
+  cal.flipImageX = true;
+  checkAgainstReference(cal, 7, 7, 12, 12, /*gradient=*/true);
+}
+
+TEST(LookingGlass, CellsMoveSubpixelsToOtherViews) {
+  // The cells matter: the same panel interleaved as if its subpixels were in a row differs.
+  VulkanContext context(test::validatedContext());
+  LookingGlassCalibration cal = portraitCalibration();
+  const Image quilt = makeQuilt(11, 6, 8, 10, /*gradient=*/false);
+  const Image row = interleaveQuilt(context, quilt, 11, 6, cal);
+  cal.subpixelCells = testCells(2);
+  cal.cellPatternMode = 2;
+  const Image cells = interleaveQuilt(context, quilt, 11, 6, cal);
+  size_t differ = 0;
+  for (size_t i = 0; i < row.rgb.size(); ++i) differ += row.rgb[i] != cells.rgb[i];
+  EXPECT_GT(differ, row.rgb.size() / 4) << differ << " of " << row.rgb.size();
+}
+
+// The whole panel at its real size, every subpixel against the reference: a Portrait (subpixels in
+// a row), and 16" Spatial panels in both orientations with their cell patterns.
+TEST(LookingGlass, PanelsAtTheirRealSizeMatchTheFormula) {
+  LookingGlassCalibration portrait = portraitCalibration();
+  portrait.screenW = 1536;
+  portrait.screenH = 2048;
+  LookingGlassCalibration landscape;
+  landscape.pitch = 44.8;
+  landscape.slope = -6.93;
+  landscape.center = 0.47;
+  landscape.dpi = 283.0;
+  landscape.screenW = 3840;
+  landscape.screenH = 2160;
+  landscape.subpixelCells = testCells(2);
+  landscape.cellPatternMode = 2;
+  LookingGlassCalibration tall = landscape;
+  tall.slope = -7.41;
+  tall.center = -0.12;
+  tall.screenW = 2160;
+  tall.screenH = 3840;
+  tall.cellPatternMode = 4;
+  checkAgainstReference(portrait, 8, 6, 4, 4, /*gradient=*/false);
+  checkAgainstReference(landscape, 7, 7, 4, 4, /*gradient=*/false);
+  checkAgainstReference(tall, 11, 6, 4, 4, /*gradient=*/false);
 }
 
 // Bounded memory: with buffers of at most 40,000 bytes the quilt goes up 2 of its 6 tile rows at a
@@ -346,6 +441,114 @@ TEST(LookingGlass, LoadsAFileAndPutsItsPathInFrontOfRefusals) {
                std::runtime_error);
   std::remove(good.c_str());
   std::remove(bad.c_str());
+}
+
+// A 16" Spatial landscape panel's file as the display reports it (numbers made up, layout real).
+const char* kSpatialVisualJson = R"({
+  "configVersion": "3.0",
+  "serial": "LKG-J01234",
+  "pitch": {"value": 44.71},
+  "slope": {"value": -6.91},
+  "center": {"value": 0.48},
+  "viewCone": {"value": 50.0},
+  "invView": {"value": 1.0},
+  "verticalAngle": {"value": 0.0},
+  "DPI": {"value": 283.0},
+  "screenW": {"value": 3840.0},
+  "screenH": {"value": 2160.0},
+  "flipImageX": {"value": 0.0},
+  "flipImageY": {"value": 0.0},
+  "flipSubp": {"value": 0.0},
+  "CellPatternMode": {"value": 2},
+  "subpixelCells": [
+    {"ROffsetX": -0.31, "ROffsetY": 0.25, "GOffsetX": 0.28, "GOffsetY": 0.25, "BOffsetX": 0.0, "BOffsetY": -0.25},
+    {"ROffsetX": -0.31, "ROffsetY": -0.25, "GOffsetX": 0.28, "GOffsetY": -0.25, "BOffsetX": 0.0, "BOffsetY": 0.25}
+  ]
+})";
+
+TEST(LookingGlass, ParsesSubpixelCellsAndTheModelsViewSet) {
+  const LookingGlassCalibration c = parseLookingGlassCalibration(kSpatialVisualJson);
+  ASSERT_EQ(c.subpixelCells.size(), 2u);
+  EXPECT_EQ(c.cellPatternMode, 2);
+  EXPECT_DOUBLE_EQ(c.subpixelCells[0].dx[0], -0.31);
+  EXPECT_DOUBLE_EQ(c.subpixelCells[0].dy[1], 0.25);
+  EXPECT_DOUBLE_EQ(c.subpixelCells[1].dy[2], 0.25);
+  EXPECT_DOUBLE_EQ(c.subpixelCells[1].dx[1], 0.28);
+  EXPECT_EQ(c.model, "Looking Glass 16\" Spatial (landscape)");
+  EXPECT_EQ(c.quiltColumns, 7);
+  EXPECT_EQ(c.quiltRows, 7);
+  EXPECT_EQ(c.viewHeight, 857);
+  EXPECT_FLOAT_EQ(c.viewCone, 50.0f);
+  // An empty list is a panel with its subpixels in a row.
+  json j = json::parse(kSpatialVisualJson);
+  j["subpixelCells"] = json::array();
+  EXPECT_TRUE(parseLookingGlassCalibration(j.dump()).subpixelCells.empty());
+}
+
+TEST(LookingGlass, RefusesBadCellsByName) {
+  struct Case {
+    const char* field;
+    json value;
+    const char* says;
+  };
+  json tooMany = json::array();
+  for (int k = 0; k < 65; ++k) tooMany.push_back(json::parse(kSpatialVisualJson)["subpixelCells"][0]);
+  json missing = json::parse(kSpatialVisualJson)["subpixelCells"];
+  missing[1].erase("BOffsetY");
+  json far = json::parse(kSpatialVisualJson)["subpixelCells"];
+  far[0]["GOffsetX"] = 12.0;
+  json text = json::parse(kSpatialVisualJson)["subpixelCells"];
+  text[0]["ROffsetY"] = "0.25";
+  const Case cases[] = {
+      {"CellPatternMode", 5, "\"CellPatternMode\" must be a whole number in 0..4"},
+      {"CellPatternMode", {{"value", 1.5}}, "\"CellPatternMode\" must be a whole number in 0..4"},
+      {"CellPatternMode", -1, "\"CellPatternMode\" must be a whole number in 0..4"},
+      {"subpixelCells", "cells", "\"subpixelCells\" must be an array"},
+      {"subpixelCells", json::array({1}), "subpixelCells[0]: expected an object"},
+      {"subpixelCells", missing, "subpixelCells[1]: missing required field \"BOffsetY\""},
+      {"subpixelCells", far, "\"subpixelCells\" offsets must be finite and within 4 pixels"},
+      {"subpixelCells", text, "subpixelCells[0]: field \"ROffsetY\" must be a number"},
+      {"subpixelCells", tooMany, "\"subpixelCells\" must hold at most 64 cells"},
+  };
+  for (const Case& c : cases) {
+    json j = json::parse(kSpatialVisualJson);
+    j[c.field] = c.value;
+    const std::string message = refusal(j.dump());
+    EXPECT_NE(message.find(c.says), std::string::npos) << c.field << " = " << c.value.dump() << ": " << message;
+  }
+}
+
+TEST(LookingGlass, ModelsBySerialAndCellsByPattern) {
+  struct Case {
+    const char* serial;
+    int w, h, columns, rows, viewHeight;
+  };
+  const Case cases[] = {
+      {"LKG-P01234", 1536, 2048, 8, 6, 560},  {"LKG-E05678", 1440, 2560, 11, 6, 682},
+      {"LKG-H00001", 2160, 3840, 11, 6, 1000}, {"LKG-J00002", 3840, 2160, 7, 7, 857},
+      {"LKG-K00003", 4320, 7680, 11, 6, 1364}, {"LKG-L00004", 7680, 4320, 7, 7, 1170},
+      {"LKG-4K1234", 3840, 2160, 5, 9, 455},  {"LKG-2K0042", 2560, 1600, 5, 9, 227},
+      {"", 1080, 1920, 8, 6, 560},            {"my-own-panel", 1920, 1080, 5, 9, 560},
+  };
+  for (const Case& c : cases) {
+    const LookingGlassModel m = lookingGlassModel(c.serial, c.w, c.h);
+    EXPECT_EQ(m.columns, c.columns) << c.serial;
+    EXPECT_EQ(m.rows, c.rows) << c.serial;
+    EXPECT_EQ(m.viewHeight, c.viewHeight) << c.serial;
+  }
+  EXPECT_EQ(lookingGlassModel("LKG-E05678", 1440, 2560).name, "Looking Glass Go");
+  // Pixel (x, y from the bottom) → cell, per pattern, for two cells and for four.
+  EXPECT_EQ(cellOfPixel(0, 2, 5, 3), 0);
+  EXPECT_EQ(cellOfPixel(1, 2, 0, 0), 0);
+  EXPECT_EQ(cellOfPixel(1, 2, 1, 0), 1);
+  EXPECT_EQ(cellOfPixel(1, 2, 1, 1), 0);
+  EXPECT_EQ(cellOfPixel(2, 4, 9, 6), 2);
+  EXPECT_EQ(cellOfPixel(2, 2, 9, 7), 1);
+  EXPECT_EQ(cellOfPixel(3, 4, 1, 3), 1);  // (3 + 2) mod 4
+  EXPECT_EQ(cellOfPixel(3, 4, 2, 3), 3);
+  EXPECT_EQ(cellOfPixel(4, 2, 7, 0), 1);
+  EXPECT_EQ(cellOfPixel(4, 2, 8, 5), 0);
+  EXPECT_EQ(cellOfPixel(2, 3, 0, 3), 0);  // 3 mod 3
 }
 
 TEST(LookingGlass, DefaultQuiltLayoutFollowsThePanelShape) {

@@ -16,7 +16,10 @@
 namespace probecast::renderer {
 namespace {
 
-// Mirrors the push-constant block of shaders/looking_glass.comp (std430: the uvec4 at offset 32).
+constexpr int kShaderCells = 4;  // no cell pattern reaches past cell 3
+
+// Mirrors the push-constant block of shaders/looking_glass.comp (std430: the uvec4 at offset 32;
+// 112 bytes, within the 128 every Vulkan device offers).
 struct LookingGlassPush {
   int32_t screen[2];
   int32_t tile[2];
@@ -29,9 +32,12 @@ struct LookingGlassPush {
   int32_t bandRows;
   int32_t panelTop;
   int32_t panelRows;
+  uint32_t cellPhase[kShaderCells * 3];  // per cell, per subpixel: its offset's phase
 };
-static_assert(sizeof(LookingGlassPush) == 64 && offsetof(LookingGlassPush, phase) == 32);
+static_assert(sizeof(LookingGlassPush) == 112 && offsetof(LookingGlassPush, phase) == 32 &&
+              offsetof(LookingGlassPush, cellPhase) == 64);
 constexpr uint32_t kInvView = 1, kFlipX = 2, kFlipY = 4;
+constexpr uint32_t kPatternShift = 3, kCellCountShift = 6;  // 3 bits each in flags
 
 // A phase in lenticules as an unsigned 0.32 fixed-point fraction (its integer part dropped).
 uint32_t fixedTurns(double turns) {
@@ -97,14 +103,33 @@ void checkQuilt(const Image& quilt, int columns, int rows, const LookingGlassCal
   checkLookingGlassCalibration(cal, where + "calibration ");
 }
 
+// The subpixels' phases within their pixel, per cell: a row of subpixels a third of a pixel apart
+// (one cell) unless the calibration places them in cells.
+void setCellPhases(LookingGlassPush& push, const LookingGlassCalibration& cal, double pitchEff, double tilt) {
+  const double w = cal.screenW, h = cal.screenH;
+  std::vector<LookingGlassSubpixelCell> cells = cal.subpixelCells;
+  int pattern = cal.cellPatternMode;
+  if (cells.empty()) {
+    LookingGlassSubpixelCell row;
+    for (int i = 0; i < 3; ++i) row.dx[i] = (cal.flipSubp ? -1.0 : 1.0) * i / 3.0;
+    cells.push_back(row);
+    pattern = 0;
+  }
+  // Patterns index cells 0..3, taken modulo the count: with four or more, only the first four.
+  const int count = std::min<int>(kShaderCells, static_cast<int>(cells.size()));
+  for (int c = 0; c < count; ++c)
+    for (int i = 0; i < 3; ++i)
+      push.cellPhase[c * 3 + i] = fixedTurns((cells[c].dx[i] / w + cells[c].dy[i] / h * tilt) * pitchEff);
+  push.flags |= static_cast<uint32_t>(pattern) << kPatternShift | static_cast<uint32_t>(count) << kCellCountShift;
+}
+
 // The push constants of every pass but its bands: the lens phase per pixel step right, per pixel
-// step up, per subpixel, and at pixel (0, 0) (its centre), in double precision before the
-// shader's fixed-point arithmetic.
+// step up, per subpixel of each cell, and at pixel (0, 0) (its centre), in double precision
+// before the shader's fixed-point arithmetic.
 LookingGlassPush interleavePush(const Image& quilt, int columns, int rows, const LookingGlassCalibration& cal) {
   const double w = cal.screenW, h = cal.screenH, slope = cal.slope;
   const double pitchEff = cal.pitch * w / cal.dpi * std::cos(std::atan(1.0 / slope));
   const double tilt = h / (w * slope);
-  const double subp = (cal.flipSubp ? -1.0 : 1.0) / (3.0 * w);
   const double perX = pitchEff / w, perY = pitchEff * tilt / h;
   LookingGlassPush push{};
   push.screen[0] = cal.screenW;
@@ -117,8 +142,8 @@ LookingGlassPush interleavePush(const Image& quilt, int columns, int rows, const
   push.flags = (cal.invView ? kInvView : 0u) | (cal.flipImageX ? kFlipX : 0u) | (cal.flipImageY ? kFlipY : 0u);
   push.phase[0] = fixedTurns(perX);
   push.phase[1] = fixedTurns(perY);
-  push.phase[2] = fixedTurns(subp * pitchEff);
   push.phase[3] = fixedTurns(0.5 * perX + 0.5 * perY - cal.center);
+  setCellPhases(push, cal, pitchEff, tilt);
   return push;
 }
 

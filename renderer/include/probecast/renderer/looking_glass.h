@@ -14,8 +14,14 @@
 // Per output pixel (x, y), x from the left and y from the BOTTOM of the screen (the display's own
 // shaders use GL texture coordinates with v pointing up):
 //   u = (x + 0.5) / screenW,  v = (y + 0.5) / screenH
-// and per subpixel i = 0, 1, 2 (R, G, B):
+// and per subpixel i = 0, 1, 2 (R, G, B), on panels whose subpixels sit in a row (all sold before
+// 2024, and any calibration without `subpixelCells`):
 //   a = (u + i·subp + v·tilt) · pitchEff − center
+// Panels sold since 2024 place their subpixels in cells (`subpixelCells`: per cell, each subpixel's
+// offset (dx, dy) from the pixel centre in pixels, y up) that repeat in a pattern
+// (`CellPatternMode`, see cellOfPixel()); the phase then takes the subpixel's own position:
+//   a = (u + dx/screenW + (v + dy/screenH) · tilt) · pitchEff − center
+// and in both cases:
 //   a = a − floor(a)                       (fractional part, in [0, 1))
 //   if invView: a = 1 − a
 //   k = min(N − 1, floor(a · N))           N = columns · rows views
@@ -34,11 +40,41 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "probecast/renderer/reference_camera.h"
 #include "probecast/renderer/vulkan_context.h"
 
 namespace probecast::renderer {
+
+// Where one pixel's red, green and blue subpixels sit, in pixels from its centre (x right, y up).
+struct LookingGlassSubpixelCell {
+  double dx[3] = {0.0, 0.0, 0.0};  // R, G, B
+  double dy[3] = {0.0, 0.0, 0.0};
+};
+
+// The cell a pixel takes (x from the left, y from the bottom) under a calibration's
+// CellPatternMode: 0 every pixel cell 0; 1 a checkerboard, (x + y) mod 2; 2 rows, y mod 4;
+// 3 rows offset by two on odd columns, (y + 2·(x mod 2)) mod 4; 4 columns, x mod 2. The cell is
+// then taken modulo the number of cells, so a pattern never reads past them. (The modes as the
+// display vendor's current runtime numbers them.)
+int cellOfPixel(int mode, int cellCount, int x, int y);
+
+// A display model's usual view set, by the serial's prefix where it names a known model.
+struct LookingGlassModel {
+  std::string name;     // "Looking Glass Go", ... or "portrait display"/"landscape display"
+  int columns = 0;      // quilt layout
+  int rows = 0;
+  int viewHeight = 0;   // pixels: the model's native quilt height divided by its rows
+};
+
+// Known models by serial prefix: Portrait (LKG-P, 8 × 6 of 560 high), Go (LKG-E, 11 × 6 of 682),
+// 16" Spatial portrait (LKG-H, 11 × 6 of 1000) and landscape (LKG-J, 7 × 7 of 857), 32" Spatial
+// portrait (LKG-K, 11 × 6 of 1364) and landscape (LKG-L, 7 × 7 of 1170), the kiosk (LKG-F, as
+// Go), 65" (LKG-D, 8 × 9 of 910), and the first two generations (LKG-2K, -4K, -8K, -A, -B: 5 × 9
+// of 227, 455 or 910). Any other serial: 8 × 6 on a portrait panel, 5 × 9 on a landscape one,
+// 560 pixels high.
+LookingGlassModel lookingGlassModel(const std::string& serial, int screenW, int screenH);
 
 struct LookingGlassCalibration {
   // Required in visual.json.
@@ -57,10 +93,17 @@ struct LookingGlassCalibration {
   bool flipImageX = false;
   bool flipImageY = false;
   bool flipSubp = false;  // BGR subpixel order instead of RGB
-  std::string serial;         // informational
+  std::string serial;         // picks the display model's view set (lookingGlassModel)
   std::string configVersion;  // informational
-  // The quilt layout to render for this display: defaultQuiltLayout() of the screen size after
-  // parsing. Callers may change it; interleaveQuilt() takes the layout of the quilt it is given.
+  // Panels sold since 2024: the subpixel cells and the pattern they repeat in (empty: subpixels
+  // in a row, the formula with subp).
+  std::vector<LookingGlassSubpixelCell> subpixelCells;
+  int cellPatternMode = 0;
+  // The model's view set and view height (lookingGlassModel of serial and screen size).
+  std::string model;
+  int viewHeight = 0;
+  // The quilt layout to render for this display: the model's after parsing. Callers may change
+  // it; interleaveQuilt() takes the layout of the quilt it is given.
   int quiltColumns = 0;
   int quiltRows = 0;
 };
@@ -78,10 +121,12 @@ QuiltLayout defaultQuiltLayout(int screenW, int screenH);
 // Parses the text of a visual.json. Each numeric field may be a plain number or an object
 // {"value": number}. Required: pitch, slope, center, DPI, screenW, screenH; optional: viewCone (40),
 // invView (1), flipImageX (0), flipImageY (0), flipSubp (0), verticalAngle (0), serial,
-// configVersion; unknown fields are ignored. Throws std::invalid_argument, naming the field, for
-// malformed JSON, a missing required field, a non-numeric or non-finite value, screenW or screenH
-// not an integer in 1..16384, DPI ≤ 0, pitch ≤ 0, |slope| outside [0.01, 1000] (zero included),
-// viewCone outside (0, 180), or a flag other than 0 or 1.
+// configVersion, subpixelCells (an array of at most 64 objects with ROffsetX, ROffsetY, GOffsetX,
+// GOffsetY, BOffsetX, BOffsetY, each in [-4, 4] pixels) and CellPatternMode (0..4); unknown fields
+// are ignored. Throws std::invalid_argument, naming the field, for malformed JSON, a missing
+// required field, a non-numeric or non-finite value, screenW or screenH not an integer in
+// 1..16384, DPI ≤ 0, pitch ≤ 0, |slope| outside [0.01, 1000] (zero included), viewCone outside
+// (0, 180), a flag other than 0 or 1, or a cell or pattern outside the rules above.
 LookingGlassCalibration parseLookingGlassCalibration(const std::string& jsonText);
 
 // Reads and parses a visual.json file: std::runtime_error when it cannot be read,
