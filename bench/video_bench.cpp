@@ -331,183 +331,245 @@ struct RunFolder {
   }
 };
 
-VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
-  checkOptions(o);
-  const RunFolder folder(o.workDir.empty() ? fs::temp_directory_path().string() : o.workDir, o.keepFiles);
-  const std::string& work = folder.path;
-  if (o.keepFiles && o.progress) o.progress("frames and bitstreams go to " + work);
-  checkFfmpeg(o, work);
-  renderer::VulkanContext context(o.context);
-  const double seconds = static_cast<double>(o.frames) / o.fps;
+namespace {
 
+// What every motion's phases see: the options, the GPU, the run's own folder and the seconds
+// recorded per motion.
+struct VideoSetup {
+  const VideoBenchOptions& o;
+  renderer::VulkanContext& context;
+  const std::string& work;
+  double seconds = 0.0;
+};
+
+// What the bench reports, filled motion by motion: a JSON entry and table rows per display and
+// motion, and each display's chart series.
+struct VideoReport {
   nlohmann::json results = nlohmann::json::array();
-  std::string table = fmt::format("{:<10} {:<8} {:<8} {:>10} {:>7} {:>9} {:>10} {:>8}\n", "display", "motion",
-                                  "stream", "probes B/s", "dB", "video", "video B/s", "ratio");
-  std::vector<std::pair<std::string, std::vector<imaging::ChartSeries>>> chartSeries;
-  for (const VideoDisplay& d : o.displays) chartSeries.push_back({d.name, {}});
+  std::string table;
+  std::vector<std::pair<std::string, std::vector<imaging::ChartSeries>>> chartSeries;  // per display
+};
 
-  for (const VideoMotion& m : o.motions) {
-    scene::Scene current = session::loadSceneOrThrow(m.scene, 0.0);
-    const bool moves = m.rate > 0 && session::sceneMoves(m.scene, current);
-    const ProbeGrid grid = o.grid(current);
-    renderer::ProbeUpdater updater(context, current, grid, o.updater);
-    std::vector<StreamState> streams(o.streams.size());
+// One motion's probes: the scene as its clock runs, the updater tracing it, and the streams that
+// carry the updater's probes to a subscriber's decoder.
+struct MotionProbes {
+  MotionProbes(const VideoSetup& s, const VideoMotion& m)
+      : current(session::loadSceneOrThrow(m.scene, 0.0)),
+        moves(m.rate > 0 && session::sceneMoves(m.scene, current)),
+        grid(s.o.grid(current)),
+        updater(s.context, current, grid, s.o.updater),
+        streams(s.o.streams.size()) {
     for (size_t k = 0; k < streams.size(); ++k) {
-      streams[k].config = &o.streams[k];
-      streams[k].encoder = std::make_unique<StreamEncoder>(streamLayoutFor(grid, o.streams[k].repr, 4), o.streams[k].encoder);
+      streams[k].config = &s.o.streams[k];
+      streams[k].encoder = std::make_unique<StreamEncoder>(streamLayoutFor(grid, s.o.streams[k].repr, 4), s.o.streams[k].encoder);
       streams[k].decoder = std::make_unique<StreamDecoder>(streams[k].encoder->layout());
     }
-    std::vector<uint8_t> frame;
-    double lastSceneTime = 0.0, updaterSceneTime = 0.0;
-    const auto updateProbes = [&](bool count) {
-      updater.update();
-      const ProbeVolume& v = updater.volume();
-      for (StreamState& st : streams) {
-        const uint32_t changed = st.encoder->update(v.probes.data(), v.active.data(), v.noise.empty() ? nullptr : v.noise.data(),
-                                                    v.stillUpdates.empty() ? nullptr : v.stillUpdates.data());
-        if (changed > 0) {
-          st.encoder->writeChangedFrame(frame);
-          if (st.decoder->apply(frame.data(), frame.size()) != CodecStatus::Ok)
-            throw std::runtime_error("bench video: the stream's own decoder refused a frame");
-          if (count) st.bytes += frame.size(), ++st.frames;
-        }
-        st.decoded = v;
-        st.decoder->copyVolume(grid.bounds, st.decoded);
-      }
-    };
-    for (uint32_t k = 0; k < o.warmup; ++k) {
-      updateProbes(false);
-      sayProgress(o.progress, fmt::format("bench video: {}: warm-up update {}/{}", m.name, k + 1, o.warmup));
-    }
-    for (StreamState& st : streams) {
-      st.encoder->writeKeyframeFrame(frame);
-      st.joinBytes = frame.size();
-    }
-
-    std::vector<DisplayFrames> displays(o.displays.size());
-    for (size_t i = 0; i < o.displays.size(); ++i) {
-      DisplayFrames& df = displays[i];
-      df.display = &o.displays[i];
-      std::string error;
-      if (!renderer::parseViewSet(df.display->viewSet, df.spec, error)) throw std::invalid_argument(error);
-      df.camera = renderer::CameraView::fromScene(current);
-      df.viewOptions = session::viewSetOptions(current, df.display->width, df.display->height);
-      df.views = renderer::makeViewSet(df.camera, df.spec, df.viewOptions);
-      df.floatRaster = std::make_unique<renderer::RasterRenderer>(context, current, df.display->width,
-                                                                  df.display->height, o.raster);
-      for (size_t k = 0; k < streams.size(); ++k)
-        df.streamRasters.push_back(std::make_unique<renderer::RasterRenderer>(context, current, df.display->width,
-                                                                              df.display->height, o.raster));
-      df.sse.assign(streams.size(), 0.0);
-      df.worstFramePsnr.assign(streams.size(), std::numeric_limits<double>::infinity());
-      df.width = df.display->width * static_cast<uint32_t>(df.spec.columns);
-      df.height = df.display->height * static_cast<uint32_t>(df.spec.rows);
-      df.reference.reserve(static_cast<size_t>(df.width) * df.height * 3 * o.frames);
-    }
-
-    uint32_t recordedUpdates = 0;
-    for (uint32_t f = 0; f < o.frames; ++f) {
-      const double t = f / o.fps;
-      const double sceneTime = m.rate * t;
-      const bool moved = moves && sceneTime != lastSceneTime;
-      if (moved) {
-        session::advanceScene(m.scene, sceneTime, current);
-        lastSceneTime = sceneTime;
-      }
-      const bool update = f == 0 || std::floor(t * o.hz) != std::floor((f - 1) / o.fps * o.hz);
-      if (update) {
-        if (lastSceneTime != updaterSceneTime) {
-          updater.setScene(current);
-          updaterSceneTime = lastSceneTime;
-        }
-        updateProbes(true);
-        ++recordedUpdates;
-      }
-      for (DisplayFrames& df : displays) {
-        if (moved) {
-          df.floatRaster->setShading(current);
-          for (auto& r : df.streamRasters) r->setShading(current);
-        }
-        if (o.headTrace)
-          df.views = renderer::makeViewSet(session::poseCamera(df.camera, *o.headTrace, t), df.spec, df.viewOptions);
-        if (update) {
-          df.floatRaster->setProbes(updater.volume());
-          for (size_t k = 0; k < streams.size(); ++k) df.streamRasters[k]->setProbes(streams[k].decoded);
-        }
-        const std::vector<uint8_t> ref = toRgb8(renderQuilt(*df.floatRaster, df), o.exposure);
-        for (size_t k = 0; k < streams.size(); ++k) {
-          const std::vector<uint8_t> got = toRgb8(renderQuilt(*df.streamRasters[k], df), o.exposure);
-          const double sse = squaredError(got.data(), ref.data(), ref.size());
-          df.sse[k] += sse;
-          df.worstFramePsnr[k] = std::min(df.worstFramePsnr[k], psnrFromSse(sse, static_cast<double>(ref.size())));
-        }
-        df.reference.insert(df.reference.end(), ref.begin(), ref.end());
-      }
-      if (f % 10 == 9 || f + 1 == o.frames)
-        sayProgress(o.progress, fmt::format("bench video: {}: frame {}/{} rendered ({} probe updates)", m.name, f + 1,
-                                            o.frames, recordedUpdates));
-    }
-
-    for (size_t i = 0; i < displays.size(); ++i) {
-      DisplayFrames& df = displays[i];
-      const Sweeps sweeps = sweepVideo(o, m, df, work, chartSeries[i].second);
-      nlohmann::json streamResults = nlohmann::json::array();
-      for (size_t k = 0; k < streams.size(); ++k) {
-        const StreamState& st = streams[k];
-        const double bytesPerSecond = static_cast<double>(st.bytes) / seconds;
-        const double psnr = psnrFromSse(df.sse[k], static_cast<double>(df.reference.size()));
-        nlohmann::json atPsnr = nlohmann::json::array();
-        std::string bestName, bestBound;
-        double bestBytes = std::numeric_limits<double>::infinity();
-        for (size_t c = 0; c < o.codecs.size(); ++c) {
-          const AtPsnr at = bytesAtPsnr(sweeps.points[c], psnr);
-          atPsnr.push_back({{"codec", o.codecs[c].name},
-                            {"bytes_per_second", at.bytesPerSecond},
-                            {"bound", at.bound.empty() ? nlohmann::json(nullptr) : nlohmann::json(at.bound)}});
-          if (at.bytesPerSecond < bestBytes) bestBytes = at.bytesPerSecond, bestName = o.codecs[c].name, bestBound = at.bound;
-        }
-        const double ratio = bytesPerSecond > 0 ? bestBytes / bytesPerSecond : std::numeric_limits<double>::infinity();
-        streamResults.push_back({{"stream", st.config->name},
-                                 {"representation", representationName(st.config->repr)},
-                                 {"deadzone", st.config->encoder.deadzone},
-                                 {"noise_scale", st.config->encoder.noiseScale},
-                                 {"frames_sent", st.frames},
-                                 {"bytes_per_second", bytesPerSecond},
-                                 {"join_bytes", st.joinBytes},
-                                 {"psnr_db", dbJson(psnr)},
-                                 {"psnr_db_worst_frame", dbJson(df.worstFramePsnr[k])},
-                                 {"video_at_equal_psnr", atPsnr},
-                                 {"best_video", bestName},
-                                 {"best_video_bytes_per_second", bestBytes},
-                                 {"best_video_bound", bestBound.empty() ? nlohmann::json(nullptr) : nlohmann::json(bestBound)},
-                                 {"video_to_probe_bytes", std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr)}});
-        chartSeries[i].second.push_back(
-            {m.name + " " + st.config->name, {{std::max(bytesPerSecond, 1.0), std::isfinite(psnr) ? psnr : 99.0, st.config->name}}, false});
-        const char* mark = bestBound == "at_least" ? "≥" : (bestBound == "at_most" ? "≤" : "");
-        table += fmt::format("{:<10} {:<8} {:<8} {:>10.0f} {:>7} {:>9} {:>3}{:>7.0f} {:>3}{:>5}\n", df.display->name,
-                             m.name, st.config->name, bytesPerSecond,
-                             std::isfinite(psnr) ? fmt::format("{:.2f}", psnr) : std::string("same"), bestName, mark,
-                             bestBytes, mark, std::isfinite(ratio) ? fmt::format("{:.1f}", ratio) : std::string("-"));
-      }
-      results.push_back({{"display", df.display->name},
-                         {"view_set", df.display->viewSet},
-                         {"frame_size", {df.width, df.height}},
-                         {"motion", m.name},
-                         {"scene", m.scene},
-                         {"rate", m.rate},
-                         {"grid", {grid.dims[0], grid.dims[1], grid.dims[2]}},
-                         {"probe_updates", recordedUpdates},
-                         {"video", sweeps.json},
-                         {"streams", streamResults}});
-    }
   }
+  scene::Scene current;
+  bool moves = false;
+  ProbeGrid grid;
+  renderer::ProbeUpdater updater;
+  std::vector<StreamState> streams;
+  std::vector<uint8_t> frame;  // the stream frame last written
+  double lastSceneTime = 0.0, updaterSceneTime = 0.0;
+  uint32_t recordedUpdates = 0;
+};
 
+// One probe update, encoded by every stream and applied by its decoder as a subscriber's would be;
+// `count`: its frames count towards the stream's bytes (the warm-up's do not).
+void updateProbes(MotionProbes& p, bool count) {
+  p.updater.update();
+  const ProbeVolume& v = p.updater.volume();
+  for (StreamState& st : p.streams) {
+    const uint32_t changed = st.encoder->update(v.probes.data(), v.active.data(), v.noise.empty() ? nullptr : v.noise.data(),
+                                                v.stillUpdates.empty() ? nullptr : v.stillUpdates.data());
+    if (changed > 0) {
+      st.encoder->writeChangedFrame(p.frame);
+      if (st.decoder->apply(p.frame.data(), p.frame.size()) != CodecStatus::Ok)
+        throw std::runtime_error("bench video: the stream's own decoder refused a frame");
+      if (count) st.bytes += p.frame.size(), ++st.frames;
+    }
+    st.decoded = v;
+    st.decoder->copyVolume(p.grid.bounds, st.decoded);
+  }
+}
+
+// The warm-up updates at scene time 0, then each stream's keyframe: what a subscriber joining then
+// is sent.
+void warmUp(const VideoBenchOptions& o, const VideoMotion& m, MotionProbes& p) {
+  for (uint32_t k = 0; k < o.warmup; ++k) {
+    updateProbes(p, false);
+    sayProgress(o.progress, fmt::format("bench video: {}: warm-up update {}/{}", m.name, k + 1, o.warmup));
+  }
+  for (StreamState& st : p.streams) {
+    st.encoder->writeKeyframeFrame(p.frame);
+    st.joinBytes = p.frame.size();
+  }
+}
+
+// Every display's views of the motion's scene, its renderers (one on the float probes, one per
+// stream) and room for its recorded frames.
+std::vector<DisplayFrames> makeDisplays(const VideoSetup& s, const MotionProbes& p) {
+  const VideoBenchOptions& o = s.o;
+  std::vector<DisplayFrames> displays(o.displays.size());
+  for (size_t i = 0; i < o.displays.size(); ++i) {
+    DisplayFrames& df = displays[i];
+    df.display = &o.displays[i];
+    std::string error;
+    if (!renderer::parseViewSet(df.display->viewSet, df.spec, error)) throw std::invalid_argument(error);
+    df.camera = renderer::CameraView::fromScene(p.current);
+    df.viewOptions = session::viewSetOptions(p.current, df.display->width, df.display->height);
+    df.views = renderer::makeViewSet(df.camera, df.spec, df.viewOptions);
+    df.floatRaster = std::make_unique<renderer::RasterRenderer>(s.context, p.current, df.display->width,
+                                                                df.display->height, o.raster);
+    for (size_t k = 0; k < p.streams.size(); ++k)
+      df.streamRasters.push_back(std::make_unique<renderer::RasterRenderer>(s.context, p.current, df.display->width,
+                                                                            df.display->height, o.raster));
+    df.sse.assign(p.streams.size(), 0.0);
+    df.worstFramePsnr.assign(p.streams.size(), std::numeric_limits<double>::infinity());
+    df.width = df.display->width * static_cast<uint32_t>(df.spec.columns);
+    df.height = df.display->height * static_cast<uint32_t>(df.spec.rows);
+    df.reference.reserve(static_cast<size_t>(df.width) * df.height * 3 * o.frames);
+  }
+  return displays;
+}
+
+// One display's frame at display time `t`: the float probes' picture, kept for the video, and each
+// stream's, set against it. `moved`: the scene moved since the last frame; `update`: the probes did.
+void renderFrame(const VideoBenchOptions& o, const MotionProbes& p, DisplayFrames& df, double t, bool moved, bool update) {
+  if (moved) {
+    df.floatRaster->setShading(p.current);
+    for (auto& r : df.streamRasters) r->setShading(p.current);
+  }
+  if (o.headTrace)
+    df.views = renderer::makeViewSet(session::poseCamera(df.camera, *o.headTrace, t), df.spec, df.viewOptions);
+  if (update) {
+    df.floatRaster->setProbes(p.updater.volume());
+    for (size_t k = 0; k < p.streams.size(); ++k) df.streamRasters[k]->setProbes(p.streams[k].decoded);
+  }
+  const std::vector<uint8_t> ref = toRgb8(renderQuilt(*df.floatRaster, df), o.exposure);
+  for (size_t k = 0; k < p.streams.size(); ++k) {
+    const std::vector<uint8_t> got = toRgb8(renderQuilt(*df.streamRasters[k], df), o.exposure);
+    const double sse = squaredError(got.data(), ref.data(), ref.size());
+    df.sse[k] += sse;
+    df.worstFramePsnr[k] = std::min(df.worstFramePsnr[k], psnrFromSse(sse, static_cast<double>(ref.size())));
+  }
+  df.reference.insert(df.reference.end(), ref.begin(), ref.end());
+}
+
+// The recorded frames: the scene clock runs at the motion's rate, the probes update at --hz and
+// every display draws every frame at --fps.
+void recordFrames(const VideoBenchOptions& o, const VideoMotion& m, MotionProbes& p, std::vector<DisplayFrames>& displays) {
+  for (uint32_t f = 0; f < o.frames; ++f) {
+    const double t = f / o.fps;
+    const double sceneTime = m.rate * t;
+    const bool moved = p.moves && sceneTime != p.lastSceneTime;
+    if (moved) {
+      session::advanceScene(m.scene, sceneTime, p.current);
+      p.lastSceneTime = sceneTime;
+    }
+    const bool update = f == 0 || std::floor(t * o.hz) != std::floor((f - 1) / o.fps * o.hz);
+    if (update) {
+      if (p.lastSceneTime != p.updaterSceneTime) {
+        p.updater.setScene(p.current);
+        p.updaterSceneTime = p.lastSceneTime;
+      }
+      updateProbes(p, true);
+      ++p.recordedUpdates;
+    }
+    for (DisplayFrames& df : displays) renderFrame(o, p, df, t, moved, update);
+    if (f % 10 == 9 || f + 1 == o.frames)
+      sayProgress(o.progress, fmt::format("bench video: {}: frame {}/{} rendered ({} probe updates)", m.name, f + 1,
+                                          o.frames, p.recordedUpdates));
+  }
+}
+
+// The video's bytes at a stream's PSNR: per codec, and the codec that needs the fewest.
+struct VideoAtPsnr {
+  nlohmann::json perCodec = nlohmann::json::array();
+  std::string bestName, bestBound;
+  double bestBytes = std::numeric_limits<double>::infinity();
+};
+
+VideoAtPsnr videoAtPsnr(const VideoBenchOptions& o, const Sweeps& sweeps, double psnr) {
+  VideoAtPsnr v;
+  for (size_t c = 0; c < o.codecs.size(); ++c) {
+    const AtPsnr at = bytesAtPsnr(sweeps.points[c], psnr);
+    v.perCodec.push_back({{"codec", o.codecs[c].name},
+                          {"bytes_per_second", at.bytesPerSecond},
+                          {"bound", at.bound.empty() ? nlohmann::json(nullptr) : nlohmann::json(at.bound)}});
+    if (at.bytesPerSecond < v.bestBytes) v.bestBytes = at.bytesPerSecond, v.bestName = o.codecs[c].name, v.bestBound = at.bound;
+  }
+  return v;
+}
+
+// Display `i`'s figures for a motion: its video sweeps, then per stream its bytes and PSNR against
+// the video's bytes at that PSNR, into the JSON, the table and the display's chart.
+void reportDisplay(const VideoSetup& s, const VideoMotion& m, const MotionProbes& p, size_t i, DisplayFrames& df,
+                   VideoReport& report) {
+  const VideoBenchOptions& o = s.o;
+  const Sweeps sweeps = sweepVideo(o, m, df, s.work, report.chartSeries[i].second);
+  nlohmann::json streamResults = nlohmann::json::array();
+  for (size_t k = 0; k < p.streams.size(); ++k) {
+    const StreamState& st = p.streams[k];
+    const double bytesPerSecond = static_cast<double>(st.bytes) / s.seconds;
+    const double psnr = psnrFromSse(df.sse[k], static_cast<double>(df.reference.size()));
+    const VideoAtPsnr v = videoAtPsnr(o, sweeps, psnr);
+    const double ratio = bytesPerSecond > 0 ? v.bestBytes / bytesPerSecond : std::numeric_limits<double>::infinity();
+    streamResults.push_back({{"stream", st.config->name},
+                             {"representation", representationName(st.config->repr)},
+                             {"deadzone", st.config->encoder.deadzone},
+                             {"noise_scale", st.config->encoder.noiseScale},
+                             {"frames_sent", st.frames},
+                             {"bytes_per_second", bytesPerSecond},
+                             {"join_bytes", st.joinBytes},
+                             {"psnr_db", dbJson(psnr)},
+                             {"psnr_db_worst_frame", dbJson(df.worstFramePsnr[k])},
+                             {"video_at_equal_psnr", v.perCodec},
+                             {"best_video", v.bestName},
+                             {"best_video_bytes_per_second", v.bestBytes},
+                             {"best_video_bound", v.bestBound.empty() ? nlohmann::json(nullptr) : nlohmann::json(v.bestBound)},
+                             {"video_to_probe_bytes", std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr)}});
+    report.chartSeries[i].second.push_back(
+        {m.name + " " + st.config->name, {{std::max(bytesPerSecond, 1.0), std::isfinite(psnr) ? psnr : 99.0, st.config->name}}, false});
+    const char* mark = v.bestBound == "at_least" ? "≥" : (v.bestBound == "at_most" ? "≤" : "");
+    report.table += fmt::format("{:<10} {:<8} {:<8} {:>10.0f} {:>7} {:>9} {:>3}{:>7.0f} {:>3}{:>5}\n", df.display->name,
+                                m.name, st.config->name, bytesPerSecond,
+                                std::isfinite(psnr) ? fmt::format("{:.2f}", psnr) : std::string("same"), v.bestName, mark,
+                                v.bestBytes, mark, std::isfinite(ratio) ? fmt::format("{:.1f}", ratio) : std::string("-"));
+  }
+  report.results.push_back({{"display", df.display->name},
+                            {"view_set", df.display->viewSet},
+                            {"frame_size", {df.width, df.height}},
+                            {"motion", m.name},
+                            {"scene", m.scene},
+                            {"rate", m.rate},
+                            {"grid", {p.grid.dims[0], p.grid.dims[1], p.grid.dims[2]}},
+                            {"probe_updates", p.recordedUpdates},
+                            {"video", sweeps.json},
+                            {"streams", streamResults}});
+}
+
+// One motion from start to end: the probes warmed up, the frames recorded, then every display's
+// video sweeps and figures.
+void measureMotion(const VideoSetup& s, const VideoMotion& m, VideoReport& report) {
+  MotionProbes p(s, m);
+  warmUp(s.o, m, p);
+  std::vector<DisplayFrames> displays = makeDisplays(s, p);
+  recordFrames(s.o, m, p, displays);
+  for (size_t i = 0; i < displays.size(); ++i) reportDisplay(s, m, p, i, displays[i], report);
+}
+
+// The run's JSON (its settings and every display and motion's figures), its table, and a chart per
+// display.
+VideoBenchResult videoResult(const VideoSetup& s, const VideoReport& report) {
+  const VideoBenchOptions& o = s.o;
   VideoBenchResult r;
   r.json = {{"command", o.command},
             {"probe_hz", o.hz},
             {"fps", o.fps},
             {"frames", o.frames},
-            {"seconds", seconds},
+            {"seconds", s.seconds},
             {"warmup_updates", o.warmup},
             {"gop", o.gop},
             {"camera", o.headTrace ? fmt::format("a recorded head's motion ({:.1f} s trace), neck model {} m ahead, {} m up",
@@ -517,10 +579,10 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
             {"av1", "libaom-av1, realtime usage, cpu-used 6, no lag"},
             {"psnr", "8-bit RGB of every frame against the float-probe render's, from the summed squared error"},
             {"probe_bytes", "stream frames of the changed bricks after the warm-up (the join keyframe apart)"},
-            {"results", results}};
-  if (o.keepFiles) r.json["kept_files"] = work;  // the run's own folder in --work-dir
-  r.table = "bench video: bytes per second at equal PSNR against the float-probe render (≤/≥: beyond the CRF sweep)\n" + table;
-  for (auto& [name, series] : chartSeries) {
+            {"results", report.results}};
+  if (o.keepFiles) r.json["kept_files"] = s.work;  // the run's own folder in --work-dir
+  r.table = "bench video: bytes per second at equal PSNR against the float-probe render (≤/≥: beyond the CRF sweep)\n" + report.table;
+  for (const auto& [name, series] : report.chartSeries) {
     imaging::ChartSpec spec;
     spec.title = "Probe stream against video: " + name;
     spec.xLabel = "bytes per second";
@@ -531,6 +593,25 @@ VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
     r.charts.push_back({name, imaging::renderSvgChart(spec, series)});
   }
   return r;
+}
+
+}  // namespace
+
+VideoBenchResult runVideoBench(const VideoBenchOptions& o) {
+  checkOptions(o);
+  const RunFolder folder(o.workDir.empty() ? fs::temp_directory_path().string() : o.workDir, o.keepFiles);
+  const std::string& work = folder.path;
+  if (o.keepFiles && o.progress) o.progress("frames and bitstreams go to " + work);
+  checkFfmpeg(o, work);
+  renderer::VulkanContext context(o.context);
+  const VideoSetup s{o, context, work, static_cast<double>(o.frames) / o.fps};
+
+  VideoReport report;
+  report.table = fmt::format("{:<10} {:<8} {:<8} {:>10} {:>7} {:>9} {:>10} {:>8}\n", "display", "motion", "stream",
+                             "probes B/s", "dB", "video", "video B/s", "ratio");
+  for (const VideoDisplay& d : o.displays) report.chartSeries.push_back({d.name, {}});
+  for (const VideoMotion& m : o.motions) measureMotion(s, m, report);
+  return videoResult(s, report);
 }
 
 }  // namespace probecast::bench
