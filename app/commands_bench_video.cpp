@@ -45,9 +45,9 @@ void addVideoOptions(CLI::App* cmd, TracingOptions& vt, VideoCli& vo) {
   cmd->add_option("--mover-scene", vo.moverScene, "an animated glTF file measured too, as motion 'mover'")
       ->check(CLI::ExistingFile);
   cmd->add_option("--head-trace", vo.headTrace,
-                  "move every display's camera as a recorded head moved (timestamp viewpoint w x y z per line, x forward, "
-                  "z up; the MMSys'18 head-movement format), with a neck model; default: the camera is still")
-      ->check(CLI::ExistingFile);
+                  "move every display's camera as a recorded head moved (a file of timestamp viewpoint w x y z per line, x "
+                  "forward, z up: the MMSys'18 head-movement format; or builtin:mmsys18-user1, 10 s of one), with a neck "
+                  "model; default: the camera is still");
   cmd->add_option("--mover-rate", vo.moverRate, "the mover's clock rate, scene seconds per second")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();

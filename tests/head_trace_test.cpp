@@ -3,7 +3,9 @@
 // the neck's pivot.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "probecast/session/head_trace.h"
 
@@ -39,6 +41,20 @@ TEST(HeadTrace, ReadsTheRecordedFormatAndRefusesWhatIsNotIt) {
 // A turn of 90° about the dataset's z (up) over one second: the project's camera, looking down −Z
 // at the start, looks down −X after it (turning left, as z up and y left make a positive turn),
 // half-way at 0.5 s, and the eyes swing about the pivot behind them. The trace loops.
+TEST(HeadTrace, TheBuiltInTraceIsTenSecondsOfARealHead) {
+  HeadTrace t;
+  std::string error;
+  ASSERT_TRUE(loadHeadTrace(kBuiltinHeadTrace, t, error)) << error;
+  EXPECT_GT(t.seconds.size(), 500u);  // about 56 samples a second
+  EXPECT_NEAR(t.duration(), 10.0, 0.05);
+  // The head moves: somewhere in the first two seconds it has turned by more than 5 degrees.
+  float most = 0.0f;
+  for (double s = 0.0; s < 2.0; s += 0.05) most = std::max(most, glm::degrees(glm::angle(t.rotationAt(s))));
+  EXPECT_GT(most, 5.0f);
+  EXPECT_FALSE(loadHeadTrace("builtin:nobody", t, error));
+  EXPECT_NE(error.find("builtin:nobody: no such trace (built in: builtin:mmsys18-user1)"), std::string::npos) << error;
+}
+
 TEST(HeadTrace, TurnsTheCameraAboutTheNeckAsTheHeadTurned) {
   const double s = std::sqrt(0.5);
   HeadTrace t;

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace probecast::session {
@@ -50,7 +52,14 @@ bool parseHeadTrace(const std::string& text, HeadTrace& out, std::string& error)
   return true;
 }
 
+extern const std::string_view kBuiltinHeadTraceUser1;  // builtin_head_trace.cpp, generated
+
 bool loadHeadTrace(const std::string& path, HeadTrace& out, std::string& error) {
+  if (path.rfind("builtin:", 0) == 0) {
+    if (path != kBuiltinHeadTrace) return error = path + ": no such trace (built in: " + kBuiltinHeadTrace + ")", false;
+    if (!parseHeadTrace(std::string(kBuiltinHeadTraceUser1), out, error)) return error = path + ": " + error, false;
+    return true;
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return error = path + ": cannot be read", false;
   std::ostringstream text;

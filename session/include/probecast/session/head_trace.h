@@ -34,8 +34,13 @@ struct HeadTrace {
 inline constexpr float kNeckForward = 0.10f;  // metres from the neck's pivot to the eyes, ahead
 inline constexpr float kNeckUp = 0.10f;       // and above
 
-// Reads a trace; false with a message naming the file and line on anything malformed (a bad
-// number, a quaternion far from unit length, time running backwards, fewer than two samples).
+// A trace built into the binary: the first 10 s of user 1 of the MMSys'18 traces (Corbillon et
+// al., MIT licence; examples/head-traces/).
+inline constexpr const char* kBuiltinHeadTrace = "builtin:mmsys18-user1";
+
+// Reads a trace (a file, or kBuiltinHeadTrace); false with a message naming the file and line on
+// anything malformed (a bad number, a quaternion far from unit length, time running backwards,
+// fewer than two samples), or an unknown builtin: name.
 bool loadHeadTrace(const std::string& path, HeadTrace& out, std::string& error);
 bool parseHeadTrace(const std::string& text, HeadTrace& out, std::string& error);
 
