@@ -51,12 +51,23 @@ void addDemoCommand(CLI::App& app) {
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   demo->add_option("--ffmpeg", o->ffmpeg, "the ffmpeg that --video runs")->capture_default_str();
+  demo->add_option("--head-trace", o->headTrace,
+                   "--video: the headset's camera turns as this recorded head turned (a trace file in the MMSys'18 "
+                   "format, or builtin:mmsys18-user1: 10 s of a person in a headset); none: a still camera. The "
+                   "light-field display stays still")
+      ->capture_default_str();
   o->environment.add(demo);
   demo->callback([o] {
     if (o->referenceSpp < 2)
       throw std::runtime_error("--reference-spp must be at least 2: a reference is two halves of different seeds");
     o->noise.apply(o->encoder, /*live=*/true);
     o->sky = o->environment.load();  // a bad map or sky fails here, before the server starts
+    if (o->video == "on" && o->headTrace != "none") {  // and so does a bad head trace
+      auto trace = std::make_shared<session::HeadTrace>();
+      std::string error;
+      if (!session::loadHeadTrace(o->headTrace, *trace, error)) throw std::runtime_error("--head-trace " + error);
+      o->trace = trace;
+    }
     DemoRun run;
     run.wallStart = DemoClock::now();
     std::filesystem::create_directories(o->out);

@@ -16,6 +16,7 @@
 #include "probecast/renderer/view_sets.h"
 #include "probecast/renderer/vulkan_context.h"
 #include "probecast/scene/scene.h"
+#include "probecast/session/head_trace.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/viewer.h"
 #include "scene_options.h"
@@ -43,6 +44,8 @@ struct DemoOptions {
   bool skipSuites = false;               // no pipeline benchmark or stability suite in the report
   std::string video = "on";              // on: the report sets the stream against video of the viewers' views
   std::string ffmpeg = "ffmpeg";         // for that comparison
+  std::string headTrace = session::kBuiltinHeadTrace;  // the headset's camera there turns as a head did; "none": still
+  std::shared_ptr<const session::HeadTrace> trace;     // read from `headTrace` before anything starts
   EnvironmentOptions environment;        // --environment/--sky...: the server's, the viewers' and the references' sky
   std::shared_ptr<const renderer::Environment> sky;  // loaded from `environment` before anything starts
   bool visibility = true;                // viewers weigh probes by visibility (RasterOptions)

@@ -80,8 +80,11 @@ std::string runVideoComparison(const DemoOptions& o, const DemoRun& run, const s
   Progress progress("demo");
   bench::VideoBenchOptions vo;
   vo.motions = {{"demo", o.scene, o.rate}};
-  for (const DemoViewer& v : run.viewers)
-    vo.displays.push_back({v.viewSet == "stereo" ? "headset" : "lightfield", v.viewSet, v.width, v.height});
+  for (const DemoViewer& v : run.viewers) {
+    const bool headset = v.viewSet == "stereo";
+    vo.displays.push_back({headset ? "headset" : "lightfield", v.viewSet, v.width, v.height, /*followsHead=*/headset});
+  }
+  vo.headTrace = o.trace;
   const std::vector<int> x265Crfs{20, 28, 36, 44}, av1Crfs{20, 32, 44, 56, 63};
   for (const char* name : {"av1-444", "x265-444"}) {
     bench::VideoCodec codec;
@@ -122,10 +125,14 @@ std::string runVideoComparison(const DemoOptions& o, const DemoRun& run, const s
     section += fmt::format(
         "Both viewers' views drawn for one second at 30 frames per second from the updater's float probes "
         "(what a video server would encode) and from what a subscriber decodes from the {} stream; the float "
-        "frames encoded with AV1 and x265 at 4:4:4 (low latency, GOP 30, a CRF sweep). Video bytes at the "
+        "frames encoded with AV1 and x265 at 4:4:4 (low latency, GOP 30, a CRF sweep). {} Video bytes at the "
         "stream's PSNR against the float frames; ≥ or ≤ where the sweep does not reach it. Data: "
         "[video.json](video.json); `probecast bench video` measures more motions, displays and codecs.\n\n```\n{}```\n",
-        o.repr, r.table);
+        o.repr,
+        vo.headTrace ? fmt::format("The headset's camera turns as a recorded head turned ({}), the light-field "
+                                   "display's stays still.", o.headTrace)
+                     : std::string("Both cameras still."),
+        r.table);
     report["video"] = r.json;
     fmt::print("demo: the stream against video of the same views\n{}", r.table);
   } catch (const std::runtime_error& e) {

@@ -441,7 +441,7 @@ void renderFrame(const VideoBenchOptions& o, const MotionProbes& p, DisplayFrame
     df.floatRaster->setShading(p.current);
     for (auto& r : df.streamRasters) r->setShading(p.current);
   }
-  if (o.headTrace)
+  if (o.headTrace && df.display->followsHead)
     df.views = renderer::makeViewSet(session::poseCamera(df.camera, *o.headTrace, t), df.spec, df.viewOptions);
   if (update) {
     df.floatRaster->setProbes(p.updater.volume());
@@ -539,6 +539,7 @@ void reportDisplay(const VideoSetup& s, const VideoMotion& m, const MotionProbes
                                 v.bestBytes, mark, std::isfinite(ratio) ? fmt::format("{:.1f}", ratio) : std::string("-"));
   }
   report.results.push_back({{"display", df.display->name},
+                            {"follows_head", o.headTrace != nullptr && df.display->followsHead},
                             {"view_set", df.display->viewSet},
                             {"frame_size", {df.width, df.height}},
                             {"motion", m.name},

@@ -35,6 +35,7 @@ struct VideoDisplay {
   std::string name;
   std::string viewSet;  // stereo, lf:NxM, lfh:NxM, mono
   uint32_t width = 0, height = 0;  // per view; even (4:2:0 needs even frame sizes)
+  bool followsHead = true;  // its camera turns with VideoBenchOptions::headTrace (a headset; not a panel)
 };
 
 // What moves: `scene` (glTF or builtin:NAME) with its clock at `rate` scene seconds per second.
@@ -79,8 +80,8 @@ struct VideoBenchOptions {
   uint32_t frames = 60;    // recorded frames per motion
   uint32_t warmup = 16;    // probe updates at scene time 0 before recording
   uint32_t gop = 30;       // video frames per keyframe interval
-  // Every display's camera turns as this head turned (session/head_trace.h), from its start, at
-  // the display clock; none: the camera is still.
+  // The camera of every display that follows a head turns as this head turned
+  // (session/head_trace.h), from its start, at the display clock; none: the cameras are still.
   std::shared_ptr<const session::HeadTrace> headTrace;
   std::string preset = "medium";  // x265's preset; AV1 (libaom, realtime) runs at cpu-used 6
   float exposure = 1.0f;
