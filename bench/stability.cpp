@@ -318,14 +318,27 @@ NetworkFaults measureNetworkFaults() {
   r.lightingKeptDuringOutage = during.volume.probes == before.volume.probes && energy > 0;
   const uint64_t bytesBefore = client.stats().bytesReceived;
   producer.setMoving(false);  // freeze so both clients can finish; the hub holds the lighting of the outage
+  // A frame the producer was making when it was frozen still reaches the hub: let it land (ten
+  // frame intervals) so the resuming client and the newcomer start from the same hub state.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
   client.start();
   service::ProbeClient newcomer(config(0));
   newcomer.start();
-  r.secondsToBitExact = waitSeconds([&] { return holdsServerVolume(client, hub); }, 20.0);
+  // Each client's bytes counted at the moment it holds the server's volume (what the hub sends
+  // after that, to either, is not the cost of catching up).
+  uint64_t resumedAt = 0, newcomerAt = 0;
+  const auto caughtUp = [&](service::ProbeClient& c, uint64_t& bytes) {
+    if (!holdsServerVolume(c, hub)) return false;
+    bytes = c.stats().bytesReceived;
+    return true;
+  };
+  r.secondsToBitExact = waitSeconds([&] { return caughtUp(client, resumedAt); }, 20.0);
   r.bitExactAfterResume = r.secondsToBitExact >= 0;
-  waitSeconds([&] { return holdsServerVolume(newcomer, hub); }, 20.0);
-  r.resumeBytes = static_cast<double>(client.stats().bytesReceived - bytesBefore);
-  r.newcomerBytes = static_cast<double>(newcomer.stats().bytesReceived);
+  waitSeconds([&] { return caughtUp(newcomer, newcomerAt); }, 20.0);
+  if (!resumedAt) resumedAt = client.stats().bytesReceived;  // never caught up: what it took so far
+  if (!newcomerAt) newcomerAt = newcomer.stats().bytesReceived;
+  r.resumeBytes = static_cast<double>(resumedAt - bytesBefore);
+  r.newcomerBytes = static_cast<double>(newcomerAt);
   // A slow link next to a fast one, joining together after the light moved again.
   producer.setMoving(true);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
