@@ -8,7 +8,8 @@
 // URL: index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL-OF-THE-SCENE-FOLDER#token=TOKEN
 // (the token in the fragment: it never reaches a web server's logs). Optional: camera=px,py,pz,tx,ty,tz,fovDeg,
 // exposure=X (as the native viewer's --exposure), xr=emulate (a headset emulated in the page, for
-// trying WebXR without one). Where the browser offers immersive VR, an "Enter VR" button opens a
+// trying WebXR without one), lkg=URL-OF-VISUAL.JSON (drive a Looking Glass: the canvas becomes the
+// panel's interleaved image; lkgview=WxH sets the size of each view, by default the model's). Where the browser offers immersive VR, an "Enter VR" button opens a
 // session that renders each eye from the same probes, starting where the page's camera stands.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
@@ -16,6 +17,7 @@ import { connect, DeliverPolicy } from 'nats.ws';
 import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
 import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
+import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
 
 const params = new URLSearchParams(location.search);
 // The fragment's token=…, percent-decoded but with '+' kept (a base64 token holds '+', which
@@ -35,6 +37,8 @@ const config = {
   scene: params.get('scene'),
   token: fragmentValue('token') || params.get('token') || '',
   camera: params.get('camera'),
+  lkg: params.get('lkg'),
+  lkgView: params.get('lkgview'),
 };
 
 // What the page shows, and what a test reads (window.probecast).
@@ -137,9 +141,19 @@ function pose(time) {
 }
 
 function frame(now, xrFrame) {
-  if (!renderer.xr.isPresenting) resize();
   pose(displayTime());
-  renderer.render(scene, renderer.xr.isPresenting ? xrCamera : camera);
+  if (lookingGlass) {
+    // The drawing buffer is the panel, pixel for pixel, whatever size the page shows it at.
+    const { screenW, screenH } = lookingGlass.cal;
+    if (canvas.width !== screenW || canvas.height !== screenH) renderer.setSize(screenW, screenH, false);
+    if (state.sceneLoaded) {
+      const distance = Math.max(0.1, sceneCentre.distanceTo(camera.getWorldPosition(new THREE.Vector3())));
+      lookingGlass.render(renderer, scene, camera, distance, renderer.toneMappingExposure);
+    }
+  } else {
+    if (!renderer.xr.isPresenting) resize();
+    renderer.render(scene, renderer.xr.isPresenting ? xrCamera : camera);
+  }
   frameTimes.push(now - last);
   if (frameTimes.length > 60) frameTimes.shift();
   last = now;
@@ -151,6 +165,27 @@ function frame(now, xrFrame) {
   state.frameMs = median(frameTimes);
 }
 renderer.setAnimationLoop(frame);
+
+// ---- a Looking Glass ---------------------------------------------------------------------------
+let lookingGlass = null;
+let sceneCentre = new THREE.Vector3();  // the display plane's distance is measured to it, as natively
+async function setupLookingGlass() {
+  const r = await fetch(new URL(config.lkg, location.href)).catch((e) => {
+    throw new Error(`the Looking Glass calibration ${config.lkg} could not be fetched (${e.message})`);
+  });
+  if (!r.ok) throw new Error(`the Looking Glass calibration ${config.lkg}: HTTP ${r.status}`);
+  const cal = parseCalibration(await r.text());
+  let viewSize = null;
+  if (config.lkgView) {
+    const m = /^(\d{1,5})x(\d{1,5})$/.exec(config.lkgView);
+    if (!m || +m[1] < 1 || +m[2] < 1 || +m[1] > 8192 || +m[2] > 8192) throw new Error('lkgview= takes WxH, each 1..8192');
+    viewSize = [+m[1], +m[2]];
+  }
+  lookingGlass = new LookingGlassOutput(cal, viewSize);
+  state.lookingGlass = { model: cal.model.name, serial: cal.serial, views: lookingGlass.views, columns: lookingGlass.columns,
+                         rows: lookingGlass.rows, view: lookingGlass.tile, panel: [cal.screenW, cal.screenH], cells: cal.cells.length };
+}
+if (config.lkg) setupLookingGlass().catch((e) => fail(e.message));
 
 // ---- WebXR -------------------------------------------------------------------------------------
 state.xr = 'none';
@@ -263,6 +298,7 @@ async function loadScene(manifestText, hash) {
     }
   });
   fitSunShadows(gltf.scene);
+  new THREE.Box3().setFromObject(gltf.scene).getCenter(sceneCentre);
   state.emitters = countEmitters(gltf.scene);
   camera = pickCamera(gltf);
   // The scene's animation, every clip at once, looped over the longest (as the native viewers).
@@ -490,6 +526,10 @@ setInterval(() => {
     `${state.connection}  ${config.stream}  ${state.representation}  bricks ${state.bricksHeld}/${state.bricks}  checksum ${state.checksum || '–'}`,
     `frame ${state.frameMs.toFixed(1)} ms  newest light ${age} ago  ${(rate / 1024).toFixed(1)} kB/s  decode ${state.decodeMs.toFixed(2)} ms/message`,
   ];
+  if (state.lookingGlass) {
+    const g = state.lookingGlass;
+    lines.push(`Looking Glass ${g.model}: ${g.views} views of ${g.view.join('x')}, panel ${g.panel.join('x')}`);
+  }
   if (state.warning) lines.push(state.warning);
   if (state.error) lines.push(state.error);
   statusEl.textContent = lines.join('\n');

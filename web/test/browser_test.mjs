@@ -12,6 +12,9 @@ import { dirname, join, extname, resolve, basename, sep } from 'node:path';
 import { chromium } from 'playwright-core';
 
 const [probecast, webDir, sceneGltf, work] = process.argv.slice(2).map((p) => resolve(p));
+// PROBECAST_WEB_LKG=visual.json: also drive that Looking Glass from the page (lkg=, views of
+// PROBECAST_WEB_LKG_VIEW) and set its panel image against the native viewer's.
+const lkgCalibration = process.env.PROBECAST_WEB_LKG ? resolve(process.env.PROBECAST_WEB_LKG) : '';
 if (!work) throw new Error('usage: node browser_test.mjs PROBECAST WEB_DIR SCENE_GLTF WORK_DIR');
 rmSync(work, { recursive: true, force: true });
 mkdirSync(work, { recursive: true });
@@ -88,6 +91,7 @@ const served = new Map();
 const http = createServer((req, res) => {
   const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
   const [root, rel] = path.startsWith('/scene/') ? [sceneDir, path.slice(7)]
+    : lkgCalibration && path === '/lkg/visual.json' ? [dirname(lkgCalibration), basename(lkgCalibration)]
     : path.startsWith('/altered/') ? [join(work, 'altered'), path.slice(9)] : [webDir, path === '/' ? 'index.html' : path.slice(1)];
   const file = resolve(root, rel);
   if (!file.startsWith(root + sep) || !existsSync(file) || !statSync(file).isFile()) { res.writeHead(404); res.end(); return; }
@@ -129,7 +133,7 @@ try {
   execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
     '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native')], { stdio: 'ignore' });
   const nativePng = 'data:image/png;base64,' + readFileSync(join(work, 'native', 'quilt.png')).toString('base64');
-  const compare = (png) => page.evaluate(async (url) => {
+  const compare = (png, on = page) => on.evaluate(async (url) => {
     const img = new Image();
     img.src = url;
     await img.decode();
@@ -162,6 +166,32 @@ try {
       '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native-at-rest')], { stdio: 'ignore' });
     const atRest = await compare('data:image/png;base64,' + readFileSync(join(work, 'native-at-rest', 'quilt.png')).toString('base64'));
     check(atRest.psnr < compared.psnr - 3, `the page poses the scene at the stream's time ${sceneTime} s (${compared.psnr.toFixed(2)} dB against the native picture then, ${atRest.psnr.toFixed(2)} dB against the scene at rest)`);
+  }
+  if (lkgCalibration) {
+    // The same camera on a Looking Glass: the page's panel image against the native viewer's.
+    // 'model': each view at the display model's own size, in the page and natively.
+    const view = process.env.PROBECAST_WEB_LKG_VIEW || '96x128';
+    const lkg = await browser.newPage({ viewport: { width: 320, height: 240 } });
+    lkg.on('pageerror', (e) => consoleLines.push('lkg page error: ' + e.message));
+    const lkgParams = view === 'model' ? '&lkg=/lkg/visual.json' : `&lkg=/lkg/visual.json&lkgview=${view}`;
+    await lkg.goto(url(busToken).replace('&scene=', `${lkgParams}&scene=`));
+    const shown = await until('the Looking Glass page to draw the panel', async () => {
+      const v = await lkg.evaluate(() => ({ ...window.probecast }));
+      if (v.error) throw new Error('the Looking Glass page says: ' + v.error);
+      return v.sceneLoaded && v.checksum === native && v.lookingGlass && v.frames > 5 ? v : null;
+    }, 90);
+    execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
+      '--looking-glass', lkgCalibration, ...(view === 'model' ? [] : ['--size', view]), '--out', join(work, 'native-lkg')],
+    { stdio: 'ignore' });
+    const panel = await compare('data:image/png;base64,' + readFileSync(join(work, 'native-lkg', 'looking_glass.png')).toString('base64'), lkg);
+    writeFileSync(join(work, 'lkg_canvas.png'), Buffer.from(panel.canvas.split(',')[1], 'base64'));
+    const g = shown.lookingGlass;
+    check(panel.size.join('x') === panel.nativeSize.join('x') && panel.size.join('x') === g.panel.join('x'),
+      `the page draws the panel at its own size (${panel.size.join('x')}; native ${panel.nativeSize.join('x')})`);
+    console.log(`Looking Glass ${g.model} (${g.views} views of ${g.view.join('x')}, ${g.cells} subpixel cells): page against the native panel image ${panel.psnr.toFixed(2)} dB PSNR, ${shown.frameMs.toFixed(1)} ms a frame`);
+    const minLkg = Number(process.env.PROBECAST_WEB_LKG_MIN_PSNR || 0);
+    check(panel.psnr >= minLkg, `the page's panel image is within ${minLkg} dB of the native one (${panel.psnr.toFixed(2)} dB)`);
+    await lkg.close();
   }
   if (process.env.PROBECAST_WEB_QUICK) {  // the picture only
     console.log('browser viewer picture ok');
