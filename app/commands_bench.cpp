@@ -191,6 +191,7 @@ void addBenchCommands(CLI::App& app) {
   addBenchCodec(bench);
   addBenchUpdate(bench);
   addBenchRaster(bench);
+  addBenchPanel(bench);
   addBenchScene(bench);
   addBenchPipeline(bench);
   addBenchEnvironment(bench);

@@ -11,6 +11,7 @@ void addBenchRaster(CLI::App* bench);
 void addBenchScene(CLI::App* bench);
 void addBenchPipeline(CLI::App* bench);
 void addBenchEnvironment(CLI::App* bench);
+void addBenchPanel(CLI::App* bench);
 
 // The probe updater over many updates (commands_bench_updater.cpp).
 void addBenchUpdate(CLI::App* bench);

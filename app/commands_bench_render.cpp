@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "commands_bench.h"
 #include "environment_bench.h"
+#include "panel_bench.h"
 #include "pipeline_bench.h"
 #include "progress.h"
 #include "raster_bench.h"
@@ -87,6 +88,53 @@ void addBenchRaster(CLI::App* bench) {
       writeTextFile(views, r.svgViews);
       fmt::print("wrote {}\n", views);
     }
+  });
+}
+
+// `probecast bench panel`: a Looking Glass panel frame, phase by phase, for ways of drawing its views.
+void addBenchPanel(CLI::App* bench) {
+  CLI::App* cmd = bench->add_subcommand(
+      "panel", "a Looking Glass panel frame: ms per phase and PSNR against full-quality views, per way of drawing them");
+  auto pt = std::make_shared<TracingOptions>();
+  struct PanelCli {
+    std::string json, calibration;
+    std::vector<std::string> ways{"msaa4", "msaa1", "half", "multiview"};
+    std::vector<uint32_t> size;
+    bench::PanelBenchOptions bench;
+    AreaLightCli areaLights{"off"};
+  };
+  auto po = std::make_shared<PanelCli>();
+  pt->add(cmd);
+  cmd->add_option("--looking-glass", po->calibration, "the display's calibration (visual.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ways", po->ways, "ways of drawing the views: msaa4 (the viewers' default), msaa1, half, multiview, ss2")
+      ->delimiter(',')
+      ->capture_default_str();
+  addSizeOption(cmd, po->size, "size of each view WxH (default: the display model's)", 8, 4096);
+  cmd->add_option("--updates", po->bench.updates, "probe updates before drawing")->check(CLI::Range(1, 10000));
+  cmd->add_option("--repeats", po->bench.repeats, "timed frames per way (median)")->check(CLI::Range(1, 1000));
+  addVisibilityOption(cmd, po->bench.raster.visibility);
+  po->areaLights.add(cmd);
+  addJsonOption(cmd, po->json);
+  cmd->callback([=] {
+    for (const std::string& name : po->ways) {
+      bench::PanelWay way;
+      std::string error;
+      if (!bench::panelWay(name, way, error)) throw std::runtime_error("--ways: " + error);
+      po->bench.ways.push_back(way);
+    }
+    po->bench.calibration = renderer::loadLookingGlassCalibration(po->calibration);
+    if (!po->size.empty()) po->bench.viewWidth = po->size[0], po->bench.viewHeight = po->size[1];
+    po->bench.scene = pt->scene.load();
+    po->bench.grid = pt->grid.resolve(po->bench.scene);
+    po->bench.updater = pt->updater(pt->scene.environment.load());
+    po->bench.updater.areaLights = po->bench.raster.areaLights = po->areaLights.options();
+    po->bench.context = pt->device.context();
+    po->bench.command = commandLine();
+    po->bench.progress = progressLine;
+    const bench::PanelBenchResult r = bench::runPanelBench(po->bench);
+    writeBenchOutputs(r.table, r.json.dump(2) + "\n", po->json, "", "");
   });
 }
 
