@@ -4,11 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <memory>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <glm/gtc/quaternion.hpp>
 
 #include "probecast/renderer/window.h"
+#include "probecast/session/head_trace.h"
 
 namespace probecast::app {
 namespace {
@@ -61,6 +64,28 @@ class FlyCamera {
   glm::vec3 offset_{0.0f};
 };
 
+// --head-trace's trace, read (or refused by name) before anything else starts.
+std::shared_ptr<const session::HeadTrace> loadWindowTrace(const std::string& spec) {
+  if (spec.empty()) return nullptr;
+  auto trace = std::make_shared<session::HeadTrace>();
+  std::string error;
+  if (!session::loadHeadTrace(spec, *trace, error)) throw std::runtime_error("--head-trace " + error);
+  fmt::print("window: the camera turns as {} turned ({:.1f} s, looping)\n", spec, trace->duration());
+  return trace;
+}
+
+// Writes the screenshot: what was presented (PNG, the window's pixels) and what was drawn (EXR).
+void writeScreenshot(const std::string& base, const renderer::Window& window, const std::vector<uint8_t>& presented,
+                     const renderer::Image& shown) {
+  std::string error;
+  if (!imaging::writePngRgba(base + ".png", presented, static_cast<int>(window.width()), static_cast<int>(window.height()),
+                             error) ||
+      !imaging::writeExr(base + ".exr", shown.rgb, static_cast<int>(shown.width), static_cast<int>(shown.height), error))
+    fmt::print(stderr, "window: screenshot not written: {}\n", error);
+  else
+    fmt::print("window: screenshot {}.png (as presented) and {}.exr (linear)\n", base, base);
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
@@ -87,6 +112,16 @@ void LiveWindowOptions::add(CLI::App* cmd) {
   cmd->add_option("--overlay", overlay, "--window: the status line (frame ms, probe age, bytes/s, connection)")
       ->capture_default_str()
       ->needs(window);
+  cmd->add_option("--head-trace", headTrace,
+                  "--window: the camera turns as a recorded head turned, from the window's opening, looping (a file "
+                  "of timestamp viewpoint w x y z lines, the MMSys'18 format, or builtin:mmsys18-user1), with a neck "
+                  "model; the mouse and keys still move it")
+      ->check([](const std::string& spec) {
+        session::HeadTrace trace;
+        std::string error;
+        return session::loadHeadTrace(spec, trace, error) ? std::string() : error;
+      })
+      ->needs(window);
 }
 
 renderer::ContextOptions LiveWindowOptions::presenting(renderer::ContextOptions options) {
@@ -110,6 +145,7 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
   std::fflush(stdout);
 
   FlyCamera camera(start, sceneSize);
+  const std::shared_ptr<const session::HeadTrace> trace = loadWindowTrace(o.headTrace);
   LiveWindowResult result;
   const Clock::time_point begin = Clock::now();
   Clock::time_point lastFrame = begin, lastReport = begin;
@@ -123,9 +159,12 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
     const double dt = std::chrono::duration<double>(frameStart - lastFrame).count();
     lastFrame = frameStart;
     const renderer::WindowInput in = window.poll();
-    const bool moved = camera.apply(in, dt) || first;
+    const bool moved = camera.apply(in, dt) || first || trace;
     first = false;
-    if (moved) views = renderer::makeViewSet(camera.camera(), spec, viewSetOptions);
+    if (moved)
+      views = renderer::makeViewSet(
+          trace ? session::poseCamera(camera.camera(), *trace, secondsSince(begin)) : camera.camera(), spec,
+          viewSetOptions);
     const bool drawn = source.render(views, moved, images);
     if (drawn) {
       shown = source.compose ? source.compose(images, views)
@@ -149,14 +188,7 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
       screenshotDone = true;
       std::filesystem::create_directories(outDir);
       const std::string base = fmt::format("{}/screenshot_{:03}", outDir, result.screenshots.size());
-      std::string error;
-      if (!imaging::writePngRgba(base + ".png", readback, static_cast<int>(window.width()),
-                                 static_cast<int>(window.height()), error) ||
-          !imaging::writeExr(base + ".exr", shown.rgb, static_cast<int>(shown.width), static_cast<int>(shown.height),
-                             error))
-        fmt::print(stderr, "window: screenshot not written: {}\n", error);
-      else
-        fmt::print("window: screenshot {}.png (as presented) and {}.exr (linear)\n", base, base);
+      writeScreenshot(base, window, readback, shown);
       result.screenshots.push_back(base);
     }
     const double ms = 1e3 * secondsSince(frameStart);

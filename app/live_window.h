@@ -23,6 +23,7 @@ struct LiveWindowOptions {
   double seconds = 0.0;           // --window-seconds: close after this long (0: when the user closes it)
   double screenshotAfter = -1.0;  // --screenshot-after: one screenshot this many seconds in (< 0: none)
   bool overlay = true;            // the status line
+  std::string headTrace;          // --head-trace: the camera turns as this recorded head turned (looping)
   void add(CLI::App* cmd);
   // The context a window presents from: the given options plus what presenting needs.
   static renderer::ContextOptions presenting(renderer::ContextOptions options);

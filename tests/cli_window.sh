@@ -52,6 +52,30 @@ assert frames >= 2, frames
 print("local window: %d frames, screenshot equals the offscreen render" % frames)
 PY
 
+# A recorded head turns the camera: a second in, the head has turned 7-9 degrees, so the window's
+# picture is not the still camera's; a trace that cannot be read is refused before any window.
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --window-seconds 3 \
+  --screenshot-after 1 --head-trace builtin:mmsys18-user1 --out "$work/head-window" >"$work/head-window.log"
+grep -q "window: the camera turns as builtin:mmsys18-user1 turned (10.0 s, looping)" "$work/head-window.log" ||
+  { cat "$work/head-window.log"; exit 1; }
+/usr/bin/python3 - "$work/head-window/screenshot_000.png" "$work/local-window/screenshot_000.png" <<'PY'
+import sys
+import matplotlib.image as mpimg
+head, still = mpimg.imread(sys.argv[1]), mpimg.imread(sys.argv[2])
+assert head.shape == still.shape, (head.shape, still.shape)
+band = 20  # below the status line
+differ = (abs(head[band:, :, :3] - still[band:, :, :3]).max(axis=2) > 0.02).mean()
+assert differ > 0.2, "the head turned, the picture did not (%.3f of pixels differ)" % differ
+print("head-tracked window: %.0f%% of pixels differ from the still camera's" % (100 * differ))
+PY
+set +e
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --head-trace builtin:nobody \
+  --out "$work/bad-trace" >"$work/bad-trace.log" 2>&1
+rc=$?
+set -e
+[ "$rc" -ne 0 ] && grep -q "builtin:nobody: no such trace" "$work/bad-trace.log" || { cat "$work/bad-trace.log"; exit 1; }
+[ ! -e "$work/bad-trace" ]
+
 # A window without --views opens one view of --size (not view's default set of 25).
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --size 160x96 --supersample 1 --window \
   --window-seconds 1 --out "$work/one-view" >"$work/one-view.log"
