@@ -48,6 +48,11 @@ void addVideoOptions(CLI::App* cmd, TracingOptions& vt, VideoCli& vo) {
                   "move every display's camera as a recorded head moved (a file of timestamp viewpoint w x y z per line, x "
                   "forward, z up: the MMSys'18 head-movement format; or builtin:mmsys18-user1, 10 s of one), with a neck "
                   "model; default: the camera is still");
+  cmd->add_option("--truth-updates", vo.bench.truthUpdates,
+                  "also score the streams and the videos against converged truth: each recorded moment's probes traced "
+                  "from scratch for this many updates (0: only against the float-probe render)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
   cmd->add_option("--mover-rate", vo.moverRate, "the mover's clock rate, scene seconds per second")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();

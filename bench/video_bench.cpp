@@ -87,6 +87,11 @@ struct DisplayFrames {
   uint32_t width = 0, height = 0;  // the quilt's
   std::vector<uint8_t> reference;
   std::vector<double> sse, worstFramePsnr;  // per stream configuration
+  // With converged truth: its renderer, its frames, and each stream's and the float probes' error.
+  std::unique_ptr<renderer::RasterRenderer> truthRaster;
+  std::vector<uint8_t> truth;
+  std::vector<double> truthSse;
+  double floatTruthSse = 0.0;
 };
 
 std::vector<uint8_t> toRgb8(const renderer::Image& image, float exposure) {
@@ -114,6 +119,7 @@ double squaredError(const uint8_t* a, const uint8_t* b, size_t n) {
 struct VideoPoint {
   int crf = 0;
   double bytesPerSecond = 0.0, psnrDb = 0.0, encodeSeconds = 0.0;
+  double truthPsnrDb = std::numeric_limits<double>::quiet_NaN();  // against converged truth, when measured
 };
 
 // Encodes `d.reference` at `crf`, decodes it and compares.
@@ -149,8 +155,10 @@ VideoPoint encodeAndMeasure(const VideoBenchOptions& o, const VideoCodec& c, int
   if (decoded.size() != d.reference.size())
     throw std::runtime_error(fmt::format("bench video: {} crf {} decoded to {} bytes of frames, not {}", c.name, crf,
                                          decoded.size(), d.reference.size()));
-  const double sse = squaredError(reinterpret_cast<const uint8_t*>(decoded.data()), d.reference.data(), decoded.size());
-  p.psnrDb = psnrFromSse(sse, static_cast<double>(decoded.size()));
+  const auto* frames = reinterpret_cast<const uint8_t*>(decoded.data());
+  p.psnrDb = psnrFromSse(squaredError(frames, d.reference.data(), decoded.size()), static_cast<double>(decoded.size()));
+  if (!d.truth.empty())
+    p.truthPsnrDb = psnrFromSse(squaredError(frames, d.truth.data(), decoded.size()), static_cast<double>(decoded.size()));
   if (!o.keepFiles) fs::remove(bitstream);
   return p;
 }
@@ -295,6 +303,7 @@ Sweeps sweepVideo(const VideoBenchOptions& o, const VideoMotion& m, DisplayFrame
       points.push_back(p);
       sweep.push_back({{"crf", crf}, {"bytes_per_second", p.bytesPerSecond}, {"psnr_db", dbJson(p.psnrDb)},
                        {"encode_seconds", p.encodeSeconds}});
+      if (!df.truth.empty()) sweep.back()["psnr_db_vs_truth"] = dbJson(p.truthPsnrDb);
       if (std::isfinite(p.psnrDb) && p.bytesPerSecond > 0) series.points.push_back({p.bytesPerSecond, p.psnrDb, ""});
     }
     sweeps.json.push_back({{"codec", c.name}, {"encoder", c.encoder}, {"pix_fmt", c.pixFmt}, {"sweep", sweep}});
@@ -346,7 +355,7 @@ struct VideoSetup {
 // motion, and each display's chart series.
 struct VideoReport {
   nlohmann::json results = nlohmann::json::array();
-  std::string table;
+  std::string table, truthTable;  // the second: against converged truth, when measured
   std::vector<std::pair<std::string, std::vector<imaging::ChartSeries>>> chartSeries;  // per display
 };
 
@@ -354,7 +363,8 @@ struct VideoReport {
 // carry the updater's probes to a subscriber's decoder.
 struct MotionProbes {
   MotionProbes(const VideoSetup& s, const VideoMotion& m)
-      : current(session::loadSceneOrThrow(m.scene, 0.0)),
+      : context(&s.context),
+        current(session::loadSceneOrThrow(m.scene, 0.0)),
         moves(m.rate > 0 && session::sceneMoves(m.scene, current)),
         grid(s.o.grid(current)),
         updater(s.context, current, grid, s.o.updater),
@@ -365,6 +375,7 @@ struct MotionProbes {
       streams[k].decoder = std::make_unique<StreamDecoder>(streams[k].encoder->layout());
     }
   }
+  renderer::VulkanContext* context;
   scene::Scene current;
   bool moves = false;
   ProbeGrid grid;
@@ -373,6 +384,11 @@ struct MotionProbes {
   std::vector<uint8_t> frame;  // the stream frame last written
   double lastSceneTime = 0.0, updaterSceneTime = 0.0;
   uint32_t recordedUpdates = 0;
+  // Converged truth (VideoBenchOptions::truthUpdates): the volume of the scene time `truthTime`,
+  // `truthFresh` until every display has taken it.
+  ProbeVolume truth;
+  double truthTime = -1.0;
+  bool truthFresh = false;
 };
 
 // One probe update, encoded by every stream and applied by its decoder as a subscriber's would be;
@@ -427,11 +443,38 @@ std::vector<DisplayFrames> makeDisplays(const VideoSetup& s, const MotionProbes&
                                                                             df.display->height, o.raster));
     df.sse.assign(p.streams.size(), 0.0);
     df.worstFramePsnr.assign(p.streams.size(), std::numeric_limits<double>::infinity());
+    if (o.truthUpdates > 0) {
+      df.truthRaster = std::make_unique<renderer::RasterRenderer>(s.context, p.current, df.display->width,
+                                                                  df.display->height, o.raster);
+      df.truthSse.assign(p.streams.size(), 0.0);
+    }
     df.width = df.display->width * static_cast<uint32_t>(df.spec.columns);
     df.height = df.display->height * static_cast<uint32_t>(df.spec.rows);
     df.reference.reserve(static_cast<size_t>(df.width) * df.height * 3 * o.frames);
   }
   return displays;
+}
+
+// Converged truth at the scene as it stands now: its probes traced from scratch for
+// truthUpdates updates, as the updater's own options say.
+void convergeTruth(const VideoBenchOptions& o, const VideoMotion& m, MotionProbes& p, double sceneTime) {
+  renderer::ProbeUpdater truth(*p.context, p.current, p.grid, o.updater);
+  for (uint32_t k = 0; k < o.truthUpdates; ++k) truth.update();
+  p.truth = truth.volume();
+  p.truthTime = sceneTime;
+  p.truthFresh = true;
+  sayProgress(o.progress, fmt::format("bench video: {}: converged truth at scene time {:.3f} s", m.name, sceneTime));
+}
+
+// The truth's picture of the frame, and every stream's and the float probes' error against it.
+void scoreAgainstTruth(const MotionProbes& p, DisplayFrames& df, bool moved, const std::vector<uint8_t>& floatRgb,
+                       const std::vector<std::vector<uint8_t>>& streamRgb, float exposure) {
+  if (moved) df.truthRaster->setShading(p.current);
+  if (p.truthFresh) df.truthRaster->setProbes(p.truth);
+  const std::vector<uint8_t> truth = toRgb8(renderQuilt(*df.truthRaster, df), exposure);
+  for (size_t k = 0; k < streamRgb.size(); ++k) df.truthSse[k] += squaredError(streamRgb[k].data(), truth.data(), truth.size());
+  df.floatTruthSse += squaredError(floatRgb.data(), truth.data(), truth.size());
+  df.truth.insert(df.truth.end(), truth.begin(), truth.end());
 }
 
 // One display's frame at display time `t`: the float probes' picture, kept for the video, and each
@@ -448,12 +491,14 @@ void renderFrame(const VideoBenchOptions& o, const MotionProbes& p, DisplayFrame
     for (size_t k = 0; k < p.streams.size(); ++k) df.streamRasters[k]->setProbes(p.streams[k].decoded);
   }
   const std::vector<uint8_t> ref = toRgb8(renderQuilt(*df.floatRaster, df), o.exposure);
+  std::vector<std::vector<uint8_t>> streamRgb;
   for (size_t k = 0; k < p.streams.size(); ++k) {
-    const std::vector<uint8_t> got = toRgb8(renderQuilt(*df.streamRasters[k], df), o.exposure);
-    const double sse = squaredError(got.data(), ref.data(), ref.size());
+    streamRgb.push_back(toRgb8(renderQuilt(*df.streamRasters[k], df), o.exposure));
+    const double sse = squaredError(streamRgb.back().data(), ref.data(), ref.size());
     df.sse[k] += sse;
     df.worstFramePsnr[k] = std::min(df.worstFramePsnr[k], psnrFromSse(sse, static_cast<double>(ref.size())));
   }
+  if (df.truthRaster) scoreAgainstTruth(p, df, moved, ref, streamRgb, o.exposure);
   df.reference.insert(df.reference.end(), ref.begin(), ref.end());
 }
 
@@ -477,7 +522,10 @@ void recordFrames(const VideoBenchOptions& o, const VideoMotion& m, MotionProbes
       updateProbes(p, true);
       ++p.recordedUpdates;
     }
+    if (o.truthUpdates > 0 && (p.truthTime < 0.0 || (p.moves && sceneTime != p.truthTime)))
+      convergeTruth(o, m, p, sceneTime);
     for (DisplayFrames& df : displays) renderFrame(o, p, df, t, moved, update);
+    p.truthFresh = false;
     if (f % 10 == 9 || f + 1 == o.frames)
       sayProgress(o.progress, fmt::format("bench video: {}: frame {}/{} rendered ({} probe updates)", m.name, f + 1,
                                           o.frames, p.recordedUpdates));
@@ -491,10 +539,14 @@ struct VideoAtPsnr {
   double bestBytes = std::numeric_limits<double>::infinity();
 };
 
-VideoAtPsnr videoAtPsnr(const VideoBenchOptions& o, const Sweeps& sweeps, double psnr) {
+// `truth`: the sweeps' PSNR against converged truth, not against the float-probe render.
+VideoAtPsnr videoAtPsnr(const VideoBenchOptions& o, const Sweeps& sweeps, double psnr, bool truth = false) {
   VideoAtPsnr v;
   for (size_t c = 0; c < o.codecs.size(); ++c) {
-    const AtPsnr at = bytesAtPsnr(sweeps.points[c], psnr);
+    std::vector<VideoPoint> points = sweeps.points[c];
+    if (truth)
+      for (VideoPoint& q : points) q.psnrDb = q.truthPsnrDb;
+    const AtPsnr at = bytesAtPsnr(points, psnr);
     v.perCodec.push_back({{"codec", o.codecs[c].name},
                           {"bytes_per_second", at.bytesPerSecond},
                           {"bound", at.bound.empty() ? nlohmann::json(nullptr) : nlohmann::json(at.bound)}});
@@ -503,19 +555,40 @@ VideoAtPsnr videoAtPsnr(const VideoBenchOptions& o, const Sweeps& sweeps, double
   return v;
 }
 
+// Stream `k`'s PSNR against converged truth and the video's bytes at that PSNR (also against
+// truth), into the JSON and the truth table's rows.
+void addTruthFigures(const VideoBenchOptions& o, const Sweeps& sweeps, const DisplayFrames& df, size_t k,
+                     double bytesPerSecond, VideoReport& report, nlohmann::json& results) {
+  const double psnr = psnrFromSse(df.truthSse[k], static_cast<double>(df.truth.size()));
+  const VideoAtPsnr v = videoAtPsnr(o, sweeps, psnr, /*truth=*/true);
+  const double ratio = bytesPerSecond > 0 ? v.bestBytes / bytesPerSecond : std::numeric_limits<double>::infinity();
+  results.push_back({{"psnr_db", dbJson(psnr)},
+                     {"video_at_equal_psnr", v.perCodec},
+                     {"best_video", v.bestName},
+                     {"best_video_bytes_per_second", v.bestBytes},
+                     {"best_video_bound", v.bestBound.empty() ? nlohmann::json(nullptr) : nlohmann::json(v.bestBound)},
+                     {"video_to_probe_bytes", std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr)}});
+  const char* mark = v.bestBound == "at_least" ? "≥" : (v.bestBound == "at_most" ? "≤" : "");
+  report.truthTable += fmt::format("{:<10} {:<8} {:>10.0f} {:>7} {:>9} {:>3}{:>7.0f} {:>3}{:>5}\n", df.display->name,
+                                   o.streams[k].name, bytesPerSecond,
+                                   std::isfinite(psnr) ? fmt::format("{:.2f}", psnr) : std::string("same"), v.bestName,
+                                   mark, v.bestBytes, mark, std::isfinite(ratio) ? fmt::format("{:.1f}", ratio) : "-");
+}
+
 // Display `i`'s figures for a motion: its video sweeps, then per stream its bytes and PSNR against
 // the video's bytes at that PSNR, into the JSON, the table and the display's chart.
 void reportDisplay(const VideoSetup& s, const VideoMotion& m, const MotionProbes& p, size_t i, DisplayFrames& df,
                    VideoReport& report) {
   const VideoBenchOptions& o = s.o;
   const Sweeps sweeps = sweepVideo(o, m, df, s.work, report.chartSeries[i].second);
-  nlohmann::json streamResults = nlohmann::json::array();
+  nlohmann::json streamResults = nlohmann::json::array(), streamResultsTruth = nlohmann::json::array();
   for (size_t k = 0; k < p.streams.size(); ++k) {
     const StreamState& st = p.streams[k];
     const double bytesPerSecond = static_cast<double>(st.bytes) / s.seconds;
     const double psnr = psnrFromSse(df.sse[k], static_cast<double>(df.reference.size()));
     const VideoAtPsnr v = videoAtPsnr(o, sweeps, psnr);
     const double ratio = bytesPerSecond > 0 ? v.bestBytes / bytesPerSecond : std::numeric_limits<double>::infinity();
+    if (!df.truth.empty()) addTruthFigures(o, sweeps, df, k, bytesPerSecond, report, streamResultsTruth);
     streamResults.push_back({{"stream", st.config->name},
                              {"representation", representationName(st.config->repr)},
                              {"deadzone", st.config->encoder.deadzone},
@@ -549,6 +622,11 @@ void reportDisplay(const VideoSetup& s, const VideoMotion& m, const MotionProbes
                             {"probe_updates", p.recordedUpdates},
                             {"video", sweeps.json},
                             {"streams", streamResults}});
+  if (!df.truth.empty()) {
+    const double n = static_cast<double>(df.truth.size());
+    report.results.back()["against_converged_truth"] = {{"float_probes_psnr_db", dbJson(psnrFromSse(df.floatTruthSse, n))},
+                                                       {"streams", streamResultsTruth}};
+  }
 }
 
 // One motion from start to end: the probes warmed up, the frames recorded, then every display's
@@ -583,6 +661,15 @@ VideoBenchResult videoResult(const VideoSetup& s, const VideoReport& report) {
             {"results", report.results}};
   if (o.keepFiles) r.json["kept_files"] = s.work;  // the run's own folder in --work-dir
   r.table = "bench video: bytes per second at equal PSNR against the float-probe render (≤/≥: beyond the CRF sweep)\n" + report.table;
+  if (o.truthUpdates > 0) {
+    r.json["truth"] = fmt::format("each recorded moment's probes traced from scratch for {} updates of {} samples per "
+                                  "probe, through the same raster",
+                                  o.truthUpdates, o.updater.samplesPerProbe);
+    r.table += "\nagainst converged truth (the motion's rows in the same order)\n" +
+               fmt::format("{:<10} {:<8} {:>10} {:>7} {:>9} {:>10} {:>8}\n", "display", "stream", "probes B/s", "dB",
+                           "video", "video B/s", "ratio") +
+               report.truthTable;
+  }
   for (const auto& [name, series] : report.chartSeries) {
     imaging::ChartSpec spec;
     spec.title = "Probe stream against video: " + name;

@@ -83,6 +83,10 @@ struct VideoBenchOptions {
   // The camera of every display that follows a head turns as this head turned
   // (session/head_trace.h), from its start, at the display clock; none: the cameras are still.
   std::shared_ptr<const session::HeadTrace> headTrace;
+  // Converged truth: every recorded moment's probes traced again from scratch for this many
+  // updates, drawn through the same raster, and the streams and the videos scored against that
+  // picture too (beside the float-probe one); 0: off.
+  uint32_t truthUpdates = 0;
   std::string preset = "medium";  // x265's preset; AV1 (libaom, realtime) runs at cpu-used 6
   float exposure = 1.0f;
   std::string ffmpeg = "ffmpeg";

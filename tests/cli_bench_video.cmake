@@ -7,6 +7,7 @@ file(WRITE ${WORK}/work/mine.txt "a file of the user's in the work folder")
 execute_process(COMMAND ${PROBECAST} bench video --scene builtin:cornell --grid 4,2,4 --spp 8 --motions still=0,fast=0.5
                         --displays stereo=stereo@32x32 --codecs x265-420,av1-444 --x265-crf 8,40 --av1-crf 10,55
                         --streams zh3,l2:0 --frames 6 --warmup 2 --gop 3 --preset ultrafast --work-dir ${WORK}/work
+                        --truth-updates 4
                         --json ${WORK}/video.json --chart ${WORK}/video.svg
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
 if(NOT rc EQUAL 0)
@@ -67,6 +68,19 @@ foreach(i 0 1)
       message(FATAL_ERROR "${motion} codec ${c}: the lower CRF gave ${b0} B/s at ${p0} dB, the higher ${b1} at ${p1}")
     endif()
   endforeach()
+endforeach()
+# Against converged truth too: every stream, the float probes and each video point scored.
+if(NOT out MATCHES "against converged truth")
+  message(FATAL_ERROR "no table against converged truth: ${out}")
+endif()
+foreach(i 0 1)
+  string(JSON floatdb GET "${json}" results ${i} against_converged_truth float_probes_psnr_db)
+  string(JSON truth0 GET "${json}" results ${i} against_converged_truth streams 0 psnr_db)
+  string(JSON tbest GET "${json}" results ${i} against_converged_truth streams 1 best_video)
+  string(JSON tpoint GET "${json}" results ${i} video 0 sweep 0 psnr_db_vs_truth)
+  if(NOT floatdb GREATER 15 OR NOT truth0 GREATER 15 OR NOT tbest MATCHES "^(x265-420|av1-444)$" OR NOT tpoint GREATER 15)
+    message(FATAL_ERROR "result ${i} against truth: float ${floatdb} dB, zh3 ${truth0} dB, best '${tbest}', video ${tpoint} dB")
+  endif()
 endforeach()
 string(JSON command GET "${json}" command)
 if(NOT command MATCHES "bench video")
