@@ -86,6 +86,45 @@ void writeScreenshot(const std::string& base, const renderer::Window& window, co
     fmt::print("window: screenshot {}.png (as presented) and {}.exr (linear)\n", base, base);
 }
 
+// The window for `wanted` pixels: that size, or, when it is larger than the screen and the window
+// is not full screen, 1/k of it each side (k the smallest whole factor that fits), the picture
+// shown box-averaged by k.
+struct WindowFit {
+  renderer::WindowOptions options;
+  uint32_t shrink = 1;
+};
+WindowFit fitWindow(uint32_t wantedW, uint32_t wantedH, bool fullscreen) {
+  WindowFit f;
+  f.options.width = wantedW;
+  f.options.height = wantedH;
+  f.options.fullscreen = fullscreen;
+  const glm::uvec2 screen = fullscreen ? glm::uvec2(0) : renderer::Window::screenWorkArea();
+  if (screen.x == 0 || screen.y == 0) return f;
+  while ((wantedW + f.shrink - 1) / f.shrink > screen.x || (wantedH + f.shrink - 1) / f.shrink > screen.y) ++f.shrink;
+  f.options.width = wantedW / f.shrink;
+  f.options.height = wantedH / f.shrink;
+  if (f.shrink > 1)
+    fmt::print("window: {}x{} is larger than the screen ({}x{}): shown at 1/{} (--fullscreen shows it whole)\n", wantedW,
+               wantedH, screen.x, screen.y, f.shrink);
+  return f;
+}
+
+// `image` box-averaged by k each side (the last partial rows and columns dropped).
+renderer::Image shrink(const renderer::Image& image, uint32_t k) {
+  if (k <= 1) return image;
+  renderer::Image out;
+  out.width = image.width / k;
+  out.height = image.height / k;
+  out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 0.0f);
+  const float w = 1.0f / static_cast<float>(k * k);
+  for (uint32_t y = 0; y < out.height * k; ++y)
+    for (uint32_t x = 0; x < out.width * k; ++x)
+      for (uint32_t c = 0; c < 3; ++c)
+        out.rgb[(static_cast<size_t>(y / k) * out.width + x / k) * 3 + c] +=
+            w * image.rgb[(static_cast<size_t>(y) * image.width + x) * 3 + c];
+  return out;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
@@ -135,10 +174,10 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
                                const renderer::ViewSetOptions& viewSetOptions, uint32_t viewWidth,
                                uint32_t viewHeight, float sceneSize, FrameSource& source, const std::string& outDir,
                                float exposure, imaging::ToneMap toneMap) {
-  renderer::WindowOptions wo;
-  wo.width = source.displayWidth ? source.displayWidth : viewWidth * static_cast<uint32_t>(spec.columns);
-  wo.height = source.displayHeight ? source.displayHeight : viewHeight * static_cast<uint32_t>(spec.rows);
-  wo.fullscreen = o.fullscreen;
+  const WindowFit fit =
+      fitWindow(source.displayWidth ? source.displayWidth : viewWidth * static_cast<uint32_t>(spec.columns),
+                source.displayHeight ? source.displayHeight : viewHeight * static_cast<uint32_t>(spec.rows), o.fullscreen);
+  const renderer::WindowOptions& wo = fit.options;
   renderer::Window window(context, wo);
   fmt::print("window: {}x{} on {}, present mode {}\n", window.width(), window.height(), context.deviceName(),
              window.presentMode());
@@ -167,8 +206,9 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
           viewSetOptions);
     const bool drawn = source.render(views, moved, images);
     if (drawn) {
-      shown = source.compose ? source.compose(images, views)
-                             : renderer::composeQuilt(images, views, spec.columns, spec.rows);
+      shown = shrink(source.compose ? source.compose(images, views)
+                                    : renderer::composeQuilt(images, views, spec.columns, spec.rows),
+                     fit.shrink);
     } else {
       shown.width = wo.width;
       shown.height = wo.height;

@@ -10,6 +10,7 @@
 set -euo pipefail
 probecast=$1
 work=$2
+calibration=$3
 rm -rf "$work"
 mkdir -p "$work"
 pids=()
@@ -75,6 +76,13 @@ rc=$?
 set -e
 [ "$rc" -ne 0 ] && grep -q "builtin:nobody: no such trace" "$work/bad-trace.log" || { cat "$work/bad-trace.log"; exit 1; }
 [ ! -e "$work/bad-trace" ]
+
+# A Looking Glass panel's window on a smaller screen (1024x768 here) is shown at 1/3, not larger
+# than the screen; --fullscreen would show it whole on the panel.
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --looking-glass "$calibration" --size 24x32 \
+  --supersample 1 --window --window-seconds 2 --out "$work/lg-window" >"$work/lg-window.log"
+grep -q "window: 1536x2048 is larger than the screen (1024x768): shown at 1/3" "$work/lg-window.log" &&
+  grep -q "window: 512x682 on" "$work/lg-window.log" || { cat "$work/lg-window.log"; exit 1; }
 
 # A window without --views opens one view of --size (not view's default set of 25).
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --size 160x96 --supersample 1 --window \

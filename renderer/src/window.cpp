@@ -166,6 +166,21 @@ std::vector<std::string> Window::instanceExtensions() {
   return std::vector<std::string>(names, names + n);
 }
 
+glm::uvec2 Window::screenWorkArea() {
+  startGlfw();
+  GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+  if (!monitor) return {0, 0};
+  int x = 0, y = 0, w = 0, h = 0;
+  glfwGetMonitorWorkarea(monitor, &x, &y, &w, &h);
+  if (w <= 0 || h <= 0) {  // some window systems report no work area: the mode, then
+    const GLFWvidmode* mode = glfwGetVideoMode(monitor);
+    if (!mode) return {0, 0};
+    w = mode->width;
+    h = mode->height;
+  }
+  return {static_cast<uint32_t>(w), static_cast<uint32_t>(h)};
+}
+
 Window::Window(VulkanContext& context, const WindowOptions& options) : impl_(std::make_unique<Impl>()) {
   startGlfw();
   Impl& w = *impl_;

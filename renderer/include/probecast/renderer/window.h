@@ -42,6 +42,9 @@ class Window {
   // presenting needs. Throws std::runtime_error naming the reason when no window can be opened
   // (no display: DISPLAY unset or unreachable; no Vulkan loader support).
   static std::vector<std::string> instanceExtensions();
+  // The primary monitor's work area (the screen less task bars), pixels; {0, 0} when the window
+  // system reports none. Throws as instanceExtensions() does when there is no window system.
+  static glm::uvec2 screenWorkArea();
 
   // Opens the window and its swapchain. Throws std::runtime_error when the context was not made
   // for presenting, or its queue cannot present to this window.
