@@ -98,7 +98,7 @@ void addBenchPanel(CLI::App* bench) {
   auto pt = std::make_shared<TracingOptions>();
   struct PanelCli {
     std::string json, calibration;
-    std::vector<std::string> ways{"msaa4", "msaa1", "half", "multiview"};
+    std::vector<std::string> ways{"msaa4", "msaa1", "half", "narrow", "multiview"};
     std::vector<uint32_t> size;
     bench::PanelBenchOptions bench;
     AreaLightCli areaLights{"off"};
@@ -108,7 +108,7 @@ void addBenchPanel(CLI::App* bench) {
   cmd->add_option("--looking-glass", po->calibration, "the display's calibration (visual.json)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--ways", po->ways, "ways of drawing the views: msaa4 (the viewers' default), msaa1, half, multiview, ss2")
+  cmd->add_option("--ways", po->ways, "ways of drawing the views: msaa4 (the viewers' default), msaa1, half, narrow (half the width), multiview, ss2")
       ->delimiter(',')
       ->capture_default_str();
   addSizeOption(cmd, po->size, "size of each view WxH (default: the display model's)", 8, 4096);

@@ -34,10 +34,11 @@ struct PanelFrame {
   renderer::Image panel;
 };
 
-// The views of the calibration's model at `scale` of the view size, across its view cone.
-std::vector<renderer::ViewInfo> panelViews(const PanelSetup& s, uint32_t w, uint32_t h) {
+// The views of the calibration's model across its view cone, at the model's view aspect whatever
+// size they are drawn at (a narrow view has wide pixels, as the panel samples it).
+std::vector<renderer::ViewInfo> panelViews(const PanelSetup& s) {
   const auto& cal = s.o.calibration;
-  renderer::ViewSetOptions vso = session::viewSetOptions(s.o.scene, w, h);
+  renderer::ViewSetOptions vso = session::viewSetOptions(s.o.scene, s.width, s.height);
   vso.lfConeDeg = cal.viewCone;
   const renderer::ViewSetSpec spec{renderer::ViewSetSpec::Kind::HorizontalLightField, cal.quiltColumns, cal.quiltRows};
   return renderer::makeViewSet(renderer::CameraView::fromScene(s.o.scene), spec, vso);
@@ -48,8 +49,8 @@ PanelFrame drawWay(const PanelSetup& s, const PanelWay& way) {
   const auto& cal = s.o.calibration;
   PanelFrame f;
   f.way = way;
-  f.width = std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(s.width * way.viewScale)));
-  f.height = std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(s.height * way.viewScale)));
+  f.width = std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(s.width * way.viewScaleX)));
+  f.height = std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(s.height * way.viewScaleY)));
   renderer::RasterOptions ro = s.o.raster;
   ro.environment = s.o.updater.environment;
   ro.samplesPerSide = way.samplesPerSide;
@@ -58,7 +59,7 @@ PanelFrame drawWay(const PanelSetup& s, const PanelWay& way) {
   renderer::checkRasterSize(f.width, f.height, ro);
   renderer::RasterRenderer raster(s.context, s.o.scene, f.width, f.height, ro);
   raster.setProbes(s.volume);
-  const std::vector<renderer::ViewInfo> views = panelViews(s, f.width, f.height);
+  const std::vector<renderer::ViewInfo> views = panelViews(s);
   std::vector<double> viewsMs, composeMs, interleaveMs;
   for (uint32_t k = 0; k <= s.o.repeats; ++k) {  // repeats 0: one frame, timed as it is
     const std::vector<renderer::Image> images = raster.renderViews(views);
@@ -134,10 +135,11 @@ bool panelWay(const std::string& name, PanelWay& out, std::string& error) {
   out.name = name;
   if (name == "msaa4") return true;
   if (name == "msaa1") return out.msaa = 1, true;
-  if (name == "half") return out.viewScale = 0.5, true;
+  if (name == "half") return out.viewScaleX = out.viewScaleY = 0.5, true;
+  if (name == "narrow") return out.viewScaleX = 0.5, true;
   if (name == "multiview") return out.passes = renderer::ViewPasses::Multiview, true;
   if (name == "ss2") return out.samplesPerSide = 2, true;
-  error = "unknown way \"" + name + "\" (msaa4, msaa1, half, multiview, ss2)";
+  error = "unknown way \"" + name + "\" (msaa4, msaa1, half, narrow, multiview, ss2)";
   return false;
 }
 

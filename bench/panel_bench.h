@@ -21,13 +21,14 @@ struct PanelWay {
   std::string name;
   uint32_t samplesPerSide = 1;
   uint32_t msaa = 4;
-  double viewScale = 1.0;  // of the model's view size (each side)
+  double viewScaleX = 1.0, viewScaleY = 1.0;  // of the model's view size
   renderer::ViewPasses passes = renderer::ViewPasses::PerView;
 };
 
 // The named ways --ways chooses from: msaa4 (the viewers' default), msaa1, half (views of half
-// the size each side, 4× MSAA), multiview (4× MSAA, chunks of views per pass), ss2 (2 × 2
-// supersampling with 4× MSAA); false with a message naming the known ones.
+// the size each side, 4× MSAA), narrow (half the width, the whole height: a lenticule shows a
+// view only a few hundred columns across), multiview (4× MSAA, chunks of views per pass), ss2
+// (2 × 2 supersampling with 4× MSAA); false with a message naming the known ones.
 bool panelWay(const std::string& name, PanelWay& out, std::string& error);
 
 struct PanelBenchOptions {
