@@ -227,7 +227,8 @@ void addViewCommand(CLI::App& app) {
     std::optional<renderer::LookingGlassCalibration> lg;
     if (!o->lookingGlass.empty()) lg = lookingGlassViewSet(*o, spec);
     renderer::ViewSetOptions vso = session::viewSetOptions(s, o->size[0], o->size[1]);
-    if (lg) vso.lfConeDeg = lg->viewCone;
+    if (lg)  // the panel's views have its aspect, whatever --size draws them at (narrow views: wide pixels)
+      vso.lfConeDeg = lg->viewCone, vso.aspect = static_cast<float>(lg->screenW) / static_cast<float>(lg->screenH);
     const std::vector<renderer::ViewInfo> views = renderer::makeViewSet(renderer::CameraView::fromScene(s), spec, vso);
     // Only live probes are traced here: every other viewer rasterises, on any Vulkan 1.3 device.
     renderer::ContextOptions co =

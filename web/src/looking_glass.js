@@ -259,7 +259,8 @@ export class LookingGlassOutput {
 
   // Renders the view set around `base` into the quilt, then the panel image onto the canvas.
   render(renderer, scene, base, distance, exposure) {
-    const cameras = viewCameras(base, this.views, this.tile[0] / this.tile[1], distance, this.cal.viewCone);
+    // The panel's aspect whatever size the views are drawn at (narrow views have wide pixels), as natively.
+    const cameras = viewCameras(base, this.views, this.cal.screenW / this.cal.screenH, distance, this.cal.viewCone);
     const toneMapping = renderer.toneMapping;
     renderer.toneMapping = THREE.NoToneMapping;  // the quilt holds linear light; the pass applies the curve
     // three.js takes a target's viewport and scissor when the target is set: set again per view.
