@@ -164,9 +164,9 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--looking-glass", o->lookingGlass,
                   "a Looking Glass display's calibration (visual.json): render its model's view set (Portrait 8x6 "
                   "views 560 pixels high, Go 11x6 of 682, 16\" and 32\" in both orientations...; unknown serials "
-                  "8x6 on portrait panels, 5x9 on others, 560 high) at the panel's aspect unless --size, across its "
-                  "view cone, and interleave it for the panel: looking_glass.png/.exr beside the quilt, or the "
-                  "window (with --fullscreen on the display)")
+                  "8x6 on portrait panels, 5x9 on others, 560 high; --size sets their pixels, the views keep the "
+                  "panel's aspect) across its view cone, and interleave it for the panel: looking_glass.png/.exr "
+                  "beside the quilt, or the window (with --fullscreen on the display)")
       ->check(CLI::ExistingFile)
       ->excludes(o->viewsOption);
   cmd->add_option("--supersample", o->supersample,

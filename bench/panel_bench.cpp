@@ -34,12 +34,13 @@ struct PanelFrame {
   renderer::Image panel;
 };
 
-// The views of the calibration's model across its view cone, at the model's view aspect whatever
-// size they are drawn at (a narrow view has wide pixels, as the panel samples it).
+// The views of the calibration's model across its view cone, at the panel's aspect whatever size
+// they are drawn at (a narrow view has wide pixels, as the panel samples it).
 std::vector<renderer::ViewInfo> panelViews(const PanelSetup& s) {
   const auto& cal = s.o.calibration;
   renderer::ViewSetOptions vso = session::viewSetOptions(s.o.scene, s.width, s.height);
   vso.lfConeDeg = cal.viewCone;
+  vso.aspect = static_cast<float>(cal.screenW) / static_cast<float>(cal.screenH);  // as view --looking-glass
   const renderer::ViewSetSpec spec{renderer::ViewSetSpec::Kind::HorizontalLightField, cal.quiltColumns, cal.quiltRows};
   return renderer::makeViewSet(renderer::CameraView::fromScene(s.o.scene), spec, vso);
 }

@@ -12,7 +12,7 @@ mkdir -p "$work"
 "$probecast" bake --scene builtin:cornell --grid 4,4,4 --spp 16 --updates 1 --out "$work/p.pcpv" >/dev/null
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" --looking-glass "$cal" --size 24x32 --supersample 1 \
   --out "$work/lg" | tee "$work/lg.log"
-grep -q "portrait display example-portrait (1536x2048): 48 views (8x6 quilt) of 24x32 across 40 degrees" "$work/lg.log"
+grep -q "Looking Glass Portrait LKG-P-example (1536x2048): 48 views (8x6 quilt) of 24x32 across 40 degrees" "$work/lg.log"
 /usr/bin/python3 - "$work/lg/looking_glass.png" "$work/lg/quilt.png" <<'PY'
 import sys
 import matplotlib.image as mpimg

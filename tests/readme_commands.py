@@ -13,6 +13,7 @@ Python block (CI's `scripts/dev.sh python` installs and tests the same module).
 Usage: readme_commands.py REPOSITORY WORK_DIR
 """
 import os
+import random
 import re
 import shutil
 import signal
@@ -58,24 +59,33 @@ def port_of(command):
     return int(m.group(1)) if m else None
 
 
-def wait_port(port, what, seconds=60):
+def wait_port(port, process, what, log, seconds=60):
     end = time.time() + seconds
     while time.time() < end:
+        if process.poll() is not None:
+            fail(f"{what}: stopped ({process.returncode}) before listening on port {port}:\n{open(log).read()[-2000:]}")
         with socket.socket() as s:
             if s.connect_ex(("127.0.0.1", port)) == 0:
                 return
         time.sleep(0.2)
-    fail(f"{what}: nothing listens on port {port} after {seconds} s")
+    fail(f"{what}: nothing listens on port {port} after {seconds} s:\n{open(log).read()[-2000:]}")
 
 
 def start_display():
-    read, write = os.pipe()
-    xvfb = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
-                            pass_fds=(write,), stderr=subprocess.DEVNULL)
-    os.close(write)
-    number = os.read(read, 16).decode().strip()
-    os.close(read)
-    return xvfb, ":" + number
+    """An X server on a display number of its own (tests running beside this one start theirs)."""
+    for _ in range(20):
+        number = random.randint(100, 999)
+        if os.path.exists(f"/tmp/.X{number}-lock"):
+            continue
+        xvfb = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        end = time.time() + 10
+        while xvfb.poll() is None and time.time() < end and not os.path.exists(f"/tmp/.X11-unix/X{number}"):
+            time.sleep(0.1)
+        if xvfb.poll() is None and os.path.exists(f"/tmp/.X11-unix/X{number}"):
+            return xvfb, f":{number}"
+        xvfb.kill()
+    fail("no X server could be started (Xvfb)")
 
 
 def stop(processes):
@@ -101,7 +111,7 @@ def start_background(command, env, log, background):
                              start_new_session=True)
     background.append((p, command, log))
     if port:
-        wait_port(port, command)
+        wait_port(port, p, command, log)
     elif "--window" in command:
         end = time.time() + 90
         while "frames presented" not in open(log).read():
@@ -122,8 +132,11 @@ def run_block(commands, env, index, background):
             start_background(command, env, log, background)
             continue
         with open(log, "w") as out:
-            rc = subprocess.run(["bash", "-c", command], cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT,
-                                timeout=600).returncode
+            try:
+                rc = subprocess.run(["bash", "-c", command], cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT,
+                                    timeout=150).returncode
+            except subprocess.TimeoutExpired:
+                fail(f"still running after 150 s: {command}\n{open(log).read()[-2000:]}")
         if rc != 0:
             fail(f"exit {rc}: {command}\n{open(log).read()[-3000:]}")
     for p, command, log in background:

@@ -44,6 +44,14 @@ function wholeField(root, name, required, fallback, low, high, unit) {
   return d;
 }
 
+// Informational text (the serial): taken as written, a {"value": ...} wrapper or not; never refused.
+function textField(root, name) {
+  if (!Object.hasOwn(root, name)) return '';
+  let v = root[name];
+  if (v !== null && typeof v === 'object' && !Array.isArray(v) && Object.hasOwn(v, 'value')) v = v.value;
+  return typeof v === 'string' ? v : JSON.stringify(v);
+}
+
 function cellsField(root) {
   const v = fieldValue(root, 'subpixelCells');
   if (v === undefined || v === null) return [];
@@ -91,10 +99,11 @@ export function parseCalibration(text) {
     center: numberField(root, 'center', true), dpi: numberField(root, 'DPI', true),
     screenW: wholeField(root, 'screenW', true, 0, 1, MAX_SCREEN_SIDE, ' of pixels'),
     screenH: wholeField(root, 'screenH', true, 0, 1, MAX_SCREEN_SIDE, ' of pixels'),
-    viewCone: numberField(root, 'viewCone', false, 40), invView: flagField(root, 'invView', true),
+    viewCone: numberField(root, 'viewCone', false, 40), verticalAngle: numberField(root, 'verticalAngle', false, 0),
+    invView: flagField(root, 'invView', true),
     flipImageX: flagField(root, 'flipImageX', false), flipImageY: flagField(root, 'flipImageY', false),
     flipSubp: flagField(root, 'flipSubp', false),
-    serial: typeof fieldValue(root, 'serial') === 'string' ? fieldValue(root, 'serial') : '',
+    serial: textField(root, 'serial'),
     cells: cellsField(root), cellPatternMode: wholeField(root, 'CellPatternMode', false, 0, 0, MAX_PATTERN, ''),
   };
   if (c.dpi <= 0 || c.dpi > MAX_PER_INCH) refuse(`field "DPI" must be > 0 and at most ${MAX_PER_INCH} (got ${c.dpi})`);
@@ -226,7 +235,9 @@ void main() {
 }`;
 
 export class LookingGlassOutput {
-  constructor(calibration, viewSize) {
+  // `maxSide`: the largest texture and render buffer side the browser allows; a quilt larger than
+  // that is refused by name (smaller views, lkgview=, fit it).
+  constructor(calibration, viewSize, maxSide) {
     this.cal = calibration;
     const m = calibration.model;
     this.columns = m.columns;
@@ -234,6 +245,12 @@ export class LookingGlassOutput {
     this.views = m.columns * m.rows;
     const [w, h] = viewSize || [Math.max(1, Math.round(m.viewHeight * calibration.screenW / calibration.screenH)), m.viewHeight];
     this.tile = [w, h];
+    if (w * m.columns > maxSide || h * m.rows > maxSide) {
+      const fit = Math.floor(Math.min(maxSide / (w * m.columns), maxSide / (h * m.rows)) * h);
+      throw new Error(`the Looking Glass quilt of ${this.views} views of ${w}x${h} (${w * m.columns}x${h * m.rows}) is ` +
+                      `larger than this browser allows (${maxSide} a side): give lkgview= smaller views, at most ` +
+                      `${Math.max(1, Math.floor(fit * w / h))}x${Math.max(1, fit)}`);
+    }
     this.target = new THREE.WebGLRenderTarget(w * m.columns, h * m.rows, { type: THREE.HalfFloatType, samples: 4,
       minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: true });
     this.target.scissorTest = true;

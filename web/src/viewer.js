@@ -181,7 +181,9 @@ async function setupLookingGlass() {
     if (!m || +m[1] < 1 || +m[2] < 1 || +m[1] > 8192 || +m[2] > 8192) throw new Error('lkgview= takes WxH, each 1..8192');
     viewSize = [+m[1], +m[2]];
   }
-  lookingGlass = new LookingGlassOutput(cal, viewSize);
+  const gl = renderer.getContext();
+  const maxSide = Math.min(renderer.capabilities.maxTextureSize, gl.getParameter(gl.MAX_RENDERBUFFER_SIZE));
+  lookingGlass = new LookingGlassOutput(cal, viewSize, maxSide);
   state.lookingGlass = { model: cal.model.name, serial: cal.serial, views: lookingGlass.views, columns: lookingGlass.columns,
                          rows: lookingGlass.rows, view: lookingGlass.tile, panel: [cal.screenW, cal.screenH], cells: cal.cells.length };
 }

@@ -23,6 +23,16 @@ test('calibrations parse, with their subpixel cells and their model', () => {
   assert.deepEqual([p.model.columns, p.model.rows, p.model.viewHeight], [8, 6, 560]);
   assert.deepEqual(lookingGlassModel('LKG-E0001', 1440, 2560), { name: 'Looking Glass Go', columns: 11, rows: 6, viewHeight: 682 });
   assert.equal(lookingGlassModel('custom', 1920, 1080).columns, 5);
+  // The serial is informational: an object without "value" is kept as written, not refused.
+  const odd = JSON.parse(portrait);
+  odd.serial = { note: 'x' };
+  assert.equal(parseCalibration(JSON.stringify(odd)).serial, '{"note":"x"}');
+});
+
+test('a quilt larger than the browser allows is refused by name, with views that fit', async () => {
+  const { LookingGlassOutput } = await import('../src/looking_glass.js');
+  const c = parseCalibration(spatial);  // 7x7 views of 1524x857: 10668x5999
+  assert.throws(() => new LookingGlassOutput(c, null, 8192), /larger than this browser allows \(8192 a side\): give lkgview= smaller views, at most 1170x658/);
 });
 
 test('bad calibrations are refused by name', () => {
@@ -33,6 +43,7 @@ test('bad calibrations are refused by name', () => {
     [with_('screenW', 0), /"screenW" must be a whole number of pixels in 1..16384/], [with_('screenH', 1e9), /"screenH"/],
     [with_('slope', 0), /"slope" must have \|slope\|/], [with_('pitch', 1e300), /"pitch" must be > 0 and at most/],
     [with_('invView', 2), /"invView" must be 0 or 1/], [with_('viewCone', 0), /"viewCone"/],
+    [with_('verticalAngle', 'x'), /"verticalAngle" must be a finite number/],
     [with_('CellPatternMode', 5), /"CellPatternMode" must be a whole number in 0..4/],
     [with_('subpixelCells', 'x'), /"subpixelCells" must be an array/], [with_('subpixelCells', [1]), /subpixelCells\[0\]: expected an object/],
     [with_('subpixelCells', [{ ROffsetX: 0 }]), /subpixelCells\[0\]: missing required field "ROffsetY"/],
