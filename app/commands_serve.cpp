@@ -1,18 +1,13 @@
-// `probecast serve` (live from the updater, or a baked probe file) and `probecast subscribe`.
+// `probecast serve`: stream probes over gRPC, traced live by the updater or read from a baked
+// probe file, and optionally published to NATS for edges (`subscribe` is commands_subscribe.cpp).
 #include <atomic>
-#include <chrono>
-#include <cmath>
 #include <csignal>
-#include <filesystem>
-#include <fstream>
-#include <thread>
+#include <cstdio>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "probecast/codec/probe_file.h"
-#include "probecast/service/client.h"
 #include "probecast/service/server.h"
 #include "probecast/session/probe_producer.h"
 #include "probecast/session/scene_state.h"
@@ -133,243 +128,126 @@ std::unique_ptr<session::ProbeProducer> makeProducer(const ServeOptions& o, Prob
   return producer;
 }
 
+// --repr, --brick, --deadzone, the noise rule, --confirmations and --error-bound: what the stream
+// sends of each update.
+void addServeStreamOptions(CLI::App* serve, ServeOptions& o) {
+  addRepresentationOption(serve, o.repr, "l1, zh3h, zh3, l2 or fp16");
+  serve->add_option("--brick", o.brick, "probes per brick edge")->check(CLI::Range(1, 8));
+  serve->add_option("--deadzone", o.deadzone, "changes up to this many quantisation steps are not sent")
+      ->check(CLI::Range(0, 127));
+  o.noise.add(serve);
+  serve->add_option("--confirmations", o.confirmations,
+                    "with --noise-scale: a probe past the noise threshold is re-sent once it has stayed past it this "
+                    "many updates more (past 4x the threshold at once; 0 = at once; bench adaptive measures 1)")
+      ->check(CLI::Range(0u, 1000u));
+  serve->add_option("--error-bound", o.errorBound,
+                    "send each brick in the cheapest of l1, zh3, l2 (up to --repr) that keeps its probes within "
+                    "this relative irradiance error (0 = every brick as --repr)")
+      ->check(CLI::Range(0.0f, 10.0f));
+}
+
+// The gRPC server's options, then --publish and the bus options that need it.
+void addServeNetworkOptions(CLI::App* serve, ServeOptions& o) {
+  o.server.add(serve);
+  CLI::Option* publish =
+      serve->add_option("--publish", o.publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
+  serve->add_option("--stream", o.stream, "the volume's name on the bus (letters, digits, - and _)")->needs(publish);
+  o.bus.add(serve, publish);
+}
+
+// --hz, --seconds, --hold-after and --animate: when updates are made, and for how long.
+void addServePacingOptions(CLI::App* serve, ServeOptions& o) {
+  serve->add_option("--hz", o.hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
+  serve->add_option("--seconds", o.seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
+  serve->add_option("--hold-after", o.holdAfter,
+                    "publish no new lighting after this many seconds (0 = never): subscribers are still served and "
+                    "settle on the last volume, to be compared bit for bit")
+      ->check(CLI::Range(0.0, 1e9));
+  o.animateOption =
+      serve->add_option("--animate", o.animate,
+                        "live: scene seconds per second (the scene clock's rate; 0: still); 0.05 by default, 0 when "
+                        "--time names a moment")
+          ->check(CLI::Range(0.0, 10.0));
+}
+
+// The line a serve starts with: what it serves, where, and how.
+void printServing(const ServeOptions& o, session::ProbeProducer& producer, const service::ServerConfig& sc,
+                  const service::HubConfig& hc, const std::string& what, int port) {
+  const AreaLightRule rule = producer.hub().volume().areaLights;
+  fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}, client area lights {}\n", what, port,
+             describeSecurity(sc, "serve", port), representationName(hc.layout.repr), hc.layout.grid[0],
+             hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o.probes.empty() ? "live" : "from file",
+             rule.on() ? fmt::format("on ({})", rule.minPowerFraction) : "off");
+  if (sc.scene) fmt::print("serve: scene {}\n", sc.scene->describe());
+  std::fflush(stdout);
+}
+
+void runServe(ServeOptions& o) {
+  // --time alone traces that moment: the clock runs only when --animate says so.
+  if (o.tracing.scene.tOption->count() > 0 && o.animateOption->count() == 0) o.animate = 0.0;
+  service::ServerConfig sc = o.server.config();
+  service::BusConfig bus;
+  bus.url = o.publish;
+  bus.stream = o.stream;
+  if (!o.publish.empty()) o.bus.apply(bus);
+  ProbeVolume file;
+  std::unique_ptr<renderer::VulkanContext> context;
+  service::HubConfig hc;
+  std::string what;
+  const std::unique_ptr<session::ProbeProducer> producer = makeProducer(o, file, context, hc, what, sc.scene);
+  const int port = producer->serve(sc);
+  if (!o.publish.empty()) {
+    producer->publishTo(bus);
+    fmt::print("serve: publishing to {} as stream {} (subjects {})\n", bus.url, service::busStreamName(bus.stream),
+               service::busSubjects(bus.stream));
+  }
+  printServing(o, *producer, sc, hc, what, port);
+  std::signal(SIGINT, [](int) { gInterrupted = true; });
+  std::signal(SIGTERM, [](int) { gInterrupted = true; });
+  if (!o.probes.empty()) producer->serveVolume(file);
+  session::Pacing pacing;
+  pacing.mode = session::Pacing::Mode::FixedRate;
+  pacing.hz = o.hz;
+  pacing.seconds = o.seconds;
+  double lastReport = 0.0;
+  bool held = false;
+  producer->run(pacing, &gInterrupted, [&](double seconds) {
+    if (o.holdAfter > 0 && seconds >= o.holdAfter && !held) {
+      producer->hold(true);
+      held = true;
+      fmt::print("serve: holding the lighting after {} updates ({:.1f} s); volume checksum {:08x}\n",
+                 producer->stats().updates, seconds, volumeChecksum(producer->hub().reconstruction()));
+      std::fflush(stdout);
+    }
+    if (!o.publish.empty() && producer->busStats().displaced)
+      throw std::runtime_error("--publish: " + producer->busStats().lastError);
+    if (seconds - lastReport < 5.0) return;
+    const service::PublisherStats sent = producer->busStats();
+    fmt::print("serve: {:.0f} s, {} updates, {} subscribers{}\n", seconds, producer->stats().updates,
+               producer->hub().subscriberCount(),
+               o.publish.empty() ? std::string()
+                                 : fmt::format(", bus {} ({} messages, {} bytes{})",
+                                               sent.connected ? "connected" : "away", sent.messages, sent.bytes,
+                                               sent.lastError.empty() ? "" : ", last error: " + sent.lastError));
+    std::fflush(stdout);
+    lastReport = seconds;
+  });
+  producer->shutdownServer();
+  fmt::print("serve: stopped after {} updates\n", producer->stats().updates);
+}
+
+}  // namespace
+
 void addServeCommand(CLI::App& app) {
   CLI::App* serve = app.add_subcommand("serve", "stream probes over gRPC (live from the updater or a probe file)");
   auto o = std::make_shared<ServeOptions>();
   o->tracing.add(serve);
   o->areaLights.add(serve, /*follows=*/true);
   serve->add_option("--probes", o->probes, "serve a baked probe volume file instead of tracing live");
-  addRepresentationOption(serve, o->repr, "l1, zh3h, zh3, l2 or fp16");
-  serve->add_option("--brick", o->brick, "probes per brick edge")->check(CLI::Range(1, 8));
-  serve->add_option("--deadzone", o->deadzone, "changes up to this many quantisation steps are not sent")
-      ->check(CLI::Range(0, 127));
-  o->noise.add(serve);
-  serve->add_option("--confirmations", o->confirmations,
-                    "with --noise-scale: a probe past the noise threshold is re-sent once it has stayed past it this "
-                    "many updates more (past 4x the threshold at once; 0 = at once; bench adaptive measures 1)")
-      ->check(CLI::Range(0u, 1000u));
-  serve->add_option("--error-bound", o->errorBound,
-                    "send each brick in the cheapest of l1, zh3, l2 (up to --repr) that keeps its probes within "
-                    "this relative irradiance error (0 = every brick as --repr)")
-      ->check(CLI::Range(0.0f, 10.0f));
-  o->server.add(serve);
-  CLI::Option* publish =
-      serve->add_option("--publish", o->publish, "also publish every brick version to NATS JetStream (nats://host:port) for edges");
-  serve->add_option("--stream", o->stream, "the volume's name on the bus (letters, digits, - and _)")->needs(publish);
-  o->bus.add(serve, publish);
-  serve->add_option("--hz", o->hz, "lighting updates (or budget ticks) per second")->check(CLI::Range(0.1, 1000.0));
-  serve->add_option("--seconds", o->seconds, "stop after this long (0 = until interrupted)")->check(CLI::Range(0.0, 1e9));
-  serve->add_option("--hold-after", o->holdAfter,
-                    "publish no new lighting after this many seconds (0 = never): subscribers are still served and "
-                    "settle on the last volume, to be compared bit for bit")
-      ->check(CLI::Range(0.0, 1e9));
-  o->animateOption =
-      serve->add_option("--animate", o->animate,
-                        "live: scene seconds per second (the scene clock's rate; 0: still); 0.05 by default, 0 when "
-                        "--time names a moment")
-          ->check(CLI::Range(0.0, 10.0));
-  serve->callback([o] {
-    // --time alone traces that moment: the clock runs only when --animate says so.
-    if (o->tracing.scene.tOption->count() > 0 && o->animateOption->count() == 0) o->animate = 0.0;
-    service::ServerConfig sc = o->server.config();
-    service::BusConfig bus;
-    bus.url = o->publish;
-    bus.stream = o->stream;
-    if (!o->publish.empty()) o->bus.apply(bus);
-    ProbeVolume file;
-    std::unique_ptr<renderer::VulkanContext> context;
-    service::HubConfig hc;
-    std::string what;
-    const std::unique_ptr<session::ProbeProducer> producer = makeProducer(*o, file, context, hc, what, sc.scene);
-    const int port = producer->serve(sc);
-    if (!o->publish.empty()) {
-      producer->publishTo(bus);
-      fmt::print("serve: publishing to {} as stream {} (subjects {})\n", bus.url, service::busStreamName(bus.stream),
-                 service::busSubjects(bus.stream));
-    }
-    const AreaLightRule rule = producer->hub().volume().areaLights;
-    fmt::print("serve: {} on port {} ({}), {} {}x{}x{} probes, bricks of {}, {}, client area lights {}\n", what, port,
-               describeSecurity(sc, "serve", port), representationName(hc.layout.repr), hc.layout.grid[0],
-               hc.layout.grid[1], hc.layout.grid[2], hc.layout.brickDim, o->probes.empty() ? "live" : "from file",
-               rule.on() ? fmt::format("on ({})", rule.minPowerFraction) : "off");
-    if (sc.scene) fmt::print("serve: scene {}\n", sc.scene->describe());
-    std::fflush(stdout);
-    std::signal(SIGINT, [](int) { gInterrupted = true; });
-    std::signal(SIGTERM, [](int) { gInterrupted = true; });
-    if (!o->probes.empty()) producer->serveVolume(file);
-    session::Pacing pacing;
-    pacing.mode = session::Pacing::Mode::FixedRate;
-    pacing.hz = o->hz;
-    pacing.seconds = o->seconds;
-    double lastReport = 0.0;
-    bool held = false;
-    producer->run(pacing, &gInterrupted, [&](double seconds) {
-      if (o->holdAfter > 0 && seconds >= o->holdAfter && !held) {
-        producer->hold(true);
-        held = true;
-        fmt::print("serve: holding the lighting after {} updates ({:.1f} s); volume checksum {:08x}\n",
-                   producer->stats().updates, seconds, volumeChecksum(producer->hub().reconstruction()));
-        std::fflush(stdout);
-      }
-      if (!o->publish.empty() && producer->busStats().displaced)
-        throw std::runtime_error("--publish: " + producer->busStats().lastError);
-      if (seconds - lastReport < 5.0) return;
-      const service::PublisherStats sent = producer->busStats();
-      fmt::print("serve: {:.0f} s, {} updates, {} subscribers{}\n", seconds, producer->stats().updates,
-                 producer->hub().subscriberCount(),
-                 o->publish.empty() ? std::string()
-                                    : fmt::format(", bus {} ({} messages, {} bytes{})",
-                                                  sent.connected ? "connected" : "away", sent.messages, sent.bytes,
-                                                  sent.lastError.empty() ? "" : ", last error: " + sent.lastError));
-      std::fflush(stdout);
-      lastReport = seconds;
-    });
-    producer->shutdownServer();
-    fmt::print("serve: stopped after {} updates\n", producer->stats().updates);
-  });
-}
-
-void writeSubscribeJson(const std::string& path, const service::ProbeClient& client, const service::ClientStats& st,
-                        const service::VolumeSnapshot& snap) {
-  nlohmann::json j;
-  j["frames_applied"] = st.framesApplied;
-  j["frames_rejected"] = st.framesRejected;
-  j["bytes"] = st.bytesReceived;
-  j["keyframes"] = st.keyframesReceived;
-  j["deltas"] = st.deltasReceived;
-  j["connects"] = st.connects;
-  j["silences"] = st.silences;
-  j["bricks"] = brickCount(snap.layout);
-  j["checksum"] = fmt::format("{:08x}", volumeChecksum(snap.volume));
-  j["server"] = {{"bytes_sent", st.serverBytesSent},           {"frames_acked", st.serverFramesAcked},
-                 {"ack_rtt_us", st.serverAckRttUs},            {"bricks_behind", st.serverBricksBehind},
-                 {"link_rate", st.serverLinkRate},             {"link_min_rtt_us", st.serverLinkMinRttUs},
-                 {"link_window", st.serverLinkWindow},         {"link_in_flight", st.serverLinkInFlight},
-                 {"link_waits", st.serverLinkWaits}};
-  nlohmann::json frames = nlohmann::json::array();
-  for (const service::AppliedFrame& f : client.appliedFrames())
-    frames.push_back({f.appliedUs, f.latencyUs, f.bytes, f.keyframes, f.deltas, f.bricksHeld});
-  j["frame_fields"] = {"applied_us", "latency_us", "bytes", "keyframes", "deltas", "bricks_held"};
-  j["frames"] = std::move(frames);
-  std::ofstream out(path);
-  out << j.dump() << "\n";
-  if (!out) throw std::runtime_error("cannot write " + path);
-  fmt::print("wrote {}\n", path);
-}
-
-void addSubscribeCommand(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("subscribe", "subscribe to a probe stream; report and save the volume");
-  struct SubOptions {
-    ConnectOptions connection;
-    std::string out, repr, json, snapshotDir;
-    uint64_t budget = 0;
-    double seconds = 5.0, snapshotEvery = 0.0;
-  };
-  auto so = std::make_shared<SubOptions>();
-  so->connection.add(sub, "server address host:port (several comma-separated: edges to fail over between)", true, true);
-  so->connection.addLimits(sub);
-  sub->add_option("--budget", so->budget, "bytes per second this subscriber accepts (0 = unlimited)");
-  sub->add_option("--seconds", so->seconds, "how long to stay subscribed")->check(CLI::Range(0.1, 1e9));
-  sub->add_option("--out", so->out, "write the received volume here (probe volume file)");
-  sub->add_option("--json", so->json,
-                  "write what was received here as JSON: totals, the server's link estimate, and every frame applied "
-                  "(when, its latency from the publish of its lighting, bytes, keyframes, bricks held)");
-  addRepresentationOption(sub, so->repr, "representation wanted (default: the server's; a coarser one is transcoded)");
-  CLI::Option* every =
-      sub->add_option("--snapshot-every", so->snapshotEvery,
-                      "write the volume held every this many seconds, at multiples of it on the system clock (so "
-                      "subscribers on one machine write theirs at the same instants): DIR/TICK.pcpv, TICK = the "
-                      "Unix time divided by the period; ticks before the first volume are skipped")
-          ->check(CLI::Range(0.05, 3600.0));
-  sub->add_option("--snapshot-dir", so->snapshotDir, "folder for --snapshot-every (created if missing)")
-      ->needs(every);
-  every->needs(sub->get_option("--snapshot-dir"));
-  sub->callback([so] {
-    if (!so->snapshotDir.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(so->snapshotDir, ec);
-      if (ec || !std::filesystem::is_directory(so->snapshotDir))
-        throw std::runtime_error("cannot create the snapshot folder " + so->snapshotDir +
-                                 (ec ? ": " + ec.message() : std::string()));
-    }
-    service::ClientConfig cc = so->connection.client("probecast-subscribe");
-    cc.budgetBytesPerSecond = so->budget;
-    if (!so->repr.empty()) cc.representation = session::parseRepresentationOrThrow(so->repr);
-    service::ProbeClient client(cc);
-    client.start();
-    const auto start = std::chrono::steady_clock::now();
-    const auto end = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                 std::chrono::duration<double>(so->seconds));
-    // Snapshot ticks: multiples of the period on the system clock.
-    const auto tickOf = [&](std::chrono::system_clock::time_point t) {
-      return static_cast<int64_t>(std::floor(std::chrono::duration<double>(t.time_since_epoch()).count() / so->snapshotEvery));
-    };
-    int64_t nextTick = so->snapshotEvery > 0 ? tickOf(std::chrono::system_clock::now()) + 1 : 0;
-    uint32_t written = 0;
-    while (std::chrono::steady_clock::now() < end) {
-      auto wake = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
-      if (so->snapshotEvery > 0) {
-        const auto tickAt = std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
-            std::chrono::duration<double>(static_cast<double>(nextTick) * so->snapshotEvery)));
-        wake = std::min(wake, std::chrono::steady_clock::now() + (tickAt - std::chrono::system_clock::now()));
-      }
-      std::this_thread::sleep_until(std::min(wake, end));
-      if (client.stats().fatal) break;
-      if (so->snapshotEvery > 0 && tickOf(std::chrono::system_clock::now()) >= nextTick) {
-        service::VolumeSnapshot held;
-        if (client.snapshot(held) && held.framesApplied > 0) {  // zeros are not the server's volume
-          std::string error;
-          orThrow(writeProbeFile(fmt::format("{}/{}.pcpv", so->snapshotDir, nextTick), held.volume, error), error);
-          ++written;
-        }
-        nextTick = tickOf(std::chrono::system_clock::now()) + 1;
-      }
-    }
-    if (so->snapshotEvery > 0) fmt::print("subscribe: {} snapshots in {}\n", written, so->snapshotDir);
-    client.stop();
-    const service::ClientStats st = client.stats();
-    fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects{}\n", st.framesApplied,
-               st.framesRejected, st.bytesReceived, st.connects, st.lastError.empty() ? "" : ", last error: " + st.lastError);
-    for (const std::string& line : service::refusalLines(st)) fmt::print("subscribe: refused: {}\n", line);
-    if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);
-    if (st.statsReceived > 0) {
-      fmt::print("subscribe: the server counted {} bytes sent, {} frames acked, frame → ack {:.1f} ms, {} bricks behind\n",
-                 st.serverBytesSent, st.serverFramesAcked, st.serverAckRttUs / 1e3, st.serverBricksBehind);
-      if (st.serverLinkWindow > 0)
-        fmt::print("subscribe: the server paces to the link: {:.1f} kB/s, round trip {:.1f} ms, window {} bytes, "
-                   "{} in flight, {} waits\n",
-                   static_cast<double>(st.serverLinkRate) / 1e3, st.serverLinkMinRttUs / 1e3, st.serverLinkWindow, st.serverLinkInFlight,
-                   st.serverLinkWaits);
-      else
-        fmt::print("subscribe: the server does not pace this stream to its link\n");
-    }
-    service::VolumeSnapshot snap;
-    if (!client.snapshot(snap)) throw std::runtime_error("no volume received from " + so->connection.connect);
-    service::ScenePackage named;
-    std::string why;
-    fmt::print("subscribe: {} at scene time {:.4f} (clock offset {:.1f} ms)\n",
-               snap.volume.scene.known() && service::parseManifest(snap.volume.scene.manifest, named, why)
-                   ? "scene " + named.describe()
-                   : std::string("no scene named"),
-               snap.volume.scene.time, static_cast<double>(snap.clockOffsetUs) / 1e3);
-    fmt::print("subscribe: volume checksum {:08x} ({} probes)\n", volumeChecksum(snap.volume), snap.volume.grid.count());
-    if (!so->json.empty()) writeSubscribeJson(so->json, client, st, snap);
-    if (!so->out.empty()) {
-      // A volume no frame was applied to is zeros, not the server's: nothing is written.
-      if (st.framesApplied == 0)
-        throw std::runtime_error("no frame applied from " + so->connection.connect + ": nothing written to " + so->out);
-      std::string error;
-      orThrow(writeProbeFile(so->out, snap.volume, error), error);
-      fmt::print("wrote {}\n", so->out);
-    }
-  });
-}
-
-}  // namespace
-
-void addServeCommands(CLI::App& app) {
-  addServeCommand(app);
-  addSubscribeCommand(app);
+  addServeStreamOptions(serve, *o);
+  addServeNetworkOptions(serve, *o);
+  addServePacingOptions(serve, *o);
+  serve->callback([o] { runServe(*o); });
 }
 
 }  // namespace probecast::app

@@ -43,7 +43,8 @@ int main(int argc, char** argv) {
   probecast::app::addBenchCommands(app);
   probecast::app::addBakeCommand(app);
   probecast::app::addReferenceCommand(app);
-  probecast::app::addServeCommands(app);
+  probecast::app::addServeCommand(app);
+  probecast::app::addSubscribeCommand(app);
   probecast::app::addEdgeCommand(app);
   probecast::app::addCompareCommand(app);
   probecast::app::addViewCommand(app);
