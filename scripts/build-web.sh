@@ -86,7 +86,7 @@ rm -rf "$OUT/src" "$OUT/vendor" "$OUT"/viewer.js "$OUT"/chunk-*.js "$OUT"/iwer.m
 NM="$ROOT/web/node_modules"
 "$NM/.bin/esbuild" "$ROOT/web/src/viewer.js" --bundle --minify --format=esm --splitting --outdir="$OUT" \
   --external:crypto --alias:nats.ws="$NM/nats.ws/esm/nats.js" --alias:iwer="$NM/iwer/build/iwer.module.js" \
-  --legal-comments=linked --log-level=warning
+  --loader:.h=text --legal-comments=linked --log-level=warning
 cp "$ROOT/web/index.html" "$OUT/"
 mkdir -p "$OUT/licenses"
 cp "$NM/three/LICENSE" "$OUT/licenses/three.LICENSE"

@@ -97,24 +97,10 @@ vec3 areaLightsDirect(vec3 p, vec3 n, vec3 ngf, vec3 wo, vec3 base, float metall
     vec3 specular = vec3(0.0);
     for (uint t = 0u; t < l.triangleCount; ++t) {
       uint k = l.firstCorner + 3u * t;
-      vec3 a = areaCorners[k].xyz, b = areaCorners[k + 1u].xyz, c = areaCorners[k + 2u].xyz;
-      float e = triangleCosineSolidAngle(p, n, a, b, c);
-      if (e <= 0.0) continue;
-      irradiance += e;
-      // GGX: the BSDF at the representative point × the triangle's solid angle, with the lobe
-      // widened by the light's angular radius and renormalised by (α/α')², so a sharp lobe under a
-      // large light reflects at most what it holds.
-      vec3 q = representativePoint(p, r, a, b, c);
-      vec3 toQ = q - p;
-      float dq = length(toQ);
-      if (dq <= 1e-6) continue;
-      vec3 wi = toQ / dq;
-      float nl = dot(n, wi);
-      if (nl <= 0.0 || dot(ngf, wi) <= 0.0) continue;
-      float omega = triangleSolidAngle(p, a, b, c);
-      float widened = min(1.0, alpha + 0.5 * sqrt(omega / PI));
-      vec3 f = evalBsdf(n, wo, wi, base, metallic, alpha) - base * (1.0 - metallic) / PI;
-      specular += max(f, vec3(0.0)) * nl * omega * (alpha * alpha) / (widened * widened);
+      vec4 tl = triangleLight(p, n, ngf, wo, r, areaCorners[k].xyz, areaCorners[k + 1u].xyz, areaCorners[k + 2u].xyz,
+                              base, metallic, alpha);
+      irradiance += tl.w;
+      specular += tl.xyz;
     }
     if (irradiance <= 0.0) continue;
     float visible = areaShadow(l, p, n, ngf);

@@ -1,16 +1,21 @@
 // Geometry of client area lights, in the subset of GLSL that is also C++ with glm, so the raster
-// shader and the tests run the same code: the cosine-weighted solid angle of a triangle (exact:
-// the triangle is clipped to the receiver's horizon, then the edge integral of Lambert's
-// formula), its solid angle, and the representative point for the GGX term.
+// shader, the browser page (which includes it as text) and the tests run the same code: the
+// cosine-weighted solid angle of a triangle (exact: the triangle is clipped to the receiver's
+// horizon, then the edge integral of Lambert's formula), its solid angle, the representative point
+// for the GGX term, and a triangle's light by both.
 #ifndef PROBECAST_AREA_LIGHT_MATH_H
 #define PROBECAST_AREA_LIGHT_MATH_H
 
 #ifdef __cplusplus
 #include <glm/glm.hpp>
+
+#include "bsdf.h"
 namespace probecast::arealight {
 using namespace glm;
+using probecast::bsdf::evalBsdf;
 #define AL_FN inline
 #else
+#include "bsdf.h"
 #define AL_FN
 #endif
 
@@ -107,6 +112,30 @@ AL_FN vec3 representativePoint(vec3 p, vec3 r, vec3 a, vec3 b, vec3 c) {
     q = nn > 0.0f ? far - nl * (dot(far - a, nl) / nn) : a;
   }
   return closestOnTriangle(q, a, b, c);
+}
+
+// Light of a unit-radiance triangle (a, b, c) reflected toward wo at p (unit shading normal n,
+// geometric normal ngf on the viewer's side, r: wo's mirror direction about n). w: the
+// cosine-weighted solid angle (the diffuse term's irradiance); xyz: the GGX term, the BSDF at the
+// representative point × the triangle's solid angle, with the lobe widened by the light's angular
+// radius and renormalised by (α/α')², so a sharp lobe under a large light reflects at most what
+// it holds.
+AL_FN vec4 triangleLight(vec3 p, vec3 n, vec3 ngf, vec3 wo, vec3 r, vec3 a, vec3 b, vec3 c, vec3 base, float metallic,
+                         float alpha) {
+  const float pi = 3.14159265358979f;
+  float e = triangleCosineSolidAngle(p, n, a, b, c);
+  if (e <= 0.0f) return vec4(0.0f);
+  vec3 q = representativePoint(p, r, a, b, c);
+  vec3 toQ = q - p;
+  float dq = length(toQ);
+  if (dq <= 1e-6f) return vec4(vec3(0.0f), e);
+  vec3 wi = toQ / dq;
+  float nl = dot(n, wi);
+  if (nl <= 0.0f || dot(ngf, wi) <= 0.0f) return vec4(vec3(0.0f), e);
+  float omega = triangleSolidAngle(p, a, b, c);
+  float widened = min(1.0f, alpha + 0.5f * sqrt(omega / pi));
+  vec3 f = evalBsdf(n, wo, wi, base, metallic, alpha) - base * (1.0f - metallic) / pi;
+  return vec4(max(f, vec3(0.0f)) * nl * omega * (alpha * alpha) / (widened * widened), e);
 }
 
 #ifdef __cplusplus

@@ -151,26 +151,7 @@ vec3 surfaceTransmittance(PtMaterial m, vec4 uvs) {
   return materialTransmission(m, base.a) * base.rgb;
 }
 
-// Lambert + GGX (Cook-Torrance, Smith-Schlick G, Schlick F), metallic-roughness as glTF.
-vec3 evalBsdf(vec3 n, vec3 wo, vec3 wi, vec3 base, float metallic, float alpha) {
-  float nl = dot(n, wi), nv = dot(n, wo);
-  if (nl <= 0.0 || nv <= 0.0) return vec3(0.0);
-  vec3 h = normalize(wo + wi);  // nonzero: wo and wi lie on the same side of n
-  // Dot products of unit vectors can round past 1; pow() of the negative 1 − v·h that follows is
-  // undefined (NaN on llvmpipe), so clamp both into [0, 1] and expand the powers as products.
-  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(wo, h), 0.0, 1.0);
-  float a2 = alpha * alpha;
-  float dd = nh * nh * (a2 - 1.0) + 1.0;
-  float d = a2 / (PI * dd * dd);
-  float k = alpha * 0.5;
-  float g = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
-  vec3 f0 = mix(vec3(0.04), base, metallic);
-  float x = 1.0 - vh, x2 = x * x;
-  vec3 f = f0 + (1.0 - f0) * (x2 * x2 * x);
-  vec3 spec = d * g * f / max(4.0 * nl * nv, 1e-6);
-  vec3 diffuse = base * (1.0 - metallic) / PI;
-  return diffuse + spec;
-}
+#include "bsdf.h"  // evalBsdf
 
 const float SHADING_NORMAL_MIN_COSINE = 0.01;
 

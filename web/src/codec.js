@@ -59,6 +59,7 @@ export class Decoder {
   sceneHash() { return this.M.UTF8ToString(this.M._pc_viewer_scene_hash(this.handle)); }
   sceneManifest() { return this.M.UTF8ToString(this.M._pc_viewer_scene_manifest(this.handle)); }
   areaLightRule() { return this.M._pc_viewer_area_light_rule(this.handle); }
+  areaLightShare() { return this.M._pc_viewer_area_light_share(this.handle); }
   representation() { return this.M.UTF8ToString(this.M._pc_viewer_representation(this.handle)); }
   sceneTime() { return this.M._pc_viewer_scene_time(this.handle); }
   sceneRate() { return this.M._pc_viewer_scene_rate(this.handle); }

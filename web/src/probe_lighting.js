@@ -10,7 +10,9 @@ import * as THREE from 'three';
 const kTexels = 7;  // 27 coefficients and a pad per probe: 7 RGBA texels along x
 
 export class ProbeLighting {
-  constructor() {
+  // area: an AreaLighting (area_light_shading.js) whose lights the patched materials draw too, or null.
+  constructor(area = null) {
+    this.area = area;
     this.uniforms = {
       pcProbes: { value: null },
       pcPositions: { value: null },
@@ -68,16 +70,16 @@ export class ProbeLighting {
 
   // Patches a MeshStandardMaterial / MeshPhysicalMaterial to add the probes' irradiance.
   apply(material) {
-    const uniforms = this.uniforms;
+    const uniforms = this.uniforms, area = this.area;
     material.onBeforeCompile = (shader) => {
-      Object.assign(shader.uniforms, uniforms);
+      Object.assign(shader.uniforms, uniforms, area ? area.uniforms : {});
       shader.vertexShader = shader.vertexShader
         .replace('#include <common>', '#include <common>\nvarying vec3 vPcWorld;\nvarying vec3 vPcNormal;')
         .replace('#include <project_vertex>', `#include <project_vertex>
   vPcWorld = (modelMatrix * vec4(transformed, 1.0)).xyz;
   vPcNormal = mat3(modelMatrix) * objectNormal;`);
       shader.fragmentShader = shader.fragmentShader
-        .replace('#include <common>', `#include <common>\n${kIrradianceGlsl}`)
+        .replace('#include <common>', `#include <common>\n${kIrradianceGlsl}${area ? area.declarations : ''}`)
         .replace('#include <lights_fragment_end>', `#include <lights_fragment_end>
   if (pcOn > 0.5) {
     vec3 pcN = normalize(vPcNormal) * faceDirection;
@@ -89,9 +91,9 @@ export class ProbeLighting {
       vec2 pcAB = texture2D(dfgLUT, vec2(roughnessFactor, saturate(dot(pcN, pcV)))).rg;
       reflectedLight.indirectSpecular += pcGlossy(pcC, reflect(-pcV, pcN), roughnessFactor) * (pcF0 * pcAB.x + pcAB.y);
     }
-  }`);
+  }${area ? area.call : ''}`);
     };
-    material.customProgramCacheKey = () => 'probecast-probes';
+    material.customProgramCacheKey = () => (area ? 'probecast-probes-area' : 'probecast-probes');
     material.needsUpdate = true;
   }
 }

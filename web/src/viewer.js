@@ -16,6 +16,8 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { connect, DeliverPolicy } from 'nats.ws';
 import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
+import { AreaLighting } from './area_light_shading.js';
+import { kAreaLightRuleVersion } from './area_lights.js';
 import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
 import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
 
@@ -39,6 +41,9 @@ const config = {
   camera: params.get('camera'),
   lkg: params.get('lkg'),
   lkgView: params.get('lkgview'),
+  // timing=1: each frame waits for the GPU to finish drawing and the time is shown (drawMs), for
+  // measurement; the frame interval alone hides drawing that overlaps the next frame.
+  timing: params.get('timing') === '1',
 };
 
 // What the page shows, and what a test reads (window.probecast).
@@ -107,7 +112,8 @@ renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 const scene = new THREE.Scene();
 let camera = new THREE.PerspectiveCamera(45, 1, 0.01, 1000);
-const lighting = new ProbeLighting();
+const areaLighting = new AreaLighting();
+const lighting = new ProbeLighting(areaLighting);
 
 function resize() {
   const w = canvas.clientWidth, h = canvas.clientHeight;
@@ -140,8 +146,14 @@ function pose(time) {
   state.sceneTime = time;
 }
 
+const drawTimes = [];
 function frame(now, xrFrame) {
+  const drawStart = performance.now();
   pose(displayTime());
+  if (state.sceneLoaded) {
+    if (animation) followAreaLights(true);  // lights on moving nodes move
+    areaLighting.drawShadows(renderer, scene, !!animation);
+  }
   if (lookingGlass) {
     // The drawing buffer is the panel, pixel for pixel, whatever size the page shows it at.
     const { screenW, screenH } = lookingGlass.cal;
@@ -153,6 +165,13 @@ function frame(now, xrFrame) {
   } else {
     if (!renderer.xr.isPresenting) resize();
     renderer.render(scene, renderer.xr.isPresenting ? xrCamera : camera);
+  }
+  if (config.timing) {
+    const gl = renderer.getContext();
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the drawing
+    drawTimes.push(performance.now() - drawStart);
+    if (drawTimes.length > 15) drawTimes.shift();
+    state.drawMs = median(drawTimes);
   }
   frameTimes.push(now - last);
   if (frameTimes.length > 60) frameTimes.shift();
@@ -302,6 +321,8 @@ async function loadScene(manifestText, hash) {
   fitSunShadows(gltf.scene);
   new THREE.Box3().setFromObject(gltf.scene).getCenter(sceneCentre);
   state.emitters = countEmitters(gltf.scene);
+  loadedScene = { root: gltf.scene, parser: gltf.parser };
+  areaLightsOf = '';
   camera = pickCamera(gltf);
   // The scene's animation, every clip at once, looped over the longest (as the native viewers).
   animation = null;
@@ -318,6 +339,7 @@ async function loadScene(manifestText, hash) {
   }
   state.sceneLoaded = true;
   state.sceneHash = hash;
+  followAreaLights();  // before the first frame of the new scene
 }
 
 // Loads the scene the stream names, and tries again every few seconds while it fails (files
@@ -437,16 +459,26 @@ function onMessage(bytes) {
   volumeDirty = true;
 }
 
-// The page does not draw client area lights yet: where the stream leaves some to the viewer (its
-// rule is on and the scene has emitting surfaces), say so rather than show a darker room silently.
-function areaLightWarning() {
-  return codec.areaLightRule() !== 0 && state.sceneLoaded && state.emitters > 0
-    ? 'this stream leaves its area lights to the viewer, and this page does not draw them yet: their direct light is missing'
+// Client area lights: the emitters the stream's rule leaves to viewers, drawn by the page (their
+// direct light is not in the probes). Chosen again when the scene, the rule or (`moved`) the pose
+// changes. A rule newer than the page's, or a browser that cannot draw their shadows, is named.
+let loadedScene = null, areaLightsOf = '';
+function followAreaLights(moved = false) {
+  if (!codec || !codec.hasVolume() || !loadedScene) return;
+  const rule = codec.areaLightRule(), share = codec.areaLightShare();
+  const key = `${state.sceneHash}/${rule}/${share}`;
+  if (key === areaLightsOf && !moved) return;
+  areaLightsOf = key;
+  const known = rule === 0 || rule === kAreaLightRuleVersion;
+  state.areaLights = areaLighting.setScene(loadedScene.root, loadedScene.parser, rule !== 0 && known ? share : null,
+                                           renderer.extensions.has('EXT_color_buffer_float'));
+  state.warning = !known ? `this stream's area light rule (version ${rule}) is newer than this page's: their direct light is missing`
+    : state.areaLights > 0 && !areaLighting.shadowed ? 'this browser cannot draw float targets: area lights are drawn without shadows'
     : '';
 }
 
 function refreshVolume() {
-  if (codec && codec.hasVolume()) state.warning = areaLightWarning();
+  followAreaLights();
   if (!volumeDirty || !codec.hasVolume()) return;
   volumeDirty = false;
   state.bricks = codec.bricks();
@@ -526,7 +558,7 @@ setInterval(() => {
   const age = state.lastBrickAt ? ((performance.now() - state.lastBrickAt) / 1000).toFixed(1) + ' s' : '–';
   const lines = [
     `${state.connection}  ${config.stream}  ${state.representation}  bricks ${state.bricksHeld}/${state.bricks}  checksum ${state.checksum || '–'}`,
-    `frame ${state.frameMs.toFixed(1)} ms  newest light ${age} ago  ${(rate / 1024).toFixed(1)} kB/s  decode ${state.decodeMs.toFixed(2)} ms/message`,
+    `frame ${state.frameMs.toFixed(1)} ms${config.timing ? ` (drawn in ${(state.drawMs || 0).toFixed(1)} ms)` : ''}  newest light ${age} ago  ${(rate / 1024).toFixed(1)} kB/s  decode ${state.decodeMs.toFixed(2)} ms/message`,
   ];
   if (state.lookingGlass) {
     const g = state.lookingGlass;

@@ -67,11 +67,12 @@ const natsBin = ['/usr/sbin/nats-server', '/usr/bin/nats-server'].find(existsSyn
 const natsArgs = ['-c', join(work, 'nats.conf'), '-a', '127.0.0.1', '-p', String(ports.nats), '-js', '-sd', join(work, 'nats')];
 let nats = start(natsBin, natsArgs, 'nats.log');
 
-// The probes hold every emitter (--area-lights off): the page does not draw client area lights yet.
+// PROBECAST_WEB_AREA_LIGHTS: bake's --area-lights (bake's default, on: the page draws the emitters
+// the rule leaves to viewers, as the native client does; off: the probes hold every emitter).
 // PROBECAST_WEB_SPP: paths per probe (the README's screenshot takes 512).
 // PROBECAST_WEB_TIME: the scene time the probes are traced at (an animated scene is posed there).
 const sceneTime = process.env.PROBECAST_WEB_TIME || '0';
-execFileSync(probecast, ['bake', '--scene', sceneGltf, '--area-lights', 'off', '--grid', '6,6,6', '--spp', process.env.PROBECAST_WEB_SPP || '32', '--updates', '1',
+execFileSync(probecast, ['bake', '--scene', sceneGltf, ...(process.env.PROBECAST_WEB_AREA_LIGHTS ? ['--area-lights', process.env.PROBECAST_WEB_AREA_LIGHTS] : []), '--grid', '6,6,6', '--spp', process.env.PROBECAST_WEB_SPP || '32', '--updates', '1',
   '--time', sceneTime, '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
 const serveArgs = ['serve', '--probes', join(work, 'served.pcpv'), '--scene', sceneGltf, '--listen', `127.0.0.1:${ports.grpc}`,
   '--plaintext', '--token', 't0k', '--seconds', '200', '--publish', `nats://127.0.0.1:${ports.nats}`, '--stream', 'web',
@@ -130,8 +131,14 @@ try {
   await page.screenshot({ path: join(work, 'page.png') });
   // The same camera rendered by the native raster client from the same probes: PSNR of the page's
   // canvas against it, both 8-bit pictures through the same curve.
-  execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
-    '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native')], { stdio: 'ignore' });
+  const nativeText = execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation,
+    '--time', sceneTime, '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native')], { encoding: 'utf8' });
+  // Client area lights: the page draws those the native client draws (none where the probes hold
+  // every emitter), and every shader the page uses compiles.
+  const nativeLights = Number((/client area lights on .*: (\d+) lights/.exec(nativeText) || [0, 0])[1]);
+  check((s.areaLights || 0) === nativeLights, `the page draws the native client's ${nativeLights} client area lights (${s.areaLights || 0})`);
+  if (process.env.PROBECAST_WEB_AREA_LIGHTS === 'on') check(nativeLights > 0, `the scene has client area lights (${nativeLights})`);
+  check(!consoleLines.some((l) => /Shader Error|Can not resolve #include|WebGLProgram/.test(l)), 'every shader of the page compiles');
   const nativePng = 'data:image/png;base64,' + readFileSync(join(work, 'native', 'quilt.png')).toString('base64');
   const compare = (png, on = page) => on.evaluate(async (url) => {
     const img = new Image();
@@ -173,12 +180,12 @@ try {
     const view = process.env.PROBECAST_WEB_LKG_VIEW || '96x128';
     const lkg = await browser.newPage({ viewport: { width: 320, height: 240 } });
     lkg.on('pageerror', (e) => consoleLines.push('lkg page error: ' + e.message));
-    const lkgParams = view === 'model' ? '&lkg=/lkg/visual.json' : `&lkg=/lkg/visual.json&lkgview=${view}`;
+    const lkgParams = (view === 'model' ? '&lkg=/lkg/visual.json' : `&lkg=/lkg/visual.json&lkgview=${view}`) + '&timing=1';
     await lkg.goto(url(busToken).replace('&scene=', `${lkgParams}&scene=`));
     const shown = await until('the Looking Glass page to draw the panel', async () => {
       const v = await lkg.evaluate(() => ({ ...window.probecast }));
       if (v.error) throw new Error('the Looking Glass page says: ' + v.error);
-      return v.sceneLoaded && v.checksum === native && v.lookingGlass && v.frames > 5 ? v : null;
+      return v.sceneLoaded && v.checksum === native && v.lookingGlass && v.frames > 5 && v.drawMs > 0 ? v : null;
     }, 90);
     execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
       '--looking-glass', lkgCalibration, ...(view === 'model' ? [] : ['--size', view]), '--out', join(work, 'native-lkg')],
@@ -188,7 +195,7 @@ try {
     const g = shown.lookingGlass;
     check(panel.size.join('x') === panel.nativeSize.join('x') && panel.size.join('x') === g.panel.join('x'),
       `the page draws the panel at its own size (${panel.size.join('x')}; native ${panel.nativeSize.join('x')})`);
-    console.log(`Looking Glass ${g.model} (${g.views} views of ${g.view.join('x')}, ${g.cells} subpixel cells): page against the native panel image ${panel.psnr.toFixed(2)} dB PSNR, ${shown.frameMs.toFixed(1)} ms a frame`);
+    console.log(`Looking Glass ${g.model} (${g.views} views of ${g.view.join('x')}, ${g.cells} subpixel cells): page against the native panel image ${panel.psnr.toFixed(2)} dB PSNR, ${shown.drawMs.toFixed(1)} ms a frame drawn, ${shown.frameMs.toFixed(1)} ms between frames`);
     const minLkg = Number(process.env.PROBECAST_WEB_LKG_MIN_PSNR || 0);
     check(panel.psnr >= minLkg, `the page's panel image is within ${minLkg} dB of the native one (${panel.psnr.toFixed(2)} dB)`);
     await lkg.close();

@@ -223,6 +223,10 @@ EMSCRIPTEN_KEEPALIVE const char* pc_viewer_scene_manifest(void* handle) {
 EMSCRIPTEN_KEEPALIVE uint32_t pc_viewer_area_light_rule(void* handle) {
   return of(handle)->haveVolume ? of(handle)->volume.areaLights.version : 0;
 }
+// Its threshold: the share of the scene's emitted power a material needs to be client-lit.
+EMSCRIPTEN_KEEPALIVE float pc_viewer_area_light_share(void* handle) {
+  return of(handle)->haveVolume ? of(handle)->volume.areaLights.minPowerFraction : 0.0f;
+}
 
 // The representation's name as the CLI spells it (l1, zh3h, zh3, l2, fp16, float).
 EMSCRIPTEN_KEEPALIVE const char* pc_viewer_representation(void* handle) {
