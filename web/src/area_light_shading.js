@@ -135,7 +135,8 @@ export class AreaLighting {
   }
 
   // The maps, once after a scene loads and every frame while it moves (`moving`). Casters that
-  // let light through (transmission, blending) are left out, as the native maps leave them.
+  // let light through (transmission, blending) are left out, as the native maps leave them, and
+  // so is the background.
   drawShadows(renderer, scene, moving) {
     if (!this.shadowed || (!this.dirty && !moving)) return;
     this.dirty = false;
@@ -145,7 +146,8 @@ export class AreaLighting {
     const hidden = [];
     scene.traverse((o) => {
       const mats = o.isMesh ? (Array.isArray(o.material) ? o.material : [o.material]) : [];
-      if (o.visible && mats.some((m) => m && (m.transparent || m.transmission > 0))) { hidden.push(o); o.visible = false; }
+      const seeThrough = mats.some((m) => m && (m.transparent || m.transmission > 0));
+      if (o.visible && (seeThrough || o.userData.probecastBackground)) { hidden.push(o); o.visible = false; }
     });
     renderer.shadowMap.autoUpdate = false;
     renderer.shadowMap.needsUpdate = false;

@@ -17,6 +17,7 @@ import { connect, DeliverPolicy } from 'nats.ws';
 import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
 import { AreaLighting } from './area_light_shading.js';
+import { lightingBackground } from './environment.js';
 import { kAreaLightRuleVersion } from './area_lights.js';
 import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
 import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
@@ -298,8 +299,14 @@ async function loadScene(manifestText, hash) {
   manager.setURLModifier((url) => files.get(url) ?? 'data:,');
   const text = await (await fetch(files.get(manifest.scene.gltf))).arrayBuffer();
   const gltf = await new GLTFLoader(manager).parseAsync(text, '');
+  // The distant light behind the scene, as the native client draws it (none: black).
+  const background = await lightingBackground(manifest.lighting, async (path) => {
+    if (!files.has(path)) throw new Error(`the stream's environment map ${path} is not among its files`);
+    return (await fetch(files.get(path))).arrayBuffer();
+  });
   scene.clear();
   scene.add(gltf.scene);
+  if (background) scene.add(background);
   if (renderer.xr.isPresenting) scene.add(dolly);  // a session goes on in the new scene
   gltf.scene.traverse((o) => {
     if (o.isMesh) {

@@ -72,9 +72,15 @@ let nats = start(natsBin, natsArgs, 'nats.log');
 // PROBECAST_WEB_SPP: paths per probe (the README's screenshot takes 512).
 // PROBECAST_WEB_TIME: the scene time the probes are traced at (an animated scene is posed there).
 const sceneTime = process.env.PROBECAST_WEB_TIME || '0';
-execFileSync(probecast, ['bake', '--scene', sceneGltf, ...(process.env.PROBECAST_WEB_AREA_LIGHTS ? ['--area-lights', process.env.PROBECAST_WEB_AREA_LIGHTS] : []), '--grid', '6,6,6', '--spp', process.env.PROBECAST_WEB_SPP || '32', '--updates', '1',
+// PROBECAST_WEB_ENVIRONMENT: an .hdr or .exr map around the scene (bake, serve and view take it; the
+// page fetches it from the scene folder's environment/, as the scene's package names it).
+const environment = process.env.PROBECAST_WEB_ENVIRONMENT || '';
+// PROBECAST_WEB_SKY: R,G,B, a uniform sky instead.
+const envArgs = environment ? ['--environment', environment]
+  : process.env.PROBECAST_WEB_SKY ? ['--sky', ...process.env.PROBECAST_WEB_SKY.split(',')] : [];
+execFileSync(probecast, ['bake', ...envArgs, '--scene', sceneGltf, ...(process.env.PROBECAST_WEB_AREA_LIGHTS ? ['--area-lights', process.env.PROBECAST_WEB_AREA_LIGHTS] : []), '--grid', '6,6,6', '--spp', process.env.PROBECAST_WEB_SPP || '32', '--updates', '1',
   '--time', sceneTime, '--out', join(work, 'served.pcpv')], { stdio: 'ignore' });
-const serveArgs = ['serve', '--probes', join(work, 'served.pcpv'), '--scene', sceneGltf, '--listen', `127.0.0.1:${ports.grpc}`,
+const serveArgs = ['serve', ...envArgs, '--probes', join(work, 'served.pcpv'), '--scene', sceneGltf, '--listen', `127.0.0.1:${ports.grpc}`,
   '--plaintext', '--token', 't0k', '--seconds', '200', '--publish', `nats://127.0.0.1:${ports.nats}`, '--stream', 'web',
   '--nats-token-file', join(work, 'bus-token'), '--nats-plaintext'];
 let serve = start(probecast, serveArgs, 'serve.log');
@@ -91,7 +97,8 @@ const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/ja
 const served = new Map();
 const http = createServer((req, res) => {
   const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
-  const [root, rel] = path.startsWith('/scene/') ? [sceneDir, path.slice(7)]
+  const [root, rel] = environment && path === `/scene/environment/${basename(environment)}` ? [dirname(resolve(environment)), basename(environment)]
+    : path.startsWith('/scene/') ? [sceneDir, path.slice(7)]
     : lkgCalibration && path === '/lkg/visual.json' ? [dirname(lkgCalibration), basename(lkgCalibration)]
     : path.startsWith('/altered/') ? [join(work, 'altered'), path.slice(9)] : [webDir, path === '/' ? 'index.html' : path.slice(1)];
   const file = resolve(root, rel);
@@ -131,14 +138,15 @@ try {
   await page.screenshot({ path: join(work, 'page.png') });
   // The same camera rendered by the native raster client from the same probes: PSNR of the page's
   // canvas against it, both 8-bit pictures through the same curve.
-  const nativeText = execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation,
+  const nativeText = execFileSync(probecast, ['view', ...envArgs, '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation,
     '--time', sceneTime, '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native')], { encoding: 'utf8' });
   // Client area lights: the page draws those the native client draws (none where the probes hold
   // every emitter), and every shader the page uses compiles.
   const nativeLights = Number((/client area lights on .*: (\d+) lights/.exec(nativeText) || [0, 0])[1]);
   check((s.areaLights || 0) === nativeLights, `the page draws the native client's ${nativeLights} client area lights (${s.areaLights || 0})`);
   if (process.env.PROBECAST_WEB_AREA_LIGHTS === 'on') check(nativeLights > 0, `the scene has client area lights (${nativeLights})`);
-  check(!consoleLines.some((l) => /Shader Error|Can not resolve #include|WebGLProgram/.test(l)), 'every shader of the page compiles');
+  const shaderErrors = consoleLines.filter((l) => /Shader Error|Can not resolve #include|WebGLProgram/.test(l));
+  check(!shaderErrors.length, `every shader of the page compiles${shaderErrors.length ? ": " + shaderErrors[0].slice(0, 2000) : ""}`);
   const nativePng = 'data:image/png;base64,' + readFileSync(join(work, 'native', 'quilt.png')).toString('base64');
   const compare = (png, on = page) => on.evaluate(async (url) => {
     const img = new Image();
@@ -169,7 +177,7 @@ try {
   if (Number(sceneTime) !== 0) {
     // The page poses the scene at the stream's time: the native picture of the scene at rest
     // (same probes) is farther from it.
-    execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', '0',
+    execFileSync(probecast, ['view', ...envArgs, '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', '0',
       '--views', 'mono', '--size', `${vw || 320}x${vh || 240}`, '--out', join(work, 'native-at-rest')], { stdio: 'ignore' });
     const atRest = await compare('data:image/png;base64,' + readFileSync(join(work, 'native-at-rest', 'quilt.png')).toString('base64'));
     check(atRest.psnr < compared.psnr - 3, `the page poses the scene at the stream's time ${sceneTime} s (${compared.psnr.toFixed(2)} dB against the native picture then, ${atRest.psnr.toFixed(2)} dB against the scene at rest)`);
@@ -187,7 +195,7 @@ try {
       if (v.error) throw new Error('the Looking Glass page says: ' + v.error);
       return v.sceneLoaded && v.checksum === native && v.lookingGlass && v.frames > 5 && v.drawMs > 0 ? v : null;
     }, 90);
-    execFileSync(probecast, ['view', '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
+    execFileSync(probecast, ['view', ...envArgs, '--scene', sceneGltf, '--probes', join(work, 'served.pcpv'), '--repr', s.representation, '--time', sceneTime,
       '--looking-glass', lkgCalibration, ...(view === 'model' ? [] : ['--size', view]), '--out', join(work, 'native-lkg')],
     { stdio: 'ignore' });
     const panel = await compare('data:image/png;base64,' + readFileSync(join(work, 'native-lkg', 'looking_glass.png')).toString('base64'), lkg);
