@@ -13,12 +13,8 @@
 // session that renders each eye from the same probes, starting where the page's camera stands.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { connect, DeliverPolicy } from 'nats.ws';
-import { loadCodec } from './codec.js';
-import { ProbeLighting } from './probe_lighting.js';
-import { AreaLighting } from './area_light_shading.js';
+import { ProbeStream } from './probe_stream.js';
 import { lightingBackground } from './environment.js';
-import { kAreaLightRuleVersion } from './area_lights.js';
 import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
 import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
 
@@ -113,8 +109,9 @@ renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 const scene = new THREE.Scene();
 let camera = new THREE.PerspectiveCamera(45, 1, 0.01, 1000);
-const areaLighting = new AreaLighting();
-const lighting = new ProbeLighting(areaLighting);
+// The stream (web/src/probe_stream.js): the bus, the codec, and the light the materials read.
+const stream = config.nats && !fatal ? new ProbeStream({ servers: config.nats, token: config.token, stream: config.stream }) : null;
+const lighting = stream?.lighting;
 
 function resize() {
   const w = canvas.clientWidth, h = canvas.clientHeight;
@@ -130,10 +127,7 @@ let animation = null;  // the scene's clips, posed at the display time every fra
 // The display clock: the newest lighting's scene time, run on at its rate from the producer's wall
 // clock (clocks on the page's and the producer's machines are taken to agree, as NTP keeps them).
 function displayTime() {
-  if (!codec || !codec.hasVolume()) return 0;
-  const rate = codec.sceneRate();
-  const t = codec.sceneTime();
-  return rate === 0 ? t : t + rate * (Date.now() * 1000 - codec.sceneClockUs()) / 1e6;
+  return stream ? stream.displayTime() : 0;
 }
 
 function pose(time) {
@@ -152,8 +146,8 @@ function frame(now, xrFrame) {
   const drawStart = performance.now();
   pose(displayTime());
   if (state.sceneLoaded) {
-    if (animation) followAreaLights(true);  // lights on moving nodes move
-    areaLighting.drawShadows(renderer, scene, !!animation);
+    if (animation) stream.setScene(loadedScene.root, loadedScene.parser, renderer, true);  // lights on moving nodes move
+    stream.drawShadows(renderer, scene, !!animation);
   }
   if (lookingGlass) {
     // The drawing buffer is the panel, pixel for pixel, whatever size the page shows it at.
@@ -329,7 +323,6 @@ async function loadScene(manifestText, hash) {
   new THREE.Box3().setFromObject(gltf.scene).getCenter(sceneCentre);
   state.emitters = countEmitters(gltf.scene);
   loadedScene = { root: gltf.scene, parser: gltf.parser };
-  areaLightsOf = '';
   camera = pickCamera(gltf);
   // The scene's animation, every clip at once, looped over the longest (as the native viewers).
   animation = null;
@@ -346,13 +339,14 @@ async function loadScene(manifestText, hash) {
   }
   state.sceneLoaded = true;
   state.sceneHash = hash;
-  followAreaLights();  // before the first frame of the new scene
+  stream.setScene(gltf.scene, gltf.parser, renderer);  // its area lights, before the first frame
 }
 
 // Loads the scene the stream names, and tries again every few seconds while it fails (files
 // missing or not yet the stream's: put right, the page picks them up by itself).
 let sceneTriedAt = 0, sceneTried = '';
 function ensureScene() {
+  const codec = stream?.codec;
   if (!codec || !codec.hasVolume() || loadingScene) return;
   const hash = codec.sceneHash();
   if (!hash || hash === state.sceneHash) return;
@@ -445,114 +439,8 @@ function pickCamera(gltf) {
 }
 
 // ---- the stream ----------------------------------------------------------------------------
-let codec;
-let volumeDirty = false;
 let loadingScene = null;
-
-function onMessage(bytes) {
-  state.messages += 1;
-  state.bytes += bytes.length;
-  const r = codec.message(bytes);
-  if (r === 0) {
-    state.lastRefusal = codec.error();  // refused and counted; what the page holds stays
-    return;
-  }
-  if (r === 1) {
-    state.epochs += 1;
-    ensureScene();
-    state.representation = codec.representation();
-  }
-  if (r === 2) state.lastBrickAt = performance.now();
-  volumeDirty = true;
-}
-
-// Client area lights: the emitters the stream's rule leaves to viewers, drawn by the page (their
-// direct light is not in the probes). Chosen again when the scene, the rule or (`moved`) the pose
-// changes. A rule newer than the page's, or a browser that cannot draw their shadows, is named.
-let loadedScene = null, areaLightsOf = '';
-function followAreaLights(moved = false) {
-  if (!codec || !codec.hasVolume() || !loadedScene) return;
-  const rule = codec.areaLightRule(), share = codec.areaLightShare();
-  const key = `${state.sceneHash}/${rule}/${share}`;
-  if (key === areaLightsOf && !moved) return;
-  areaLightsOf = key;
-  const known = rule === 0 || rule === kAreaLightRuleVersion;
-  state.areaLights = areaLighting.setScene(loadedScene.root, loadedScene.parser, rule !== 0 && known ? share : null,
-                                           renderer.extensions.has('EXT_color_buffer_float'));
-  state.warning = !known ? `this stream's area light rule (version ${rule}) is newer than this page's: their direct light is missing`
-    : state.areaLights > 0 && !areaLighting.shadowed ? 'this browser cannot draw float targets: area lights are drawn without shadows'
-    : '';
-}
-
-function refreshVolume() {
-  followAreaLights();
-  if (!volumeDirty || !codec.hasVolume()) return;
-  volumeDirty = false;
-  state.bricks = codec.bricks();
-  state.bricksHeld = codec.bricksHeld();
-  state.checksum = codec.checksum();
-  state.decodeMs = median(codec.decodeMs);
-  lighting.update(codec.dims(), codec.bounds(), codec.probes(), codec.active(), codec.offsets());
-}
-setInterval(refreshVolume, 100);
-
-async function subscribe() {
-  for (;;) {
-    let nc;
-    try {
-      state.connection = 'connecting';
-      nc = await connect({ servers: config.nats, token: config.token || undefined, reconnect: true,
-                           maxReconnectAttempts: -1, reconnectTimeWait: 500, pingInterval: 5000 });
-    } catch (e) {
-      const text = String(e && (e.code || e.message));
-      if (/AUTHORIZATION|Authorization|authorization/.test(text) || e.code === 'AUTHORIZATION_VIOLATION') {
-        state.connection = 'refused';
-        fail('not authorised: the bus refused the token (give it as #token=… in the address)');
-        return;
-      }
-      state.connection = 'unreachable';
-      problem('bus', `the bus at ${config.nats} is unreachable (${text}); trying again`);
-      await sleep(1000);
-      continue;
-    }
-    (async () => {
-      for await (const s of nc.status()) {
-        if (s.type === 'disconnect' || s.type === 'reconnecting') {
-          state.connection = 'reconnecting';
-          problem('bus', `lost the bus at ${config.nats}; reconnecting`);
-        } else if (s.type === 'reconnect') {
-          state.connection = 'connected';
-          problem('bus', '');
-        }
-      }
-    })();
-    try {
-      const js = nc.jetstream();
-      // The newest message of every subject (the volume and each brick), then everything new.
-      const consumer = await js.consumers.get(`PROBECAST_${config.stream}`, {
-        filterSubjects: `probecast.${config.stream}.>`,
-        deliver_policy: DeliverPolicy.LastPerSubject,
-      });
-      state.connection = 'connected';
-      problem('bus', '');
-      problem('stream', '');
-      const messages = await consumer.consume({ max_messages: 512 });
-      for await (const m of messages) onMessage(m.data);
-    } catch (e) {
-      state.lastStreamError = String(e && e.message);
-      const missing = /stream not found/i.test(state.lastStreamError);
-      state.connection = missing ? 'waiting for the producer' : 'reconnecting';
-      problem('bus', '');
-      problem('stream', missing
-        ? `no stream "${config.stream}" on the bus: is a producer publishing it (serve --publish … --stream ${config.stream})?`
-        : `the stream "${config.stream}" stopped (${state.lastStreamError}); reconnecting`);
-    }
-    await nc.close().catch(() => {});
-    await sleep(1000);
-  }
-}
-
-function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
+let loadedScene = null;
 
 // ---- the status line -----------------------------------------------------------------------
 let bytesBefore = 0, rate = 0;
@@ -576,7 +464,8 @@ setInterval(() => {
   statusEl.textContent = lines.join('\n');
 }, 250);
 
-loadCodec().then((c) => {
-  codec = c;
-  if (!state.error) subscribe();
-}).catch((e) => fail('the WebAssembly codec did not load: ' + e.message));
+if (stream) {
+  stream.on('problem', problem).on('fatal', fail).on('epoch', ensureScene);
+  setInterval(() => Object.assign(state, stream.status), 100);
+  stream.start().catch((e) => fail('the WebAssembly codec did not load: ' + e.message));
+}
