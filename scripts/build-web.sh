@@ -2,7 +2,8 @@
 # Builds the browser viewer: the probe codec and the bus format compiled to WebAssembly with
 # emscripten (zstd included, from Debian's own source package), and the page's JavaScript
 # dependencies from web/package-lock.json. Output: build/web/ (served as static files: only the page,
-# its code and licences); intermediate files go beside it, in build/web-work/.
+# its code and licences), and beside it the npm package for three.js applications
+# (build/web-package/, web/package/README.md); intermediate files go in build/web-work/.
 #   scripts/build-web.sh [OUT]      (OUT defaults to build/web)
 set -euo pipefail
 
@@ -94,3 +95,16 @@ cp "$NM/nats.ws/LICENSE" "$OUT/licenses/nats.ws.LICENSE"
 cp "$NM/iwer/LICENSE" "$OUT/licenses/iwer.LICENSE"
 cp "$ZSTD/LICENSE" "$OUT/licenses/zstd.LICENSE"  # compiled into the codec's WebAssembly
 echo "build-web: page in $OUT (index.html)"
+
+# The npm package (web/package): the module for three.js applications, bundled without three and
+# nats.ws (the application's own), the codec beside it; packed into $OUT-package/*.tgz.
+PKG="$OUT-package/probecast-three"
+rm -rf "$OUT-package" && mkdir -p "$PKG/dist/licenses" "$PKG/example"
+"$NM/.bin/esbuild" "$ROOT/web/package/index.js" --bundle --format=esm --outfile="$PKG/dist/probecast-three.js" \
+  --external:three --external:'three/*' --external:nats.ws --loader:.h=text --log-level=warning
+cp "$OUT/probecast_codec.mjs" "$OUT/probecast_codec.wasm" "$PKG/dist/"
+cp "$ZSTD/LICENSE" "$PKG/dist/licenses/zstd.LICENSE"
+cp "$ROOT/web/package/package.json" "$ROOT/web/package/README.md" "$ROOT/LICENSE" "$PKG/"
+cp "$ROOT/web/package/example/index.html" "$ROOT/web/package/example/example.js" "$PKG/example/"
+(cd "$OUT-package" && npm pack ./probecast-three --silent >/dev/null)
+echo "build-web: npm package $(ls "$OUT-package"/*.tgz)"

@@ -3,17 +3,17 @@
 // equirect convention: top row +Y, centre facing −Z, turned about +Y by the rotation), with the
 // intensity applied, through the same curve as the scene. A uniform sky is a 1 × 1 map.
 import * as THREE from 'three';
-import { HDRLoader } from 'three/addons/loaders/HDRLoader.js';
-import { EXRLoader } from 'three/addons/loaders/EXRLoader.js';
 
 export const kMaxEnvironmentTexels = 8192 * 4096;
 
 // RGBA floats, top row first, from an .hdr or .exr file's bytes (ArrayBuffer). Throws an Error
-// naming the file for a map the page cannot use.
-export function decodeEnvironment(buffer, path) {
+// naming the file for a map the page cannot use. The loaders are fetched only when a map is.
+export async function decodeEnvironment(buffer, path) {
   const lower = path.toLowerCase();
-  const loader = lower.endsWith('.hdr') ? new HDRLoader() : lower.endsWith('.exr') ? new EXRLoader() : null;
-  if (!loader) throw new Error(`environment map ${path}: not .hdr or .exr`);
+  const hdr = lower.endsWith('.hdr');
+  if (!hdr && !lower.endsWith('.exr')) throw new Error(`environment map ${path}: not .hdr or .exr`);
+  const loader = hdr ? new (await import('three/addons/loaders/HDRLoader.js')).HDRLoader()
+    : new (await import('three/addons/loaders/EXRLoader.js')).EXRLoader();
   loader.setDataType(THREE.FloatType);
   let t;
   try {
@@ -28,7 +28,7 @@ export function decodeEnvironment(buffer, path) {
   if (channels !== 4) throw new Error(`environment map ${path}: ${channels} channels, not RGBA`);
   const rgba = new Float32Array(w * h * 4);
   // HDRLoader gives rows top first; EXRLoader bottom first (its texture is not flipped).
-  const bottomFirst = loader instanceof EXRLoader;
+  const bottomFirst = !hdr;
   for (let y = 0; y < h; ++y) {
     const from = (bottomFirst ? h - 1 - y : y) * w * 4;
     rgba.set(t.data.subarray(from, from + w * 4), y * w * 4);
@@ -96,7 +96,7 @@ export async function lightingBackground(lighting, fetchFile) {
     const e = lighting.environment;
     if (typeof e.file !== 'string' || !(e.intensity >= 0) || !Number.isFinite(e.intensity) || !Number.isFinite(e.rotation_deg))
       throw new Error('the stream\'s environment needs a file, an intensity >= 0 and a rotation');
-    return backgroundMesh(decodeEnvironment(await fetchFile(e.file), e.file), e.intensity, e.rotation_deg);
+    return backgroundMesh(await decodeEnvironment(await fetchFile(e.file), e.file), e.intensity, e.rotation_deg);
   }
   if (lighting.sky) {
     const s = lighting.sky;

@@ -14,6 +14,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { ProbeStream } from './probe_stream.js';
+import { useProbecastCurve } from './tone_curve.js';
 import { lightingBackground } from './environment.js';
 import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
 import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
@@ -91,20 +92,9 @@ if (!/^[A-Za-z0-9_-]+$/.test(config.stream)) fail(`stream name "${config.stream}
 if (!config.nats) fail('no bus given: open index.html?nats=ws://HOST:PORT&stream=NAME&scene=URL#token=TOKEN');
 
 // ---- rendering -----------------------------------------------------------------------------
-// The native viewer's picture: linear light times the exposure, the filmic curve
-// (imaging/image_io.cpp: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)), then gamma 2.2.
-THREE.ShaderChunk.tonemapping_pars_fragment = THREE.ShaderChunk.tonemapping_pars_fragment.replace(
-  'vec3 CustomToneMapping( vec3 color ) { return color; }',
-  `vec3 CustomToneMapping( vec3 color ) {
-  vec3 v = max( color * toneMappingExposure, vec3( 0.0 ) );
-  v = v * ( 2.51 * v + 0.03 ) / ( v * ( 2.43 * v + 0.59 ) + 0.14 );
-  return pow( min( v, vec3( 1.0 ) ), vec3( 1.0 / 2.2 ) );
-}`);
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
-renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // the curve above ends in gamma 2.2
-renderer.toneMapping = THREE.CustomToneMapping;
-renderer.toneMappingExposure = Number(params.get('exposure') || 1);
+useProbecastCurve(renderer, Number(params.get('exposure') || 1));  // the native viewer's picture
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 const scene = new THREE.Scene();

@@ -120,7 +120,9 @@ const page = await browser.newPage({ viewport: { width: vw || 320, height: vh ||
 const consoleLines = [];
 page.on('console', (m) => consoleLines.push(m.text()));
 page.on('pageerror', (e) => consoleLines.push('page error: ' + e.message));
-const url = (token) => `http://127.0.0.1:${ports.http}/index.html?nats=ws://127.0.0.1:${ports.ws}&stream=web&scene=/scene/#token=${token}`;
+// PROBECAST_WEB_SCENE_FILE=1: scene= names the glTF file, not its folder (the npm package's example).
+const sceneParam = process.env.PROBECAST_WEB_SCENE_FILE ? `/scene/${basename(sceneGltf)}` : '/scene/';
+const url = (token) => `http://127.0.0.1:${ports.http}/index.html?nats=ws://127.0.0.1:${ports.ws}&stream=web&scene=${sceneParam}#token=${token}`;
 const probe = () => page.evaluate(() => ({ ...window.probecast }));
 
 try {
