@@ -6,48 +6,12 @@
 // the tests compare metres, not depth-buffer values.
 import * as THREE from 'three';
 import { extractAreaLights, kMaxAreaLights, kMaxAreaTriangles } from './area_lights.js';
+import { sceneEmitters } from './scene_emitters.js';
 import areaLightMath from '../../shaders/area_light_math.h';
 import bsdf from '../../shaders/bsdf.h';
 
 const kShadowSize = 512;       // texels a side of each light's map (RasterOptions::areaShadowMapSize)
 const kShadowFovDegrees = 150;  // renderer/src/area_light_shadows.h
-
-// The scene's materials and world-space triangles as extractAreaLights takes them, posed as the
-// scene stands now. Materials are the glTF's (parser.associations): three.js may hold copies of one.
-export function sceneEmitters(root, parser) {
-  const materials = [], index = new Map(), corners = [], triangleMaterial = [];
-  const materialOf = (m) => {
-    const key = parser?.associations?.get(m)?.materials ?? m.uuid;
-    if (!index.has(key)) {
-      index.set(key, materials.length);
-      const e = m.emissive ? [m.emissive.r, m.emissive.g, m.emissive.b].map((c) => c * (m.emissiveIntensity ?? 1)) : [0, 0, 0];
-      materials.push({ emission: e, textured: !!m.emissiveMap, opaque: !m.transparent && !(m.alphaTest > 0) && !(m.transmission > 0) });
-    }
-    return index.get(key);
-  };
-  root.updateMatrixWorld(true);
-  const v = [new THREE.Vector3(), new THREE.Vector3(), new THREE.Vector3()];
-  root.traverse((o) => {
-    if (!o.isMesh || !o.visible || !o.geometry?.attributes?.position) return;
-    const g = o.geometry, pos = g.attributes.position, idx = g.index;
-    const count = idx ? idx.count : pos.count;
-    const flip = o.matrixWorld.determinant() < 0;  // mirrored nodes reverse winding
-    const groups = Array.isArray(o.material) ? g.groups : [{ start: 0, count, materialIndex: 0 }];
-    for (const grp of groups) {
-      const mat = Array.isArray(o.material) ? o.material[grp.materialIndex] : o.material;
-      if (!mat) continue;
-      const m = materialOf(mat);
-      const end = Math.min(grp.start + grp.count, count);
-      for (let i = grp.start; i + 3 <= end; i += 3) {
-        for (let k = 0; k < 3; ++k) v[k].fromBufferAttribute(pos, idx ? idx.getX(i + k) : i + k).applyMatrix4(o.matrixWorld);
-        const order = flip ? [0, 2, 1] : [0, 1, 2];
-        for (const k of order) corners.push(v[k].x, v[k].y, v[k].z);
-        triangleMaterial.push(m);
-      }
-    }
-  });
-  return { materials, corners, triangleMaterial };
-}
 
 export class AreaLighting {
   constructor() {
@@ -96,7 +60,7 @@ export class AreaLighting {
 
   writeUniforms(root) {
     const u = this.uniforms, data = this.cornerTexture.image.data;
-    const box = new THREE.Box3().setFromObject(root);
+    const box = new THREE.Box3().setFromObject(root, true);  // the vertices' bounds, as the native scene's
     const center = box.getCenter(new THREE.Vector3());
     const radius = Math.max(0.5 * box.getSize(new THREE.Vector3()).length(), 1e-3);
     const fov = THREE.MathUtils.degToRad(kShadowFovDegrees);

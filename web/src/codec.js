@@ -1,8 +1,11 @@
 // The probe codec compiled to WebAssembly (web/wasm/probecast_web.cpp): bus messages in, the
 // volume the native client would hold out.
-export async function loadCodec(options = {}) {
+// options: the codec module's own (locateFile: where its .wasm is), and moduleUrl: where
+// probecast_codec.mjs is served, when not beside this script (an application's bundler moved it).
+export async function loadCodec({ moduleUrl, ...options } = {}) {
   // Beside the page's script (build/web): loaded at run time, not bundled.
-  const { default: createProbecastCodec } = await import(new URL('./probecast_codec.mjs', import.meta.url).href);
+  const url = moduleUrl ?? new URL('./probecast_codec.mjs', import.meta.url).href;
+  const { default: createProbecastCodec } = await import(/* @vite-ignore */ /* webpackIgnore: true */ url);
   const M = await createProbecastCodec(options);
   return new Decoder(M);
 }

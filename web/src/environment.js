@@ -3,12 +3,14 @@
 // equirect convention: top row +Y, centre facing −Z, turned about +Y by the rotation), with the
 // intensity applied, through the same curve as the scene. A uniform sky is a 1 × 1 map.
 import * as THREE from 'three';
+import { printable } from './scene_rules.js';
 
 export const kMaxEnvironmentTexels = 8192 * 4096;
 
 // RGBA floats, top row first, from an .hdr or .exr file's bytes (ArrayBuffer). Throws an Error
 // naming the file for a map the page cannot use. The loaders are fetched only when a map is.
-export async function decodeEnvironment(buffer, path) {
+// maxSize: the largest texture side the renderer takes.
+export async function decodeEnvironment(buffer, path, maxSize = 16384) {
   const lower = path.toLowerCase();
   const hdr = lower.endsWith('.hdr');
   if (!hdr && !lower.endsWith('.exr')) throw new Error(`environment map ${path}: not .hdr or .exr`);
@@ -22,8 +24,8 @@ export async function decodeEnvironment(buffer, path) {
     throw new Error(`environment map ${path}: unreadable (${e.message})`);
   }
   const { width: w, height: h } = t || {};
-  if (!(w >= 1 && h >= 1) || w * h > kMaxEnvironmentTexels || !t.data)
-    throw new Error(`environment map ${path}: ${w}x${h} is not a map this page takes (at most ${kMaxEnvironmentTexels} texels)`);
+  if (!(w >= 1 && h >= 1) || w * h > kMaxEnvironmentTexels || w > maxSize || h > maxSize || !t.data)
+    throw new Error(`environment map ${path}: ${w}x${h} is not a map this page takes (at most ${kMaxEnvironmentTexels} texels, ${maxSize} a side)`);
   const channels = t.data.length / (w * h);
   if (channels !== 4) throw new Error(`environment map ${path}: ${channels} channels, not RGBA`);
   const rgba = new Float32Array(w * h * 4);
@@ -40,8 +42,9 @@ export async function decodeEnvironment(buffer, path) {
 
 // A mesh that draws `map` ({ width, height, rgba }) behind everything, for any camera (the box
 // follows the view's rotation only and lies on the far plane).
+// The map's texels are scaled in place (it is not kept).
 export function backgroundMesh(map, intensity, rotationDegrees) {
-  const data = map.rgba.slice();
+  const data = map.rgba;
   for (let i = 0; i < data.length; i += 4) {
     data[i] *= intensity;
     data[i + 1] *= intensity;
@@ -89,14 +92,18 @@ void main() {
 }
 
 // The background of a manifest's lighting: { environment: { file, intensity, rotation_deg } }
-// (`fetchFile(path)` gives its bytes), { sky: [r, g, b] }, or {} (none: black, as natively).
-export async function lightingBackground(lighting, fetchFile) {
-  if (!lighting || typeof lighting !== 'object') return null;
+// (`fetchFile(path)` gives its bytes), { sky: [r, g, b] }, or {} (none: black, as natively); any
+// other kind, or more than one, is refused as the native viewer refuses it. maxSize: as above.
+export async function lightingBackground(lighting, maxSize, fetchFile) {
+  if (lighting === undefined) return null;
+  if (!lighting || typeof lighting !== 'object' || Array.isArray(lighting) || Object.keys(lighting).length > 1 ||
+      Object.keys(lighting).some((k) => k !== 'environment' && k !== 'sky'))
+    throw new Error('the stream\'s scene lighting is not {} or one known kind');
   if (lighting.environment) {
     const e = lighting.environment;
     if (typeof e.file !== 'string' || !(e.intensity >= 0) || !Number.isFinite(e.intensity) || !Number.isFinite(e.rotation_deg))
       throw new Error('the stream\'s environment needs a file, an intensity >= 0 and a rotation');
-    return backgroundMesh(await decodeEnvironment(await fetchFile(e.file), e.file), e.intensity, e.rotation_deg);
+    return backgroundMesh(await decodeEnvironment(await fetchFile(e.file), printable(e.file), maxSize), e.intensity, e.rotation_deg);
   }
   if (lighting.sky) {
     const s = lighting.sky;

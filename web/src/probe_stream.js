@@ -63,9 +63,10 @@ export class ProbeStream {
     this.nc?.close().catch(() => {});
   }
 
-  // Patches a MeshStandardMaterial or MeshPhysicalMaterial to take the stream's light.
+  // Patches a MeshStandardMaterial or MeshPhysicalMaterial (or each of an array of them, as a
+  // mesh with groups holds) to take the stream's light; other materials are left as they are.
   apply(material) {
-    if (material?.isMeshStandardMaterial) this.lighting.apply(material);
+    for (const m of Array.isArray(material) ? material : [material]) if (m?.isMeshStandardMaterial) this.lighting.apply(m);
   }
 
   // The scene the stream's area lights are chosen from (its glTF root and GLTFLoader parser, posed

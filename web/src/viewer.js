@@ -16,7 +16,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { ProbeStream } from './probe_stream.js';
 import { useProbecastCurve } from './tone_curve.js';
 import { lightingBackground } from './environment.js';
-import { checkedManifest, sceneFileUrl, sha256Hex } from './scene_rules.js';
+import { checkedManifest, printable, sceneFileUrl, sha256Hex } from './scene_rules.js';
 import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
 
 const params = new URLSearchParams(location.search);
@@ -132,12 +132,16 @@ function pose(time) {
 }
 
 const drawTimes = [];
+let areaLightsPosedAt = null;
 function frame(now, xrFrame) {
   const drawStart = performance.now();
   pose(displayTime());
   if (state.sceneLoaded) {
-    if (animation) stream.setScene(loadedScene.root, loadedScene.parser, renderer, true);  // lights on moving nodes move
-    stream.drawShadows(renderer, scene, !!animation);
+    // Lights on moving nodes move: chosen again, and their maps drawn, when the pose changed.
+    const moved = animation && state.sceneTime !== areaLightsPosedAt;
+    areaLightsPosedAt = state.sceneTime;
+    if (moved) stream.setScene(loadedScene.root, loadedScene.parser, renderer, true);
+    stream.drawShadows(renderer, scene, moved);
   }
   if (lookingGlass) {
     // The drawing buffer is the panel, pixel for pixel, whatever size the page shows it at.
@@ -281,13 +285,25 @@ async function loadScene(manifestText, hash) {
   // The glTF reads its buffers and images from the checked copies only.
   const manager = new THREE.LoadingManager();
   manager.setURLModifier((url) => files.get(url) ?? 'data:,');
-  const text = await (await fetch(files.get(manifest.scene.gltf))).arrayBuffer();
-  const gltf = await new GLTFLoader(manager).parseAsync(text, '');
-  // The distant light behind the scene, as the native client draws it (none: black).
-  const background = await lightingBackground(manifest.lighting, async (path) => {
-    if (!files.has(path)) throw new Error(`the stream's environment map ${path} is not among its files`);
-    return (await fetch(files.get(path))).arrayBuffer();
-  });
+  let gltf, background = null;
+  try {
+    const text = await (await fetch(files.get(manifest.scene.gltf))).arrayBuffer();
+    gltf = await new GLTFLoader(manager).parseAsync(text, '');
+    // The distant light behind the scene, as the native client draws it. One the page cannot use
+    // is named and the scene shown without it (black, as where there is none).
+    try {
+      background = await lightingBackground(manifest.lighting, renderer.capabilities.maxTextureSize, async (path) => {
+        if (!files.has(path)) throw new Error(`the stream's environment map ${printable(path)} is not among its files`);
+        return (await fetch(files.get(path))).arrayBuffer();
+      });
+      problem('environment', '');
+    } catch (e) {
+      problem('environment', `${e.message}; the scene is drawn without it`);
+    }
+  } finally {
+    for (const url of files.values()) URL.revokeObjectURL(url);  // read: the copies are no longer needed
+  }
+  disposeScene(scene);
   scene.clear();
   scene.add(gltf.scene);
   if (background) scene.add(background);
@@ -330,6 +346,7 @@ async function loadScene(manifestText, hash) {
   state.sceneLoaded = true;
   state.sceneHash = hash;
   stream.setScene(gltf.scene, gltf.parser, renderer);  // its area lights, before the first frame
+  Object.assign(state, stream.status);  // shown with the scene, not up to 100 ms after it
 }
 
 // Loads the scene the stream names, and tries again every few seconds while it fails (files
@@ -353,6 +370,18 @@ setInterval(ensureScene, 500);
 // A directional light's shadow covers the whole scene (three.js's default box is 10 m wide around
 // the light's node): its orthographic camera is fitted to the scene's bounds seen from the light,
 // with a map large enough to keep the native client's texel size on scenes of a few tens of metres.
+// Frees what the previous scene holds on the GPU (geometry, materials, textures, the background).
+function disposeScene(root) {
+  root.traverse((o) => {
+    o.geometry?.dispose();
+    for (const m of Array.isArray(o.material) ? o.material : o.material ? [o.material] : []) {
+      for (const v of Object.values(m)) if (v?.isTexture) v.dispose();
+      if (o.userData.probecastBackground) m.uniforms.envMap.value.dispose();  // the stream's light stays
+      m.dispose();
+    }
+  });
+}
+
 function fitSunShadows(root) {
   root.updateMatrixWorld(true);
   const box = new THREE.Box3().setFromObject(root);
