@@ -119,6 +119,7 @@ void windowLocal(const ViewOptions& o, renderer::VulkanContext& context, const s
   source.status = [&] {
     return updater ? fmt::format("traced here: update {}/{}", done, o.updates) : "probes from " + o.probes;
   };
+  source.setRenderScale = [&](float scale) { raster.setRenderScale(scale); };
   showOnLookingGlass(source, context, lg);
   const renderer::CameraView start = renderer::CameraView::fromScene(s);
   runLiveWindow(o.window, context, start, spec, vso, o.size[0], o.size[1], glm::length(s.boundsMax - s.boundsMin),

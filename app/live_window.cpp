@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "dynamic_resolution.h"
 #include "probecast/renderer/window.h"
 #include "probecast/session/head_trace.h"
 
@@ -151,6 +152,12 @@ void LiveWindowOptions::add(CLI::App* cmd) {
   cmd->add_option("--overlay", overlay, "--window: the status line (frame ms, probe age, bytes/s, connection)")
       ->capture_default_str()
       ->needs(window);
+  cmd->add_option("--window-fps", fps,
+                  "--window: the frame rate to hold on a device too slow for the full size, by drawing the views "
+                  "smaller and scaling them up (down to 1/4 a side; 0: always full size)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0))
+      ->needs(window);
   cmd->add_option("--head-trace", headTrace,
                   "--window: the camera turns as a recorded head turned, from the window's opening, looping (a file "
                   "of timestamp viewpoint w x y z lines, the MMSys'18 format, or builtin:mmsys18-user1), with a neck "
@@ -193,6 +200,7 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
   std::vector<renderer::ViewInfo> views;
   renderer::Image shown;
   bool screenshotDone = false, first = true;
+  DynamicResolution resolution(source.setRenderScale ? o.fps : 0.0);
   while (window.isOpen() && (o.seconds <= 0.0 || secondsSince(begin) < o.seconds)) {
     const Clock::time_point frameStart = Clock::now();
     const double dt = std::chrono::duration<double>(frameStart - lastFrame).count();
@@ -206,6 +214,7 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
           viewSetOptions);
     const bool drawn = source.render(views, moved, images);
     if (drawn) {
+      for (renderer::Image& image : images) image = upscale(image, viewWidth, viewHeight);
       shown = shrink(source.compose ? source.compose(images, views)
                                     : renderer::composeQuilt(images, views, spec.columns, spec.rows),
                      fit.shrink);
@@ -216,7 +225,9 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
     }
     std::vector<unsigned char> rgba = imaging::toneMapRgba8(shown.rgb, exposure, toneMap);
     const double lastMs = frameMs.empty() ? 0.0 : frameMs.back();
-    const std::string status = source.status();
+    const std::string status = source.status() + (resolution.scale() < 1.0f
+                                                       ? fmt::format(" | drawn at {:.0f} %", 100.0f * resolution.scale())
+                                                       : std::string());
     if (o.overlay)
       imaging::drawTextLine(rgba, static_cast<int>(shown.width), static_cast<int>(shown.height), 6, 0,
                             fmt::format("{:.1f} ms | {}", lastMs, status), shown.width >= 1280 ? 2 : 1);
@@ -232,6 +243,7 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
       result.screenshots.push_back(base);
     }
     const double ms = 1e3 * secondsSince(frameStart);
+    if (resolution.update(ms)) source.setRenderScale(resolution.scale());
     frameMs.push_back(ms);
     secondMs.push_back(ms);
     if (secondsSince(lastReport) >= 1.0) {

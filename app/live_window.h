@@ -24,6 +24,7 @@ struct LiveWindowOptions {
   double screenshotAfter = -1.0;  // --screenshot-after: one screenshot this many seconds in (< 0: none)
   bool overlay = true;            // the status line
   std::string headTrace;          // --head-trace: the camera turns as this recorded head turned (looping)
+  double fps = 10.0;              // --window-fps: the rate dynamic resolution holds (0: always full size)
   void add(CLI::App* cmd);
   // The context a window presents from: the given options plus what presenting needs.
   static renderer::ContextOptions presenting(renderer::ContextOptions options);
@@ -41,6 +42,8 @@ struct FrameSource {
   std::function<renderer::Image(const std::vector<renderer::Image>& images, const std::vector<renderer::ViewInfo>& views)>
       compose;
   uint32_t displayWidth = 0, displayHeight = 0;  // 0: the quilt's size
+  // Optional: draw the next views at this scale of their size (dynamic resolution; none: full size).
+  std::function<void(float scale)> setRenderScale;
 };
 
 struct LiveWindowResult {

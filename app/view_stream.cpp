@@ -153,6 +153,7 @@ void windowFromServer(const ViewOptions& o, renderer::VulkanContext& context, co
     return true;
   };
   source.status = [&] { return status.line(); };
+  source.setRenderScale = [&](float scale) { viewer.setRenderScale(scale); };
   showOnLookingGlass(source, context, lg);
   runLiveWindow(o.window, context, start, spec, vso, o.size[0], o.size[1],
                 glm::length(s.boundsMax - s.boundsMin), source, o.out, o.exposure, toneMapOf(o));

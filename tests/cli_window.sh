@@ -34,9 +34,9 @@ set -e
 [ "$rc" -eq 1 ] || { echo "no display: exit $rc"; exit 1; }
 grep -q "cannot open a window: .*DISPLAY" "$work/no-display.log" || { cat "$work/no-display.log"; exit 1; }
 
-# 1. Local probes.
+# 1. Local probes (at full size throughout: --window-fps 0, so the screenshot is the render's).
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --window-seconds 5 \
-  --screenshot-after 0.5 --out "$work/local-window" | tee "$work/local-window.log"
+  --window-fps 0 --screenshot-after 0.5 --out "$work/local-window" | tee "$work/local-window.log"
 grep -q "window: 160x96 on" "$work/local-window.log"
 "$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --exr --out "$work/local-off" >/dev/null
 cmp "$work/local-window/screenshot_000.exr" "$work/local-off/view_00.exr"
@@ -51,6 +51,19 @@ assert (abs(shot[:band, :, :3] - off[:band, :, :3]) > 1e-3).any(), "no status li
 frames = int(re.search(r"closed after [0-9.]+ s, (\d+) frames presented", open(sys.argv[3]).read()).group(1))
 assert frames >= 2, frames
 print("local window: %d frames, screenshot equals the offscreen render" % frames)
+PY
+
+# Dynamic resolution: a rate no device holds at full size (1000 frames a second) draws the views at
+# the smallest scale, a quarter a side, and the window still shows them at its own size.
+"$probecast" view --scene builtin:cornell --probes "$work/p.pcpv" "${view[@]}" --window --window-seconds 3 \
+  --window-fps 1000 --screenshot-after 2.5 --out "$work/fast-window" >"$work/fast-window.log"
+grep -q "frames presented.*| drawn at 25 %" "$work/fast-window.log" || { cat "$work/fast-window.log"; exit 1; }
+/usr/bin/python3 - "$work/fast-window/screenshot_000.png" <<'PY'
+import sys
+import matplotlib.image as mpimg
+shot = mpimg.imread(sys.argv[1])
+assert shot.shape[:2] == (96, 160), shot.shape
+print("dynamic resolution: drawn at 25 %, shown at the window's 160x96")
 PY
 
 # A recorded head turns the camera: a second in, the head has turned 7-9 degrees, so the window's

@@ -307,6 +307,36 @@ TEST(RasterClient, LightFieldQuiltTileEqualsMonoRenderOfThatView) {
   EXPECT_EQ(context.validationMessages(), 0u);
 }
 
+// A render scale draws the views smaller in the same targets: the images are those of a renderer
+// made at that size (the same pixel grid and projection), and back at 1 the full size again.
+TEST(RasterClient, ARenderScaleDrawsWhatASmallerRendererDraws) {
+  VulkanContext context(test::validatedContext());
+  const scene::Scene s = test::builtinScene("cornell", 0.0f);
+  RasterRenderer big(context, s, 40, 30), small(context, s, 20, 15);
+  const ProbeVolume v = onceUpdatedProbes(context, s, 4, 32);
+  big.setProbes(v);
+  small.setProbes(v);
+  const glm::mat4 viewProj = big.viewProjection(CameraView::fromScene(s));
+  const glm::vec3 eye = CameraView::fromScene(s).position;
+  const Image full = big.render(viewProj, eye);
+  big.setRenderScale(0.5f);
+  EXPECT_EQ(big.renderScale(), 0.5f);
+  const Image half = big.render(viewProj, eye);
+  const Image reference = small.render(viewProj, eye);
+  ASSERT_EQ(half.width, 20u);
+  ASSERT_EQ(half.height, 15u);
+  EXPECT_EQ(half.rgb, reference.rgb);
+  big.setRenderScale(1.0f);
+  EXPECT_EQ(big.render(viewProj, eye).rgb, full.rgb);
+  big.setRenderScale(0.001f);  // at least a pixel a side
+  const Image tiny = big.render(viewProj, eye);
+  EXPECT_EQ(tiny.width, 1u);
+  EXPECT_EQ(tiny.height, 1u);
+  for (float bad : {0.0f, -1.0f, 1.5f, std::numeric_limits<float>::quiet_NaN()})
+    EXPECT_THROW(big.setRenderScale(bad), std::invalid_argument) << bad;
+  EXPECT_EQ(context.validationMessages(), 0u);
+}
+
 // N × N samples per pixel: each pixel of a W × H image is the mean of its N × N block of the same
 // view drawn at one sample per pixel and N × the size (same aspect, so the same projection and the
 // same sample positions). Differs from the one-sample W × H image at the box's edges.

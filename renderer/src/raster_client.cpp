@@ -173,6 +173,8 @@ struct RasterRenderer::Impl {
   float visibilityFar = 0.0f;
   bool visibilityBuilt = false;
   uint32_t width = 0, height = 0, chunk = 1;  // of the targets: samplesPerSide × the images' size
+  uint32_t drawWidth = 0, drawHeight = 0;     // the part of them drawn (setRenderScale; else all)
+  float renderScale = 1.0f;
   GpuScene gpu;
   GpuImage color, depth;  // `chunk` layers each; with MSAA, depth is multisampled and color the resolve target
   GpuImage msColor;       // MSAA: the multisampled colour target
@@ -201,12 +203,12 @@ struct RasterRenderer::Impl {
   // far planes (off-axis views too), written as RGBA float with alpha 0 into `layer`: the colour
   // target starts from it, so transmissive surfaces in front of the sky tint it.
   void writeBackground(float* layer, const glm::mat4& inverse) const {
-    for (uint32_t y = 0; y < height; ++y)
-      for (uint32_t x = 0; x < width; ++x) {
-        float* px = layer + (static_cast<size_t>(y) * width + x) * 4;
+    for (uint32_t y = 0; y < drawHeight; ++y)
+      for (uint32_t x = 0; x < drawWidth; ++x) {
+        float* px = layer + (static_cast<size_t>(y) * drawWidth + x) * 4;
         px[0] = px[1] = px[2] = px[3] = 0.0f;
-        const float nx = (static_cast<float>(x) + 0.5f) / static_cast<float>(width) * 2.0f - 1.0f;
-        const float ny = (static_cast<float>(y) + 0.5f) / static_cast<float>(height) * 2.0f - 1.0f;
+        const float nx = (static_cast<float>(x) + 0.5f) / static_cast<float>(drawWidth) * 2.0f - 1.0f;
+        const float ny = (static_cast<float>(y) + 0.5f) / static_cast<float>(drawHeight) * 2.0f - 1.0f;
         const glm::vec4 nearPoint = inverse * glm::vec4(nx, ny, 0.0f, 1.0f);
         const glm::vec4 farPoint = inverse * glm::vec4(nx, ny, 1.0f, 1.0f);
         const glm::vec3 dir = glm::vec3(farPoint) / farPoint.w - glm::vec3(nearPoint) / nearPoint.w;
@@ -378,7 +380,7 @@ struct RasterRenderer::Impl {
 
   // Renders views [first, first + count) into layers 0..count-1 and reads them back.
   void renderChunk(uint32_t first, uint32_t count, std::vector<Image>& out) {
-    const size_t pixels = static_cast<size_t>(width) * height;
+    const size_t pixels = static_cast<size_t>(drawWidth) * drawHeight;
     const bool msaa = samples != VK_SAMPLE_COUNT_1_BIT;
     // Without MSAA the target starts as the environment; with it, the environment goes behind the
     // resolved pixels afterwards, weighted by what their samples left uncovered (alpha).
@@ -394,7 +396,7 @@ struct RasterRenderer::Impl {
         transitionImage(cmd, color, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, count};
-        region.imageExtent = {width, height, 1};
+        region.imageExtent = {drawWidth, drawHeight, 1};
         vkCmdCopyBufferToImage(cmd, readback.buffer, color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
         transitionImage(cmd, color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
       } else {
@@ -419,14 +421,14 @@ struct RasterRenderer::Impl {
         const VkRenderingAttachmentInfo depthInfo =
             clearedAttachment(depthView, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_ATTACHMENT_STORE_OP_DONT_CARE);
         VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, {width, height}};
+        ri.renderArea = {{0, 0}, {drawWidth, drawHeight}};
         ri.layerCount = 1;
         ri.viewMask = multiview ? (1u << count) - 1u : 0u;
         ri.colorAttachmentCount = 1;
         ri.pColorAttachments = &colorInfo;
         ri.pDepthAttachment = &depthInfo;
         vkCmdBeginRendering(cmd, &ri);
-        setViewportScissor(cmd, width, height);
+        setViewportScissor(cmd, drawWidth, drawHeight);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineFor(ri.viewMask, RS_PASS_OPAQUE));
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &set, 0, nullptr);
         push.viewBase = first + p;
@@ -436,7 +438,7 @@ struct RasterRenderer::Impl {
       transitionImage(cmd, color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
       VkBufferImageCopy region{};
       region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, count};
-      region.imageExtent = {width, height, 1};
+      region.imageExtent = {drawWidth, drawHeight, 1};
       vkCmdCopyImageToBuffer(cmd, color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
       VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -461,14 +463,14 @@ struct RasterRenderer::Impl {
     const float weight = 1.0f / static_cast<float>(n * n);
     for (uint32_t v = 0; v < count; ++v) {
       Image& img = out[first + v];
-      img.width = width / n;
-      img.height = height / n;
+      img.width = drawWidth / n;
+      img.height = drawHeight / n;
       img.rgb.assign(static_cast<size_t>(img.width) * img.height * 3, 0.0f);
       const float* layer = src + v * pixels * 4;
-      for (uint32_t y = 0; y < height; ++y) {
+      for (uint32_t y = 0; y < drawHeight; ++y) {
         float* row = img.rgb.data() + static_cast<size_t>(y / n) * img.width * 3;
-        const float* in = layer + static_cast<size_t>(y) * width * 4;
-        for (uint32_t x = 0; x < width; ++x)
+        const float* in = layer + static_cast<size_t>(y) * drawWidth * 4;
+        for (uint32_t x = 0; x < drawWidth; ++x)
           for (uint32_t c = 0; c < 3; ++c) row[(x / n) * 3 + c] += weight * in[x * 4 + c];
       }
     }
@@ -506,6 +508,8 @@ RasterRenderer::RasterRenderer(VulkanContext& context, const scene::Scene& scene
   s.options = options;
   s.width = width * options.samplesPerSide;
   s.height = height * options.samplesPerSide;
+  s.drawWidth = s.width;
+  s.drawHeight = s.height;
   s.chunk = std::min<uint32_t>(8, d.maxMultiviewViewCount);
   s.sceneMin = scene.boundsMin;
   s.sceneMax = scene.boundsMax;
@@ -736,6 +740,21 @@ void RasterRenderer::setShading(const scene::Scene& scene) {
   s.shadedMaterials = scene.materials;
   s.writeDescriptors();
 }
+
+void RasterRenderer::setRenderScale(float scale) {
+  if (!(scale > 0.0f && scale <= 1.0f)) throw std::invalid_argument("render scale must be in (0, 1]");
+  Impl& s = *impl_;
+  const uint32_t n = s.options.samplesPerSide;
+  const auto side = [&](uint32_t target) {
+    const auto image = static_cast<uint32_t>(std::lround(static_cast<double>(target / n) * scale));
+    return std::clamp(image, 1u, target / n) * n;
+  };
+  s.renderScale = scale;
+  s.drawWidth = side(s.width);
+  s.drawHeight = side(s.height);
+}
+
+float RasterRenderer::renderScale() const { return impl_->renderScale; }
 
 void RasterRenderer::setAreaLights(const scene::Scene& scene, const scene::AreaLightOptions& options) {
   impl_->options.areaLights = options;

@@ -134,6 +134,12 @@ class RasterRenderer {
   std::vector<Image> renderViews(const std::vector<ViewInfo>& views);
   // Renders one view; `viewProj` maps world to Vulkan clip space (y down, z in [0, 1]).
   Image render(const glm::mat4& viewProj, const glm::vec3& eye);
+  // Draws the next view sets at `scale` × the image size on each side (at least a pixel; 1, the
+  // default: full size), in a corner of the same targets, so that a device too slow for the full
+  // size holds a frame rate (the live window's dynamic resolution). The images come out that size.
+  // Throws std::invalid_argument for a scale outside (0, 1] (NaN included).
+  void setRenderScale(float scale);
+  float renderScale() const;
   // Views per chunk (multiview: the device's limit, at most 8).
   uint32_t chunkSize() const;
   const RasterTimings& timings() const;

@@ -70,6 +70,8 @@ class Viewer {
   service::ClientStats clientStats() const { return client_->stats(); }
   bool snapshot(service::VolumeSnapshot& out) const { return client_->snapshot(out); }
   const renderer::RasterTimings& timings() const { return raster_->timings(); }
+  // Draws the next frames at this scale of the views' size (RasterRenderer::setRenderScale).
+  void setRenderScale(float scale) { raster_->setRenderScale(scale); }
   // The rule the viewer lights by now (that of the last volume rendered).
   const AreaLightRule& areaLightRule() const { return lit_; }
   const scene::AreaLightSet& areaLights() const { return raster_->areaLights(); }
