@@ -12,6 +12,7 @@ import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
 import { AreaLighting } from './area_light_shading.js';
 import { kAreaLightRuleVersion } from './area_lights.js';
+import { DisplayClock } from './display_clock.js';
 
 function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
 function median(values) {
@@ -37,6 +38,7 @@ export class ProbeStream {
     this.stopped = false;
     this.scene = null;
     this.areaKey = '';
+    this.clock = new DisplayClock();
   }
 
   // Events: 'problem' (key, message; '' when put right), 'fatal' (message: the token was refused),
@@ -80,13 +82,12 @@ export class ProbeStream {
   // The area lights' shadow maps, once after the scene changes and each frame while it moves.
   drawShadows(renderer, scene, moving = false) { this.area.drawShadows(renderer, scene, moving); }
 
-  // The display clock: the newest lighting's scene time, run on at its rate from the producer's
-  // wall clock (the machines' clocks taken to agree, as NTP keeps them).
+  // The display clock (display_clock.js): the newest lighting's scene time, run on at its rate from
+  // the producer's wall clock, the offset between the machines' clocks estimated from the messages.
   displayTime() {
     const c = this.codec;
     if (!c || !c.hasVolume()) return 0;
-    const rate = c.sceneRate();
-    return rate === 0 ? c.sceneTime() : c.sceneTime() + rate * (Date.now() * 1000 - c.sceneClockUs()) / 1e6;
+    return this.clock.at(c.sceneTime(), c.sceneRate(), c.sceneClockUs(), Date.now() * 1000);
   }
 
   onMessage(bytes) {
@@ -103,7 +104,11 @@ export class ProbeStream {
       s.representation = this.codec.representation();
       this.emit('epoch');
     }
-    if (r === 2) s.lastBrickAt = performance.now();
+    if (r === 2) {
+      s.lastBrickAt = performance.now();
+      this.clock.sample(Date.now() * 1000, this.codec.sceneClockUs());
+      s.clockOffsetMs = this.clock.offsetUs() / 1000;
+    }
     this.dirty = true;
   }
 
