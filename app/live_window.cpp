@@ -126,6 +126,30 @@ renderer::Image shrink(const renderer::Image& image, uint32_t k) {
   return out;
 }
 
+// The views as the window shows them: composed (a quilt, or the source's own image) and shrunk
+// to the window.
+renderer::Image composed(const FrameSource& source, const std::vector<renderer::Image>& images,
+                         const std::vector<renderer::ViewInfo>& views, const renderer::ViewSetSpec& spec,
+                         const WindowFit& fit) {
+  return shrink(source.compose ? source.compose(images, views)
+                               : renderer::composeQuilt(images, views, spec.columns, spec.rows),
+                fit.shrink);
+}
+
+// The status line's right part: the source's, and the scale the views are drawn at when reduced.
+std::string statusOf(const FrameSource& source, const DynamicResolution& resolution) {
+  if (resolution.scale() >= 1.0f) return source.status();
+  return fmt::format("{} | drawn at {:.0f} %", source.status(), 100.0f * resolution.scale());
+}
+
+renderer::Image black(uint32_t width, uint32_t height) {
+  renderer::Image out;
+  out.width = width;
+  out.height = height;
+  out.rgb.assign(size_t{width} * height * 3, 0.0f);
+  return out;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
@@ -212,22 +236,15 @@ LiveWindowResult runLiveWindow(const LiveWindowOptions& o, renderer::VulkanConte
       views = renderer::makeViewSet(
           trace ? session::poseCamera(camera.camera(), *trace, secondsSince(begin)) : camera.camera(), spec,
           viewSetOptions);
-    const bool drawn = source.render(views, moved, images);
-    if (drawn) {
+    if (source.render(views, moved, images)) {
       for (renderer::Image& image : images) image = upscale(image, viewWidth, viewHeight);
-      shown = shrink(source.compose ? source.compose(images, views)
-                                    : renderer::composeQuilt(images, views, spec.columns, spec.rows),
-                     fit.shrink);
+      shown = composed(source, images, views, spec, fit);
     } else {
-      shown.width = wo.width;
-      shown.height = wo.height;
-      shown.rgb.assign(size_t{wo.width} * wo.height * 3, 0.0f);
+      shown = black(wo.width, wo.height);  // nothing to draw yet
     }
     std::vector<unsigned char> rgba = imaging::toneMapRgba8(shown.rgb, exposure, toneMap);
     const double lastMs = frameMs.empty() ? 0.0 : frameMs.back();
-    const std::string status = source.status() + (resolution.scale() < 1.0f
-                                                       ? fmt::format(" | drawn at {:.0f} %", 100.0f * resolution.scale())
-                                                       : std::string());
+    const std::string status = statusOf(source, resolution);
     if (o.overlay)
       imaging::drawTextLine(rgba, static_cast<int>(shown.width), static_cast<int>(shown.height), 6, 0,
                             fmt::format("{:.1f} ms | {}", lastMs, status), shown.width >= 1280 ? 2 : 1);
