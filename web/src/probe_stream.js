@@ -73,10 +73,11 @@ export class ProbeStream {
 
   // The scene the stream's area lights are chosen from (its glTF root and GLTFLoader parser, posed
   // as drawn); renderer: the WebGLRenderer (whether it can draw their shadows). Call again when
-  // nodes move (moved: true).
-  setScene(root, parser, renderer, moved = false) {
+  // nodes move: the lights are chosen again from the posed scene.
+  setScene(root, parser, renderer) {
     this.scene = { root, parser, canShadow: renderer.extensions.has('EXT_color_buffer_float') };
-    this.followAreaLights(moved);
+    this.areaKey = '';  // chosen again whatever the rule
+    this.followAreaLights();
   }
 
   // The area lights' shadow maps, once after the scene changes and each frame while it moves.
@@ -112,16 +113,15 @@ export class ProbeStream {
     this.dirty = true;
   }
 
-  // The emitters the stream's rule leaves to viewers, chosen again when the scene, the rule or
-  // (`moved`) the pose changes. A rule newer than this module's, or no float targets, is named.
-  followAreaLights(moved = false) {
+  // The emitters the stream's rule leaves to viewers, chosen again when the scene or the rule
+  // changes (setScene, each refresh). A rule newer than this module's, or no float targets, is named.
+  followAreaLights() {
     const c = this.codec;
     if (!c || !c.hasVolume() || !this.scene) return;
     const rule = c.areaLightRule(), share = c.areaLightShare();
     const key = `${c.sceneHash()}/${rule}/${share}`;
-    if (key === this.areaKey && !moved && this.scene.followed) return;
+    if (key === this.areaKey) return;
     this.areaKey = key;
-    this.scene.followed = true;
     const known = rule === 0 || rule === kAreaLightRuleVersion;
     const s = this.status;
     s.areaLights = this.area.setScene(this.scene.root, this.scene.parser, rule !== 0 && known ? share : null, this.scene.canShadow);

@@ -140,7 +140,7 @@ function frame(now, xrFrame) {
     // Lights on moving nodes move: chosen again, and their maps drawn, when the pose changed.
     const moved = animation && state.sceneTime !== areaLightsPosedAt;
     areaLightsPosedAt = state.sceneTime;
-    if (moved) stream.setScene(loadedScene.root, loadedScene.parser, renderer, true);
+    if (moved) stream.setScene(loadedScene.root, loadedScene.parser, renderer);
     stream.drawShadows(renderer, scene, moved);
   }
   if (lookingGlass) {
@@ -327,7 +327,6 @@ async function loadScene(manifestText, hash) {
   });
   fitSunShadows(gltf.scene);
   new THREE.Box3().setFromObject(gltf.scene).getCenter(sceneCentre);
-  state.emitters = countEmitters(gltf.scene);
   loadedScene = { root: gltf.scene, parser: gltf.parser };
   camera = pickCamera(gltf);
   // The scene's animation, every clip at once, looped over the longest (as the native viewers).
@@ -420,17 +419,6 @@ function fitSunShadows(root) {
     o.shadow.bias = -0.0002;
     o.shadow.normalBias = 1.5 * Math.max(bounds.max.x - bounds.min.x, bounds.max.y - bounds.min.y) / size;
   });
-}
-
-// Meshes whose material emits: the only surfaces a stream's area-light rule can leave to the page.
-function countEmitters(root) {
-  let n = 0;
-  root.traverse((o) => {
-    if (!o.isMesh) return;
-    for (const m of Array.isArray(o.material) ? o.material : [o.material])
-      if (m.emissive && m.emissive.getHex() !== 0 && (m.emissiveIntensity ?? 1) > 0) n += 1;
-  });
-  return n;
 }
 
 function pickCamera(gltf) {
