@@ -7,6 +7,7 @@
 import * as THREE from 'three';
 import { extractAreaLights, kMaxAreaLights, kMaxAreaTriangles } from './area_lights.js';
 import { sceneEmitters } from './scene_emitters.js';
+import { drawOffscreen, isSeeThrough } from './offscreen.js';
 import areaLightMath from '../../shaders/area_light_math.h';
 import bsdf from '../../shaders/bsdf.h';
 
@@ -104,42 +105,19 @@ export class AreaLighting {
   drawShadows(renderer, scene, moving) {
     if (!this.shadowed || (!this.dirty && !moving)) return;
     this.dirty = false;
-    const saved = { target: renderer.getRenderTarget(), auto: renderer.shadowMap.autoUpdate, needs: renderer.shadowMap.needsUpdate,
-                    background: scene.background, override: scene.overrideMaterial, clear: renderer.getClearColor(new THREE.Color()),
-                    alpha: renderer.getClearAlpha(), scissor: renderer.getScissorTest() };
-    const hidden = [];
-    scene.traverse((o) => {
-      const mats = o.isMesh ? (Array.isArray(o.material) ? o.material : [o.material]) : [];
-      const seeThrough = mats.some((m) => m && (m.transparent || m.transmission > 0));
-      if (o.visible && (seeThrough || o.userData.probecastBackground)) { hidden.push(o); o.visible = false; }
+    const hide = (o) => isSeeThrough(o) || o.userData.probecastBackground;
+    // 1: the far plane.
+    drawOffscreen(renderer, scene, { target: this.target, clearColor: 0xffffff, clearAlpha: 1, override: this.depthMaterial, hide }, () => {
+      this.cameras.forEach(({ cam, centroid, axis, far }, i) => {
+        this.depthMaterial.uniforms.alOrigin.value.copy(centroid);
+        this.depthMaterial.uniforms.alAxis.value.copy(axis);
+        this.depthMaterial.uniforms.alFar.value = far;
+        this.target.viewport.set(i * kShadowSize, 0, kShadowSize, kShadowSize);
+        this.target.scissor.set(i * kShadowSize, 0, kShadowSize, kShadowSize);
+        renderer.setRenderTarget(this.target);
+        renderer.render(scene, cam);
+      });
     });
-    renderer.shadowMap.autoUpdate = false;
-    renderer.shadowMap.needsUpdate = false;
-    scene.background = null;
-    scene.overrideMaterial = this.depthMaterial;
-    renderer.setClearColor(0xffffff, 1);  // 1: the far plane
-    this.target.scissor.set(0, 0, this.target.width, this.target.height);
-    this.target.viewport.set(0, 0, this.target.width, this.target.height);
-    renderer.setRenderTarget(this.target);
-    renderer.clear();
-    this.cameras.forEach(({ cam, centroid, axis, far }, i) => {
-      this.depthMaterial.uniforms.alOrigin.value.copy(centroid);
-      this.depthMaterial.uniforms.alAxis.value.copy(axis);
-      this.depthMaterial.uniforms.alFar.value = far;
-      this.target.viewport.set(i * kShadowSize, 0, kShadowSize, kShadowSize);
-      this.target.scissor.set(i * kShadowSize, 0, kShadowSize, kShadowSize);
-      this.target.scissorTest = true;
-      renderer.setRenderTarget(this.target);
-      renderer.render(scene, cam);
-    });
-    this.target.scissorTest = false;
-    for (const o of hidden) o.visible = true;
-    scene.overrideMaterial = saved.override;
-    scene.background = saved.background;
-    renderer.setClearColor(saved.clear, saved.alpha);
-    renderer.shadowMap.autoUpdate = saved.auto;
-    renderer.shadowMap.needsUpdate = saved.needs;
-    renderer.setRenderTarget(saved.target);
   }
 }
 

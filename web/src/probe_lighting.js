@@ -1,18 +1,23 @@
 // Indirect light from the probe volume in three.js's physical material, as the native raster
 // client computes it (shaders/raster.frag): the 8 probes of a point's cell weighted by trilinear ×
-// backface × activity (probeCoefficientsVisible, without its per-probe depth moments: the browser
-// has no visibility maps yet, docs/WEB.md); diffuse base (1 − metallic) / π · E(n) with
+// backface × activity × Chebyshev visibility from each probe's distance moments
+// (probeCoefficientsVisible; the moments from probe_visibility.js, the weights without them until
+// the first map is made); diffuse base (1 − metallic) / π · E(n) with
 // E(n) = Σ Â_l c_lm Y_lm(n) (sh.h: L2 SH of incident radiance), and glossy by the split sum,
 // Σ_l g_l(roughness) c_lm Y_lm(R) · (F0·A + B) (glossy_sh.h). Both are added to three's reflected
 // light directly, so that three's own energy split does not scale them.
 import * as THREE from 'three';
+import { kOct, kTile, kTilesPerRow } from './probe_visibility.js';
 
 const kTexels = 7;  // 27 coefficients and a pad per probe: 7 RGBA texels along x
 
 export class ProbeLighting {
-  // area: an AreaLighting (area_light_shading.js) whose lights the patched materials draw too, or null.
-  constructor(area = null) {
+  // area: an AreaLighting (area_light_shading.js) whose lights the patched materials draw too, or null;
+  // visibility: a ProbeVisibility (probe_visibility.js) whose moments weigh the probes, or null.
+  constructor(area = null, visibility = null) {
     this.area = area;
+    this.visibility = visibility;
+    this.positions = new Float32Array(0);  // xyz a probe: grid point plus offset
     this.uniforms = {
       pcProbes: { value: null },
       pcPositions: { value: null },
@@ -20,6 +25,7 @@ export class ProbeLighting {
       pcMax: { value: new THREE.Vector3() },
       pcDims: { value: new THREE.Vector3(1, 1, 1) },
       pcOn: { value: 0 },
+      ...(visibility ? visibility.uniforms : { pcVis: { value: null }, pcVisOn: { value: 0 }, pcReach: { value: 1e30 } }),
     };
     this.dims = null;
   }
@@ -46,6 +52,7 @@ export class ProbeLighting {
     }
     const coef = this.uniforms.pcProbes.value.image.data;
     const pos = this.uniforms.pcPositions.value.image.data;
+    if (this.positions.length !== 3 * count) this.positions = new Float32Array(3 * count);
     const step = [0, 1, 2].map((a) => (dims[a] > 1 ? (bounds.max[a] - bounds.min[a]) / (dims[a] - 1) : 0));
     for (let i = 0; i < count; ++i) {
       const x = i % nx, y = Math.floor(i / nx) % ny, z = Math.floor(i / (nx * ny));
@@ -59,6 +66,7 @@ export class ProbeLighting {
       pos[p + 1] = g[1] + o[1];
       pos[p + 2] = g[2] + o[2];
       pos[p + 3] = active[i] ? 1 : 0;
+      this.positions.set(pos.subarray(p, p + 3), 3 * i);
     }
     this.uniforms.pcProbes.value.needsUpdate = true;
     this.uniforms.pcPositions.value.needsUpdate = true;
@@ -66,6 +74,7 @@ export class ProbeLighting {
     this.uniforms.pcMax.value.fromArray(bounds.max);
     this.uniforms.pcDims.value.fromArray(dims);
     this.uniforms.pcOn.value = 1;
+    this.grid = { dims: dims.slice(), bounds: { min: bounds.min.slice(), max: bounds.max.slice() } };
   }
 
   // Patches a MeshStandardMaterial / MeshPhysicalMaterial to add the probes' irradiance.
@@ -84,8 +93,12 @@ export class ProbeLighting {
   if (pcOn > 0.5) {
     vec3 pcN = normalize(vPcNormal) * faceDirection;
     vec3 pcV = normalize(cameraPosition - vPcWorld);
+    // The geometric normal on the viewer's side, from the position's screen derivatives (raster.frag).
+    vec3 pcNg = cross(dFdx(vPcWorld), dFdy(vPcWorld));
+    pcNg = length(pcNg) > 1e-20 ? normalize(pcNg) : pcV;
+    if (dot(pcNg, pcV) < 0.0) pcNg = -pcNg;
     float pcC[28];
-    if (pcCoefficients(vPcWorld, pcN, pcC)) {
+    if (pcCoefficients(vPcWorld, pcNg, pcV, pcC)) {
       reflectedLight.indirectDiffuse += diffuseColor.rgb * (1.0 - metalnessFactor) * RECIPROCAL_PI * pcIrradiance(pcC, pcN);
       vec3 pcF0 = mix(vec3(0.04), diffuseColor.rgb, metalnessFactor);
       vec2 pcAB = texture2D(dfgLUT, vec2(roughnessFactor, saturate(dot(pcN, pcV)))).rg;
@@ -106,11 +119,39 @@ uniform vec3 pcMin;
 uniform vec3 pcMax;
 uniform vec3 pcDims;
 uniform float pcOn;
+precision highp sampler2D;
+uniform sampler2D pcVis;
+uniform float pcVisOn;
+uniform float pcReach;
 varying vec3 vPcWorld;
 varying vec3 vPcNormal;
 
-// The 27 coefficients at p (normal n) from the 8 probes of its cell; false where no probe lights it.
-bool pcCoefficients(vec3 p, vec3 n, out float s[28]) {
+// Octahedral map of unit directions to [-1, 1]² (probe_visibility.js's octEncode).
+vec2 pcOctEncode(vec3 v) {
+  vec2 e = v.xy / (abs(v.x) + abs(v.y) + abs(v.z));
+  if (v.z < 0.0) e = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);
+  return e;
+}
+
+// (E[r], E[r²]) of probe index toward dir, bilinear inside its tile (the border repeats the
+// texels across the octahedron's edges), as the native sampler filters the atlas.
+vec2 pcMomentsToward(int index, vec3 dir) {
+  ivec2 tile = ivec2(index % ${kTilesPerRow}, index / ${kTilesPerRow}) * ${kTile};
+  vec2 t = vec2(tile) + 1.0 + (pcOctEncode(dir) * 0.5 + 0.5) * ${kOct}.0 - 0.5;
+  ivec2 i = ivec2(floor(t));
+  vec2 f = t - vec2(i);
+  vec2 a = mix(texelFetch(pcVis, i, 0).xy, texelFetch(pcVis, i + ivec2(1, 0), 0).xy, f.x);
+  vec2 b = mix(texelFetch(pcVis, i + ivec2(0, 1), 0).xy, texelFetch(pcVis, i + ivec2(1, 1), 0).xy, f.x);
+  return mix(a, b, f.y);
+}
+
+// The 27 coefficients at p (geometric normal ng on the viewer's side, towards the viewer wo) from
+// the 8 probes of its cell, each weighted by trilinear × backface × Chebyshev visibility: the
+// point, moved off the surface along ng and wo by a fraction of the probe spacing, is visible from
+// a probe with probability at least σ²/(σ² + (r − μ)²) when farther than the mean distance μ of
+// what the probe sees that way (both no farther than the probe's reach). False where no probe
+// lights it.
+bool pcCoefficients(vec3 p, vec3 ng, vec3 wo, out float s[28]) {
   for (int i = 0; i < 28; ++i) s[i] = 0.0;
   vec3 dims = pcDims;
   ivec3 last = ivec3(dims) - 1;
@@ -120,6 +161,8 @@ bool pcCoefficients(vec3 p, vec3 n, out float s[28]) {
   vec3 a = clamp(g - vec3(base), vec3(0.0), vec3(1.0));
   vec3 cell = extent / max(dims - 1.0, vec3(1.0));
   float spacing = min(dims.x > 1.0 ? cell.x : 1e9, min(dims.y > 1.0 ? cell.y : 1e9, dims.z > 1.0 ? cell.z : 1e9));
+  spacing = spacing < 1e9 ? spacing : 1.0;
+  vec3 q = p + (0.2 * ng + 0.8 * wo) * (0.75 * 0.3 * spacing);
   vec4 c[7];
   for (int t = 0; t < 7; ++t) c[t] = vec4(0.0);
   float total = 0.0;
@@ -133,9 +176,24 @@ bool pcCoefficients(vec3 p, vec3 n, out float s[28]) {
     if (trilinear <= 0.0 || probe.w < 0.5) continue;
     vec3 toProbe = probe.xyz - p;
     float len = length(toProbe);
-    float facing = len > 1e-6 ? (dot(toProbe / len, n) + 1.0) * 0.5 : 1.0;
-    anyInFront = anyInFront || dot(toProbe, n) > -1e-3 * spacing;
-    float w = (facing * facing + 0.2) * trilinear;
+    float facing = len > 1e-6 ? (dot(toProbe / len, ng) + 1.0) * 0.5 : 1.0;
+    anyInFront = anyInFront || dot(toProbe, ng) > -1e-3 * spacing;
+    float w = facing * facing + 0.2;
+    if (pcVisOn > 0.5) {
+      vec3 fromProbe = q - probe.xyz;
+      float r = length(fromProbe);
+      vec2 m = pcMomentsToward(idx.x + int(dims.x) * (idx.y + int(dims.y) * idx.z), r > 1e-6 ? fromProbe / r : ng);
+      r = min(r, pcReach);  // beyond its reach a point is tested as if at it
+      if (r > m.x) {
+        float variance = abs(m.y - m.x * m.x);
+        float d = r - m.x;
+        float chebyshev = variance / (variance + d * d);
+        w *= chebyshev * chebyshev * chebyshev;
+      }
+      if (w < 0.2) w *= w * w / (0.2 * 0.2);  // a mostly hidden probe adds nothing
+    }
+    w *= trilinear;
+    if (w <= 0.0) continue;
     for (int t = 0; t < 7; ++t) c[t] += w * texelFetch(pcProbes, ivec3(idx.x * 7 + t, idx.y, idx.z), 0);
     total += w;
   }

@@ -11,6 +11,7 @@ import { connect, DeliverPolicy } from 'nats.ws';
 import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
 import { AreaLighting } from './area_light_shading.js';
+import { ProbeVisibility } from './probe_visibility.js';
 import { kAreaLightRuleVersion } from './area_lights.js';
 import { DisplayClock } from './display_clock.js';
 
@@ -28,7 +29,8 @@ export class ProbeStream {
     if (!/^[A-Za-z0-9_-]+$/.test(stream)) throw new Error(`ProbeStream: "${stream}" is not a stream name (letters, digits, - and _)`);
     this.config = { servers, token, stream };
     this.area = new AreaLighting();
-    this.lighting = new ProbeLighting(this.area);
+    this.visibility = new ProbeVisibility();
+    this.lighting = new ProbeLighting(this.area, this.visibility);
     this.codec = null;
     // What a status line shows: the connection, counts, the volume's checksum and representation.
     this.status = { connection: 'starting', messages: 0, bytes: 0, epochs: 0, checksum: '', bricks: 0, bricksHeld: 0,
@@ -75,13 +77,26 @@ export class ProbeStream {
   // as drawn); renderer: the WebGLRenderer (whether it can draw their shadows). Call again when
   // nodes move: the lights are chosen again from the posed scene.
   setScene(root, parser, renderer) {
-    this.scene = { root, parser, canShadow: renderer.extensions.has('EXT_color_buffer_float') };
+    const canShadow = renderer.extensions.has('EXT_color_buffer_float');
+    this.scene = { root, parser, canShadow };
     this.areaKey = '';  // chosen again whatever the rule
     this.followAreaLights();
+    if (canShadow) this.visibility.setRoot(root);  // the probes' depth cubes need float targets too
+    this.requestVisibility();
   }
 
-  // The area lights' shadow maps, once after the scene changes and each frame while it moves.
-  drawShadows(renderer, scene, moving = false) { this.area.drawShadows(renderer, scene, moving); }
+  // The area lights' shadow maps, once after the scene changes and each frame while it moves, and
+  // the probes' visibility while it is being made (a few batches a frame).
+  drawShadows(renderer, scene, moving = false) {
+    this.area.drawShadows(renderer, scene, moving);
+    this.visibility.draw(renderer, scene, moving);
+  }
+
+  // Visibility for the probes the lighting holds, made again when they or the scene change.
+  requestVisibility() {
+    const g = this.lighting.grid;
+    if (g) this.visibility.request(this.lighting.positions, g.dims, g.bounds);
+  }
 
   // The display clock (display_clock.js): the newest lighting's scene time, run on at its rate from
   // the producer's wall clock, the offset between the machines' clocks estimated from the messages.
@@ -133,6 +148,7 @@ export class ProbeStream {
   // The newest volume into the lighting, at most ten times a second.
   refresh() {
     this.followAreaLights();
+    this.status.visibility = { ...this.visibility.status };
     const c = this.codec;
     if (!this.dirty || !c.hasVolume()) return;
     this.dirty = false;
@@ -142,6 +158,7 @@ export class ProbeStream {
     s.checksum = c.checksum();
     s.decodeMs = median(c.decodeMs);
     this.lighting.update(c.dims(), c.bounds(), c.probes(), c.active(), c.offsets());
+    this.requestVisibility();
   }
 
   async connectBus() {
