@@ -7,12 +7,22 @@
 import * as THREE from 'three';
 import { extractAreaLights, kMaxAreaLights, kMaxAreaTriangles } from './area_lights.js';
 import { sceneEmitters } from './scene_emitters.js';
-import { drawOffscreen, isSeeThrough } from './offscreen.js';
+import { drawOffscreen, kMapCutout, kMapHeader, leftOutOfMaps, MapMaterials } from './offscreen.js';
 import areaLightMath from '../../shaders/area_light_math.h';
 import bsdf from '../../shaders/bsdf.h';
 
 const kShadowSize = 512;       // texels a side of each light's map (RasterOptions::areaShadowMapSize)
 const kShadowFovDegrees = 150;  // renderer/src/area_light_shadows.h
+
+// The maps' fragments: distance along the light's axis over its far distance (posed meshes, cut-outs cut).
+const kAreaDepthFragment = /* glsl */ `${kMapHeader}
+uniform vec3 alOrigin;
+uniform vec3 alAxis;
+uniform float alFar;
+void main() {
+${kMapCutout}
+  gl_FragColor = vec4(dot(vWorldPosition - alOrigin, alAxis) / alFar, 0.0, 0.0, 1.0);
+}`;
 
 export class AreaLighting {
   constructor() {
@@ -37,12 +47,8 @@ export class AreaLighting {
     this.target = null;
     this.shadowed = false;
     this.dirty = false;
-    this.depthMaterial = new THREE.ShaderMaterial({
-      uniforms: { alOrigin: { value: new THREE.Vector3() }, alAxis: { value: new THREE.Vector3() }, alFar: { value: 1 } },
-      vertexShader: 'varying vec3 vAlWorld;\nvoid main() {\n  vec4 w = modelMatrix * vec4(position, 1.0);\n  vAlWorld = w.xyz;\n  gl_Position = projectionMatrix * viewMatrix * w;\n}',
-      fragmentShader: 'uniform vec3 alOrigin;\nuniform vec3 alAxis;\nuniform float alFar;\nvarying vec3 vAlWorld;\nvoid main() { gl_FragColor = vec4(dot(vAlWorld - alOrigin, alAxis) / alFar, 0.0, 0.0, 1.0); }',
-      side: THREE.DoubleSide,
-    });
+    this.depthUniforms = { alOrigin: { value: new THREE.Vector3() }, alAxis: { value: new THREE.Vector3() }, alFar: { value: 1 } };
+    this.depthMaterials = new MapMaterials(kAreaDepthFragment, this.depthUniforms);
   }
 
   // The lights of `root` under the stream's rule (share: its threshold; null: no client lights).
@@ -105,13 +111,12 @@ export class AreaLighting {
   drawShadows(renderer, scene, moving) {
     if (!this.shadowed || (!this.dirty && !moving)) return;
     this.dirty = false;
-    const hide = (o) => isSeeThrough(o) || o.userData.probecastBackground;
     // 1: the far plane.
-    drawOffscreen(renderer, scene, { target: this.target, clearColor: 0xffffff, clearAlpha: 1, override: this.depthMaterial, hide }, () => {
+    drawOffscreen(renderer, scene, { target: this.target, clearColor: 0xffffff, clearAlpha: 1, materials: this.depthMaterials, hide: leftOutOfMaps }, () => {
       this.cameras.forEach(({ cam, centroid, axis, far }, i) => {
-        this.depthMaterial.uniforms.alOrigin.value.copy(centroid);
-        this.depthMaterial.uniforms.alAxis.value.copy(axis);
-        this.depthMaterial.uniforms.alFar.value = far;
+        this.depthUniforms.alOrigin.value.copy(centroid);
+        this.depthUniforms.alAxis.value.copy(axis);
+        this.depthUniforms.alFar.value = far;
         this.target.viewport.set(i * kShadowSize, 0, kShadowSize, kShadowSize);
         this.target.scissor.set(i * kShadowSize, 0, kShadowSize, kShadowSize);
         renderer.setRenderTarget(this.target);

@@ -9,7 +9,7 @@
 // is used until the new one is whole. While the scene moves, the probes within reach of what moved
 // are drawn again.
 import * as THREE from 'three';
-import { drawOffscreen, isSeeThrough } from './offscreen.js';
+import { drawOffscreen, kMapCutout, kMapHeader, leftOutOfMaps, MapMaterials } from './offscreen.js';
 
 export const kCube = 32;            // texels a side of each cube face (kVisibilityCubeSize)
 const kLobeCube = kCube / 2;        // the faces are averaged 2×2 before the lobes
@@ -138,19 +138,11 @@ export function visibilityReach(dims, bounds, extent) {
   return 1.5 * Math.hypot(...cell) + 0.25 * Math.min(...steps);
 }
 
-const kDistanceFragment = /* glsl */ `
-#define DISTANCE
+// The cubes' fragments: distance from the probe (posed meshes, cut-outs cut).
+const kDistanceFragment = /* glsl */ `${kMapHeader}
 uniform vec3 pvProbe;
-uniform float opacity;
-varying vec3 vWorldPosition;
-#include <common>
-#include <uv_pars_fragment>
-#include <map_pars_fragment>
-#include <alphatest_pars_fragment>
 void main() {
-  vec4 diffuseColor = vec4(1.0, 1.0, 1.0, opacity);
-  #include <map_fragment>
-  #include <alphatest_fragment>
+${kMapCutout}
   gl_FragColor = vec4(length(vWorldPosition - pvProbe), 0.0, 0.0, 1.0);
 }`;
 
@@ -162,8 +154,7 @@ export class ProbeVisibility {
       pcReach: { value: 1e30 },
     };
     this.probe = { value: new THREE.Vector3() };
-    this.solid = this.distanceMaterial(null);
-    this.cutouts = new WeakMap();  // a cut-out material → its distance material
+    this.materials = new MapMaterials(kDistanceFragment, { pvProbe: this.probe });
     this.status = { probes: 0, ms: 0, ready: false, batches: 0 };
     this.root = null;
     this.requested = null;  // the probes and reach of the last request
@@ -171,22 +162,6 @@ export class ProbeVisibility {
     this.built = null;  // { positions, reach, far, atlas, width, height } of the map in use
     this.boxes = new Map();
     this.target = null;
-  }
-
-  distanceMaterial(cutout) {
-    const m = new THREE.ShaderMaterial({
-      uniforms: { pvProbe: this.probe, opacity: { value: cutout ? cutout.opacity : 1 },
-                  map: { value: cutout?.map ?? null }, mapTransform: { value: cutout?.map?.matrix ?? new THREE.Matrix3() },
-                  alphaTest: { value: cutout?.alphaTest ?? 0 } },
-      vertexShader: THREE.ShaderLib.distance.vertexShader,
-      fragmentShader: kDistanceFragment,
-      side: THREE.DoubleSide,
-    });
-    if (cutout) {
-      m.map = cutout.map;  // USE_MAP and its uv channel
-      m.alphaTest = cutout.alphaTest;
-    }
-    return m;
   }
 
   // The scene the probes see (the glTF root, posed); a new root is drawn again whole.
@@ -325,35 +300,14 @@ export class ProbeVisibility {
 
   // Runs `draw` with every opaque mesh drawn in distance (cut-outs cut as their material cuts) and
   // everything else hidden: see-through casters, the background, points, lines and sprites, as the
-  // native cubes leave them out.
+  // native cubes leave them out. Alpha 0: nothing seen that way.
   withDistanceMaterials(renderer, scene, draw) {
-    const hide = (o) => (o.isMesh ? isSeeThrough(o) || o.userData.probecastBackground : o.isPoints || o.isLine || o.isSprite);
-    // Alpha 0: nothing seen that way.
-    drawOffscreen(renderer, scene, { target: this.target, clearColor: 0x000000, clearAlpha: 0, hide }, () => {
-      const swapped = [];
-      scene.traverse((o) => {
-        if (!o.isMesh || !o.visible) return;
-        swapped.push([o, o.material]);
-        o.material = Array.isArray(o.material) ? o.material.map((m) => this.distanceFor(m)) : this.distanceFor(o.material);
-      });
-      try {
-        draw();
-      } finally {
-        for (const [o, m] of swapped) o.material = m;
-      }
-    });
-  }
-
-  distanceFor(m) {
-    if (!(m?.alphaTest > 0 && m.map)) return this.solid;
-    let d = this.cutouts.get(m);
-    if (!d) this.cutouts.set(m, (d = this.distanceMaterial(m)));
-    return d;
+    drawOffscreen(renderer, scene, { target: this.target, clearColor: 0x000000, clearAlpha: 0, materials: this.materials, hide: leftOutOfMaps }, draw);
   }
 
   dispose() {
     this.target?.dispose();
     this.uniforms.pcVis.value?.dispose();
-    this.solid.dispose();
+    this.materials.dispose();
   }
 }
