@@ -47,7 +47,8 @@ void addVideoOptions(CLI::App* cmd, TracingOptions& vt, VideoCli& vo) {
   cmd->add_option("--head-trace", vo.headTrace,
                   "move every display's camera as a recorded head moved (a file of timestamp viewpoint w x y z per line, x "
                   "forward, z up: the MMSys'18 head-movement format; or builtin:mmsys18-user1, 10 s of one), with a neck "
-                  "model; default: the camera is still");
+                  "model; or along a scripted camera path (a file starting probecast-camera-path 1, lines of seconds "
+                  "forward right up yaw pitch; or builtin:walk-1m); default: the camera is still");
   cmd->add_option("--truth-updates", vo.bench.truthUpdates,
                   "also score the streams and the videos against converged truth: each recorded moment's probes traced "
                   "from scratch for this many updates (0: only against the float-probe render)")

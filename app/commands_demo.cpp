@@ -53,8 +53,9 @@ void addDemoCommand(CLI::App& app) {
   demo->add_option("--ffmpeg", o->ffmpeg, "the ffmpeg that --video runs")->capture_default_str();
   demo->add_option("--head-trace", o->headTrace,
                    "--video: the headset's camera turns as this recorded head turned (a trace file in the MMSys'18 "
-                   "format, or builtin:mmsys18-user1: 10 s of a person in a headset); none: a still camera. The "
-                   "light-field display stays still")
+                   "format, or builtin:mmsys18-user1: 10 s of a person in a headset), or follows a camera path "
+                   "(probecast-camera-path 1, or builtin:walk-1m); none: a still camera. The light-field display "
+                   "stays still")
       ->capture_default_str();
   o->environment.add(demo);
   demo->callback([o] {

@@ -129,8 +129,9 @@ std::string runVideoComparison(const DemoOptions& o, const DemoRun& run, const s
         "stream's PSNR against the float frames; ≥ or ≤ where the sweep does not reach it. Data: "
         "[video.json](video.json); `probecast bench video` measures more motions, displays and codecs.\n\n```\n{}```\n",
         o.repr,
-        vo.headTrace ? fmt::format("The headset's camera turns as a recorded head turned ({}), the light-field "
-                                   "display's stays still.", o.headTrace)
+        vo.headTrace ? fmt::format("The headset's camera {} ({}), the light-field display's stays still.",
+                                   vo.headTrace->isPath() ? "follows a scripted path" : "turns as a recorded head turned",
+                                   o.headTrace)
                      : std::string("Both cameras still."),
         r.table);
     report["video"] = r.json;

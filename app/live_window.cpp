@@ -71,7 +71,8 @@ std::shared_ptr<const session::HeadTrace> loadWindowTrace(const std::string& spe
   auto trace = std::make_shared<session::HeadTrace>();
   std::string error;
   if (!session::loadHeadTrace(spec, *trace, error)) throw std::runtime_error("--head-trace " + error);
-  fmt::print("window: the camera turns as {} turned ({:.1f} s, looping)\n", spec, trace->duration());
+  fmt::print("window: the camera {} ({:.1f} s, looping)\n",
+             trace->isPath() ? "follows " + spec : "turns as " + spec + " turned", trace->duration());
   return trace;
 }
 
@@ -185,7 +186,8 @@ void LiveWindowOptions::add(CLI::App* cmd) {
   cmd->add_option("--head-trace", headTrace,
                   "--window: the camera turns as a recorded head turned, from the window's opening, looping (a file "
                   "of timestamp viewpoint w x y z lines, the MMSys'18 format, or builtin:mmsys18-user1), with a neck "
-                  "model; the mouse and keys still move it")
+                  "model; or follows a camera path (a file starting probecast-camera-path 1, or builtin:walk-1m); the "
+                  "mouse and keys still move it")
       ->check([](const std::string& spec) {
         session::HeadTrace trace;
         std::string error;

@@ -656,9 +656,10 @@ VideoBenchResult videoResult(const VideoSetup& s, const VideoReport& report) {
             {"seconds", s.seconds},
             {"warmup_updates", o.warmup},
             {"gop", o.gop},
-            {"camera", o.headTrace ? fmt::format("a recorded head's motion ({:.1f} s trace), neck model {} m ahead, {} m up",
-                                                 o.headTrace->duration(), session::kNeckForward, session::kNeckUp)
-                                   : std::string("still")},
+            {"camera", !o.headTrace         ? std::string("still")
+                       : o.headTrace->isPath() ? fmt::format("a scripted camera path ({:.1f} s, looping)", o.headTrace->duration())
+                                               : fmt::format("a recorded head's motion ({:.1f} s trace), neck model {} m ahead, {} m up",
+                                                             o.headTrace->duration(), session::kNeckForward, session::kNeckUp)},
             {"x265", fmt::format("libx265, preset {}, tune zerolatency (no B-frames, no lookahead)", o.preset)},
             {"av1", "libaom-av1, realtime usage, cpu-used 6, no lag"},
             {"psnr", "8-bit RGB of every frame against the float-probe render's, from the summed squared error"},
