@@ -17,8 +17,10 @@ it before the display shows the movement. Each component is measured here, not a
     sent down at the display rate over TCP; and a `probecast serve` -> `probecast subscribe` over
     the same link for the lighting's age.
 
-Video's pose-to-photon = pose up + render + encode + frame down + decode (each component's median;
-the p99 column sums the components' p99s, an upper bound). JSON (--json) and an SVG chart (--svg).
+Video's pose-to-photon = pose up + render + encode + frame down + decode: the link terms' medians
+(and, for the p99 column, their p99s) with the drawing's median and the codec's mean time a frame
+over the whole run (ffmpeg's start included: throughput, which a frame's latency is at least).
+JSON (--json) and an SVG chart (--svg).
 Needs root (network namespaces), iproute2 and ffmpeg.
 
   sudo bench/motion_to_photon.py --probecast build/probecast --wan-link build/testing/wan_link \\
@@ -73,10 +75,14 @@ def equal_quality_points(video):
     stream (or the closest point when none is), with its bitstream and encode time a frame."""
     points = []
     for r in video["results"]:
+        if r["view_set"] != "stereo":
+            continue  # the headset's run (a --video-json may hold other displays too)
         for s in r["streams"]:
             for v in r["video"]:
-                sweep = v["sweep"]
-                good = [p for p in sweep if p["psnr_db"] >= s["psnr_db"]]
+                # "identical": a point equal to the reference frame for frame, as close as any.
+                sweep = [dict(p, psnr_db=float("inf") if p["psnr_db"] == "identical" else p["psnr_db"]) for p in v["sweep"]]
+                stream_db = float("inf") if s["psnr_db"] == "identical" else s["psnr_db"]
+                good = [p for p in sweep if p["psnr_db"] >= stream_db]
                 p = min(good, key=lambda q: q["bytes_per_second"]) if good else max(sweep, key=lambda q: q["psnr_db"])
                 ext = "hevc" if v["encoder"] == "libx265" else "obu"
                 bitstream = os.path.join(video["kept_files"], "%s-%s-%s-crf%d.%s" % (r["motion"], r["display"], v["codec"], p["crf"], ext))

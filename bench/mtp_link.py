@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from wan_bench import Run  # noqa: E402
 
 PORT = 9100
-POSE = struct.Struct("<dI28x")  # send time, sequence, a pose's 28 bytes (position and orientation)
+POSE = struct.Struct("<dI28x")  # 40 bytes: send time, sequence, a pose's 28 (position, orientation)
 FRAME = struct.Struct("<dI")     # send time, payload bytes
 SETTLE_S = 1.0                    # the first second (TCP's slow start) is left out
 
@@ -67,7 +67,8 @@ def server(a):
         due = start + i / a.fps
         time.sleep(max(0.0, due - time.time()))
         n = sizes[i % len(sizes)]
-        conn.sendall(FRAME.pack(time.time(), n) + os.urandom(n))
+        # Stamped when it is due (made): time spent behind earlier frames on a slow link counts.
+        conn.sendall(FRAME.pack(due, n) + os.urandom(n))
         i += 1
     conn.shutdown(socket.SHUT_WR)
     t.join(timeout=a.seconds + 30)
@@ -83,6 +84,8 @@ def client(a):
             break
         except OSError:
             time.sleep(0.1)
+    if sock is None:
+        sys.exit("mtp_link client: cannot connect to 10.88.0.1:%d through the link" % PORT)
     sock.settimeout(None)
     sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     stop = threading.Event()
@@ -156,6 +159,8 @@ def measure(a, work, profile, size_lists, fps):
     with Run(a, folder, profile, "direct", True) as r:
         traffics = [traffic(r, a, folder, sizes, fps) for sizes in size_lists]
         age = lighting_age(r, a, folder)
+    if not age:
+        raise RuntimeError("%s: the subscriber applied no frame after its first 3 s (see %s)" % (profile, folder))
     out = []
     for up, down, late in traffics:
         log("%s: pose up %.1f ms, frame down %.1f ms (p99 %.1f), %d frames late, lighting %.0f ms old"

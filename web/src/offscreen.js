@@ -11,9 +11,11 @@ export function isSeeThrough(o) {
 }
 
 // What the maps leave out, as the native ones do: see-through meshes, the page's background, and
-// points, lines and sprites.
+// points, lines and sprites; and what the page does not draw (meshes whose materials are hidden).
 export function leftOutOfMaps(o) {
-  return o.isMesh ? isSeeThrough(o) || !!o.userData.probecastBackground : !!(o.isPoints || o.isLine || o.isSprite);
+  if (!o.isMesh) return !!(o.isPoints || o.isLine || o.isSprite);
+  const mats = Array.isArray(o.material) ? o.material : [o.material];
+  return isSeeThrough(o) || !!o.userData.probecastBackground || mats.every((m) => m && m.visible === false);
 }
 
 // What a map's fragment shader starts with: the world position (three's distance vertex shader
@@ -40,6 +42,7 @@ export class MapMaterials {
   constructor(fragmentShader, uniforms) {
     this.fragmentShader = fragmentShader;
     this.uniforms = uniforms;
+    this.made = [];
     this.solid = this.make(null);
     this.cutouts = new WeakMap();
   }
@@ -55,10 +58,12 @@ export class MapMaterials {
     if (cutout) {
       m.map = cutout.map;  // USE_MAP and its uv channel
       m.alphaTest = cutout.alphaTest;
+      this.made.push(m);
     }
     return m;
   }
 
+  // (A cut-out's map, cutoff and opacity are taken when first drawn.)
   for(m) {
     if (!(m?.alphaTest > 0 && m.map)) return this.solid;
     let d = this.cutouts.get(m);
@@ -66,7 +71,10 @@ export class MapMaterials {
     return d;
   }
 
-  dispose() { this.solid.dispose(); }
+  dispose() {
+    this.solid.dispose();
+    for (const m of this.made) m.dispose();
+  }
 }
 
 // Runs draw() with `target` bound and cleared to (clearColor, clearAlpha), the visible objects for
@@ -74,7 +82,8 @@ export class MapMaterials {
 export function drawOffscreen(renderer, scene, { target, clearColor, clearAlpha, materials, hide }, draw) {
   const saved = { target: renderer.getRenderTarget(), auto: renderer.shadowMap.autoUpdate, needs: renderer.shadowMap.needsUpdate,
                   background: scene.background, override: scene.overrideMaterial, clear: renderer.getClearColor(new THREE.Color()),
-                  alpha: renderer.getClearAlpha(), toneMapping: renderer.toneMapping };
+                  alpha: renderer.getClearAlpha(), toneMapping: renderer.toneMapping, xr: renderer.xr.enabled };
+  renderer.xr.enabled = false;  // the maps' own cameras, not the headset's eyes
   const hidden = [], swapped = [];
   scene.traverse((o) => {
     if (o.visible && hide(o)) hidden.push(o);
@@ -109,5 +118,6 @@ export function drawOffscreen(renderer, scene, { target, clearColor, clearAlpha,
     renderer.shadowMap.autoUpdate = saved.auto;
     renderer.shadowMap.needsUpdate = saved.needs;
     renderer.setRenderTarget(saved.target);
+    renderer.xr.enabled = saved.xr;
   }
 }

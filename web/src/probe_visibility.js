@@ -164,10 +164,13 @@ export class ProbeVisibility {
     this.target = null;
   }
 
-  // The scene the probes see (the glTF root, posed); a new root is drawn again whole.
+  // The scene the probes see (the glTF root, posed); a new root is drawn again whole. Its extent
+  // (which sets the probes' reach and the open distance) is taken once, as loaded, as the native
+  // client takes the scene's bounds.
   setRoot(root) {
     if (root === this.root) return;
     this.root = root;
+    this.rootBox = new THREE.Box3().setFromObject(root, true);
     this.requested = null;
   }
 
@@ -178,37 +181,41 @@ export class ProbeVisibility {
     const count = positions.length / 3;
     if (count < 1 || count > kMaxProbes) {
       this.uniforms.pcVisOn.value = 0;
+      this.build = this.built = this.requested = null;
       this.status = { probes: 0, ms: 0, ready: false, batches: 0, skipped: count > kMaxProbes ? `${count} probes` : '' };
       return;
     }
-    const box = new THREE.Box3().setFromObject(this.root, true);
+    const box = this.rootBox.clone();
     box.expandByPoint(new THREE.Vector3().fromArray(bounds.min)).expandByPoint(new THREE.Vector3().fromArray(bounds.max));
     const extent = box.getSize(new THREE.Vector3()).toArray();
     const reach = visibilityReach(dims, bounds, extent);
     const far = Math.max(2 * Math.hypot(...extent), 1);
-    const last = this.requested;
-    if (last && last.reach === reach && last.far === far && last.positions.length === positions.length &&
+    const last = this.requested, key = dims.join('x');
+    if (last && last.reach === reach && last.far === far && last.key === key && last.positions.length === positions.length &&
         last.positions.every((v, i) => v === positions[i])) return;
-    this.requested = { positions: Float32Array.from(positions), reach, far };
-    this.start(this.requested.positions, reach, far, null);
+    this.requested = { positions: Float32Array.from(positions), reach, far, key };
+    this.start(this.requested.positions, reach, far, null, key);
   }
 
-  // Starts drawing `which` probes (null: all, into a new map).
-  start(positions, reach, far, which) {
+  // Starts drawing `which` probes (null: all, into a new map); `key`: the grid's dimensions.
+  start(positions, reach, far, which, key) {
     const count = positions.length / 3;
     const whole = which === null;
     const width = Math.min(count, kTilesPerRow) * kTile, height = Math.ceil(count / kTilesPerRow) * kTile;
     const atlas = whole ? new Float32Array(width * height * 2) : this.built.atlas;
-    this.build = { positions, reach, far, whole, width, height, atlas, started: performance.now(),
+    this.build = { positions, reach, far, key, whole, width, height, atlas, started: performance.now(),
                    queue: whole ? Array.from({ length: count }, (_, i) => i) : which };
-    if (whole) this.status.ready = false;
-    // A map of another volume's probes would be read at the wrong tiles: none until the new one is made.
-    if (whole && this.built?.positions.length !== positions.length) this.uniforms.pcVisOn.value = 0;
+    if (!whole) return;
+    this.status.ready = false;
+    // What moves from now on is drawn again once this map is made.
+    this.rememberBoxes();
+    // A map of another grid's probes would be read at the wrong tiles: none until the new one is made.
+    if (this.built?.key !== key) this.uniforms.pcVisOn.value = 0;
   }
 
   // Draws what is pending, a few batches a frame; `moving`: the scene's pose changed this frame.
   draw(renderer, scene, moving) {
-    if (moving && this.built && this.root) this.followMoved();
+    if (moving && this.built && this.root && !this.build?.whole) this.followMoved();
     const b = this.build;
     if (!b) return;
     const until = performance.now() + kFrameBudgetMs;
@@ -216,10 +223,11 @@ export class ProbeVisibility {
     if (b.queue.length) return;
     this.build = null;
     this.finish(b);
+    if (b.whole && this.root) this.followMoved();  // what moved while it was drawn
   }
 
   finish(b) {
-    this.built = { positions: b.positions, reach: b.reach, far: b.far, atlas: b.atlas, width: b.width, height: b.height };
+    this.built = { positions: b.positions, reach: b.reach, far: b.far, key: b.key, atlas: b.atlas, width: b.width, height: b.height };
     const u = this.uniforms;
     if (!u.pcVis.value || u.pcVis.value.image.width !== b.width || u.pcVis.value.image.height !== b.height) {
       u.pcVis.value?.dispose();
@@ -231,35 +239,41 @@ export class ProbeVisibility {
     u.pcVis.value.needsUpdate = true;
     u.pcReach.value = Number.isFinite(b.reach) ? b.reach : 1e30;
     u.pcVisOn.value = 1;
-    this.rememberBoxes();
     if (b.whole) this.status = { probes: b.positions.length / 3, ms: performance.now() - b.started, ready: true, batches: this.status.batches };
   }
 
-  // The world boxes of the meshes, as the map was drawn (what moves is compared with them).
-  rememberBoxes() {
-    this.boxes = new Map();
-    this.root?.traverse((o) => { if (o.isMesh) this.boxes.set(o, new THREE.Box3().setFromObject(o)); });
+  // The world boxes of the meshes as posed now (skinned, instanced and batched meshes measured
+  // again: three keeps their boxes from when they were first asked for).
+  meshBoxes() {
+    const boxes = new Map();
+    this.root.traverse((o) => {
+      if (!o.isMesh) return;
+      if (o.boundingBox !== undefined) o.computeBoundingBox();
+      boxes.set(o, new THREE.Box3().setFromObject(o));
+    });
+    return boxes;
   }
+
+  // The boxes the map in the making is drawn against (what moves is compared with them).
+  rememberBoxes() { this.boxes = this.root ? this.meshBoxes() : new Map(); }
 
   // The probes within reach of a mesh that moved since the map was drawn, drawn again.
   followMoved() {
-    const moved = [];
-    this.root.traverse((o) => {
-      if (!o.isMesh) return;
-      const now = new THREE.Box3().setFromObject(o), before = this.boxes.get(o);
-      if (!before || !before.equals(now)) moved.push(before ? now.clone().union(before) : now);
-    });
+    const now = this.meshBoxes(), moved = [];
+    for (const [o, box] of now) {
+      const before = this.boxes.get(o);
+      if (!before || !before.equals(box)) moved.push(before ? box.clone().union(before) : box);
+    }
+    this.boxes = now;
     if (!moved.length) return;
-    const { positions, reach, far } = this.built;
-    const pending = new Set(this.build && !this.build.whole ? this.build.queue : []);
+    const { positions, reach, far, key } = this.built;
+    const pending = new Set(this.build ? this.build.queue : []);
     const p = new THREE.Vector3();
     for (let i = 0; i < positions.length / 3; ++i) {
       p.fromArray(positions, 3 * i);
       if (moved.some((box) => box.distanceToPoint(p) <= reach)) pending.add(i);
     }
-    if (this.build?.whole) return;  // a whole build under way is drawn from the scene as it is
-    if (pending.size) this.start(positions, reach, far, [...pending]);
-    this.rememberBoxes();
+    if (pending.size) this.start(positions, reach, far, [...pending], key);
   }
 
   // One row of probes: six faces each into the float target, read back, moments into the atlas.
