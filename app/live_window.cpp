@@ -184,16 +184,15 @@ void LiveWindowOptions::add(CLI::App* cmd) {
       ->check(CLI::Range(0.0, 1000.0))
       ->needs(window);
   cmd->add_option("--head-trace", headTrace,
-                  "--window: the camera turns as a recorded head turned, from the window's opening, looping (a file "
-                  "of timestamp viewpoint w x y z lines, the MMSys'18 format, or builtin:mmsys18-user1), with a neck "
-                  "model; or follows a camera path (a file starting probecast-camera-path 1, or builtin:walk-1m); the "
-                  "mouse and keys still move it")
+                  "the camera turns as a recorded head turned (a file of timestamp viewpoint w x y z lines, the "
+                  "MMSys'18 format, or builtin:mmsys18-user1), with a neck model, or follows a camera path (a file "
+                  "starting probecast-camera-path 1, or builtin:walk-1m): in a --window from its opening, looping, "
+                  "the mouse and keys still moving it; without, --frames pictures --fps apart")
       ->check([](const std::string& spec) {
         session::HeadTrace trace;
         std::string error;
         return session::loadHeadTrace(spec, trace, error) ? std::string() : error;
-      })
-      ->needs(window);
+      });
 }
 
 renderer::ContextOptions LiveWindowOptions::presenting(renderer::ContextOptions options) {

@@ -2,6 +2,7 @@
 // server's stream (view_stream.cpp): its options, what a render returns, and the helpers both use.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,7 +41,9 @@ struct ViewOptions {
   bool visibilityCulling = true;
   std::string sceneCache;             // --connect: where fetched scenes are kept (empty: the default)
   uint64_t sceneMaxBytes = uint64_t{4} << 30;
-  LiveWindowOptions window;
+  LiveWindowOptions window;          // its --head-trace also moves the camera of --frames pictures
+  uint32_t frames = 1;               // --head-trace without --window: pictures along the trace
+  double fps = 30.0;                 // and their rate
   std::string lookingGlass;  // a display's calibration (visual.json)
   std::optional<service::SceneHash> streamScene;  // --connect: the scene drawn, which the stream must keep naming
   CLI::Option* viewsOption = nullptr;
@@ -71,6 +74,31 @@ void writeLookingGlass(const ViewOptions& o, renderer::VulkanContext& context,
                        const renderer::LookingGlassCalibration& lg);
 
 imaging::ToneMap toneMapOf(const ViewOptions& o);
+
+// --- viewers of local probes (view_local.cpp) ---
+
+// Local probes (--probes live or a file, through --repr) on a raster client of --size.
+std::unique_ptr<renderer::RasterRenderer> localRaster(const ViewOptions& o, renderer::VulkanContext& context,
+                                                      const scene::Scene& s, renderer::RasterOptions ro);
+
+// The views drawn once from local probes.
+Rendered renderLocal(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                     const std::vector<renderer::ViewInfo>& views, const renderer::RasterOptions& ro);
+
+// A live window on local probes: a file's, or traced one update per frame up to --updates.
+void windowLocal(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                 const renderer::ViewSetSpec& spec, const renderer::ViewSetOptions& vso, renderer::RasterOptions ro,
+                 const renderer::LookingGlassCalibration* lg);
+
+// --frames and --fps (view_sequence.cpp), and what they cannot go with, refused before anything starts.
+void addViewSequenceOptions(CLI::App* cmd, ViewOptions& o);
+void checkSequenceOptions(const ViewOptions& o);
+
+// --head-trace without --window: --frames quilts, --fps apart, of the camera moved along the trace
+// or path, drawn from one set of local probes: frame_NNNN.png (and .exr with --exr) in --out.
+void writeSequence(const ViewOptions& o, renderer::VulkanContext& context, const scene::Scene& s,
+                   const renderer::ViewSetSpec& spec, const renderer::ViewSetOptions& vso,
+                   const renderer::RasterOptions& ro);
 
 // One line on the client area lights a viewer draws (as the probes say).
 void printAreaLights(const AreaLightRule& rule, const scene::AreaLightSet& set);
