@@ -155,7 +155,7 @@ export class ProbeVisibility {
     };
     this.probe = { value: new THREE.Vector3() };
     this.materials = new MapMaterials(kDistanceFragment, { pvProbe: this.probe });
-    this.status = { probes: 0, ms: 0, ready: false, batches: 0 };
+    this.status = { probes: 0, ms: 0, ready: false, batches: 0, redrawn: 0 };  // redrawn: probes drawn again after moves
     this.root = null;
     this.requested = null;  // the probes and reach of the last request
     this.build = null;  // { positions, reach, far, queue, atlas, started, whole }
@@ -182,7 +182,7 @@ export class ProbeVisibility {
     if (count < 1 || count > kMaxProbes) {
       this.uniforms.pcVisOn.value = 0;
       this.build = this.built = this.requested = null;
-      this.status = { probes: 0, ms: 0, ready: false, batches: 0, skipped: count > kMaxProbes ? `${count} probes` : '' };
+      this.status = { probes: 0, ms: 0, ready: false, batches: 0, redrawn: 0, skipped: count > kMaxProbes ? `${count} probes` : '' };
       return;
     }
     const box = this.rootBox.clone();
@@ -204,7 +204,7 @@ export class ProbeVisibility {
     const width = Math.min(count, kTilesPerRow) * kTile, height = Math.ceil(count / kTilesPerRow) * kTile;
     const atlas = whole ? new Float32Array(width * height * 2) : this.built.atlas;
     this.build = { positions, reach, far, key, whole, width, height, atlas, started: performance.now(),
-                   queue: whole ? Array.from({ length: count }, (_, i) => i) : which };
+                   queue: whole ? Array.from({ length: count }, (_, i) => i) : which, drawn: 0 };
     if (!whole) return;
     this.status.ready = false;
     // What moves from now on is drawn again once this map is made.
@@ -219,7 +219,11 @@ export class ProbeVisibility {
     const b = this.build;
     if (!b) return;
     const until = performance.now() + kFrameBudgetMs;
-    do this.drawBatch(renderer, scene, b.queue.splice(0, kBatchColumns)); while (b.queue.length && performance.now() < until);
+    do {
+      const batch = b.queue.splice(0, kBatchColumns);
+      this.drawBatch(renderer, scene, batch);
+      b.drawn += batch.length;
+    } while (b.queue.length && performance.now() < until);
     if (b.queue.length) return;
     this.build = null;
     this.finish(b);
@@ -239,7 +243,9 @@ export class ProbeVisibility {
     u.pcVis.value.needsUpdate = true;
     u.pcReach.value = Number.isFinite(b.reach) ? b.reach : 1e30;
     u.pcVisOn.value = 1;
-    if (b.whole) this.status = { probes: b.positions.length / 3, ms: performance.now() - b.started, ready: true, batches: this.status.batches };
+    if (b.whole) this.status = { probes: b.positions.length / 3, ms: performance.now() - b.started, ready: true,
+                                 batches: this.status.batches, redrawn: 0 };
+    else this.status.redrawn += b.drawn;
   }
 
   // The world boxes of the meshes as posed now (skinned, instanced and batched meshes measured

@@ -151,6 +151,15 @@ try {
   const nativeVisible = Number((/probe visibility for (\d+) probes/.exec(nativeText) || [0, 0])[1]);
   console.log(`the page's probe visibility: ${s.visibility.probes} probes made in ${s.visibility.ms.toFixed(0)} ms (${s.visibility.batches} batches)`);
   check(nativeVisible > 0 && s.visibility.probes === nativeVisible, `the page made visibility for the native client's ${nativeVisible} probes (${s.visibility.probes})`);
+  if (process.env.PROBECAST_WEB_TIME) {
+    // Posed at the stream's time after the map was begun at rest: the probes near what moved are drawn again.
+    const moved = await until('the probes near the moved meshes to be drawn again', async () => {
+      const v = await probe();
+      return v.visibility?.redrawn > 0 ? v : null;
+    }, 60);
+    console.log(`the page drew ${moved.visibility.redrawn} probes' cubes again after the scene was posed`);
+    check(moved.visibility.redrawn < moved.visibility.probes, `only probes within reach of what moved (${moved.visibility.redrawn} of ${moved.visibility.probes})`);
+  }
   check((s.areaLights || 0) === nativeLights, `the page draws the native client's ${nativeLights} client area lights (${s.areaLights || 0})`);
   if (process.env.PROBECAST_WEB_AREA_LIGHTS === 'on') check(nativeLights > 0, `the scene has client area lights (${nativeLights})`);
   const shaderErrors = consoleLines.filter((l) => /Shader Error|Can not resolve #include|WebGLProgram/.test(l));
