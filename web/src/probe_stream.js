@@ -12,6 +12,7 @@ import { loadCodec } from './codec.js';
 import { ProbeLighting } from './probe_lighting.js';
 import { AreaLighting } from './area_light_shading.js';
 import { ProbeVisibility } from './probe_visibility.js';
+import { movingMeshes } from './visibility_proxy.js';
 import { kAreaLightRuleVersion } from './area_lights.js';
 import { DisplayClock } from './display_clock.js';
 
@@ -81,7 +82,7 @@ export class ProbeStream {
     this.scene = { root, parser, canShadow };
     this.areaKey = '';  // chosen again whatever the rule
     this.followAreaLights();
-    if (canShadow) this.visibility.setRoot(root);  // the probes' depth cubes need float targets too
+    if (canShadow) this.visibility.setRoot(root, movingMeshes(root, parser));  // the cubes need float targets too
     this.requestVisibility();
   }
 

@@ -10,6 +10,7 @@
 // are drawn again.
 import * as THREE from 'three';
 import { drawOffscreen, kMapCutout, kMapHeader, leftOutOfMaps, MapMaterials } from './offscreen.js';
+import { VisibilityProxy } from './visibility_proxy.js';
 
 export const kCube = 32;            // texels a side of each cube face (kVisibilityCubeSize)
 const kLobeCube = kCube / 2;        // the faces are averaged 2×2 before the lobes
@@ -167,9 +168,13 @@ export class ProbeVisibility {
   // The scene the probes see (the glTF root, posed); a new root is drawn again whole. Its extent
   // (which sets the probes' reach and the open distance) is taken once, as loaded, as the native
   // client takes the scene's bounds.
-  setRoot(root) {
+  // moving: the meshes that move (visibility_proxy.js's movingMeshes); the others are drawn as a
+  // simplified proxy once the simplifier has loaded.
+  setRoot(root, moving = new Set()) {
     if (root === this.root) return;
     this.root = root;
+    this.proxy?.dispose();
+    this.proxy = new VisibilityProxy(root, moving);
     this.rootBox = new THREE.Box3().setFromObject(root, true);
     this.requested = null;
   }
@@ -219,11 +224,13 @@ export class ProbeVisibility {
     const b = this.build;
     if (!b) return;
     const until = performance.now() + kFrameBudgetMs;
+    const t0 = performance.now();
     do {
       const batch = b.queue.splice(0, kBatchColumns);
       this.drawBatch(renderer, scene, batch);
       b.drawn += batch.length;
     } while (b.queue.length && performance.now() < until);
+    b.drawingMs = (b.drawingMs || 0) + performance.now() - t0;
     if (b.queue.length) return;
     this.build = null;
     this.finish(b);
@@ -243,8 +250,8 @@ export class ProbeVisibility {
     u.pcVis.value.needsUpdate = true;
     u.pcReach.value = Number.isFinite(b.reach) ? b.reach : 1e30;
     u.pcVisOn.value = 1;
-    if (b.whole) this.status = { probes: b.positions.length / 3, ms: performance.now() - b.started, ready: true,
-                                 batches: this.status.batches, redrawn: 0 };
+    if (b.whole) this.status = { probes: b.positions.length / 3, ms: performance.now() - b.started, drawingMs: b.drawingMs,
+                                 ready: true, batches: this.status.batches, redrawn: 0, triangles: this.status.triangles };
     else this.status.redrawn += b.drawn;
   }
 
@@ -322,12 +329,21 @@ export class ProbeVisibility {
   // everything else hidden: see-through casters, the background, points, lines and sprites, as the
   // native cubes leave them out. Alpha 0: nothing seen that way.
   withDistanceMaterials(renderer, scene, draw) {
-    drawOffscreen(renderer, scene, { target: this.target, clearColor: 0x000000, clearAlpha: 0, materials: this.materials, hide: leftOutOfMaps }, draw);
+    const proxy = this.proxy?.for(this.build.reach);
+    const hide = proxy ? (o) => leftOutOfMaps(o) || this.proxy.replaced.has(o) : leftOutOfMaps;
+    if (proxy) scene.add(proxy);
+    try {
+      drawOffscreen(renderer, scene, { target: this.target, clearColor: 0x000000, clearAlpha: 0, materials: this.materials, hide }, draw);
+    } finally {
+      if (proxy) scene.remove(proxy);
+    }
+    this.status.triangles = proxy ? { ...this.proxy.triangles } : null;
   }
 
   dispose() {
     this.target?.dispose();
     this.uniforms.pcVis.value?.dispose();
     this.materials.dispose();
+    this.proxy?.dispose();
   }
 }
