@@ -158,9 +158,11 @@ export class ProbeVisibility {
     this.materials = new MapMaterials(kDistanceFragment, { pvProbe: this.probe });
     this.status = { probes: 0, ms: 0, ready: false, batches: 0, redrawn: 0 };  // redrawn: probes drawn again after moves
     this.root = null;
-    this.requested = null;  // the probes and reach of the last request
-    this.build = null;  // { positions, reach, far, queue, atlas, started, whole }
-    this.built = null;  // { positions, reach, far, atlas, width, height } of the map in use
+    this.rootBox = null;    // the root's extent as loaded
+    this.proxy = null;      // its still geometry, simplified (visibility_proxy.js)
+    this.requested = null;  // the probes, reach and grid of the last request
+    this.build = null;  // the map in the making: { positions, reach, far, key, whole, queue, drawn, atlas, started }
+    this.built = null;  // the map in use: { positions, reach, far, key, atlas, width, height }
     this.boxes = new Map();
     this.target = null;
   }
