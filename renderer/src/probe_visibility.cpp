@@ -174,17 +174,13 @@ struct CubeTexels {
 const CubeTexels& cubeTexels() {
   static const CubeTexels texels = [] {
     CubeTexels t;
-    const std::vector<glm::mat4> faces = cubeFaceViews(100.0f);
-    for (const glm::mat4& vp : faces) {
-      const glm::mat4 inv = glm::inverse(vp);
+    for (uint32_t f = 0; f < 6; ++f)
       for (uint32_t y = 0; y < kLobeCube; ++y)
         for (uint32_t x = 0; x < kLobeCube; ++x) {
           const float u = texelCentre(x, kLobeCube), v = texelCentre(y, kLobeCube);
-          const glm::vec4 p = inv * glm::vec4(u, v, 0.5f, 1.0f);
-          t.dir.push_back(glm::normalize(glm::vec3(p) / p.w));
+          t.dir.push_back(cubeTexelDirection(f, x, y, kLobeCube));
           t.solidAngle.push_back(std::pow(1.0f + u * u + v * v, -1.5f));
         }
-    }
     return t;
   }();
   return texels;
@@ -495,6 +491,16 @@ void finishDepthCubes(VulkanDevice& d, const std::vector<glm::mat4>& faces, floa
 }
 
 }  // namespace
+
+glm::vec3 cubeTexelDirection(uint32_t face, uint32_t x, uint32_t y, uint32_t size) {
+  static const std::vector<glm::mat4> inverse = [] {
+    std::vector<glm::mat4> out;
+    for (const glm::mat4& vp : cubeFaceViews(100.0f)) out.push_back(glm::inverse(vp));
+    return out;
+  }();
+  const glm::vec4 p = inverse.at(face) * glm::vec4(texelCentre(x, size), texelCentre(y, size), 0.5f, 1.0f);
+  return glm::normalize(glm::vec3(p) / p.w);
+}
 
 glm::vec2 octEncode(const glm::vec3& v) {
   glm::vec2 e = glm::vec2(v.x, v.y) / (std::abs(v.x) + std::abs(v.y) + std::abs(v.z));

@@ -112,6 +112,9 @@ void destroyProbeVisibility(VulkanDevice& d, ProbeVisibility& vis);
 // The moments of one probe from its depth cube (6 faces of `size`² distances, face order +x −x +y
 // −y +z −z as `cubeFaceViews`): RS_VIS_TILE² texels × 2 floats into `tile`, borders included.
 void octahedralMoments(const float* cubeDistances, uint32_t size, float* tile);
+// The unit direction through the centre of texel (x, y) of face `face` of a depth cube `size`
+// texels a side, as the cubes are drawn (faces +x −x +y −y +z −z, rows as the depth image's).
+glm::vec3 cubeTexelDirection(uint32_t face, uint32_t x, uint32_t y, uint32_t size);
 // (E[r], E[r²]) of `probe` toward `dir` from the host copy, at the nearest texel.
 glm::vec2 probeMomentsAt(const ProbeVisibility& vis, uint32_t probe, const glm::vec3& dir);
 

@@ -1,7 +1,9 @@
 // The page's probe visibility (web/src/probe_visibility.js), run in Node: the octahedral mapping,
 // the lobes, the moments of known depth cubes, the tile borders and the reach, as the native
-// client's (renderer/src/probe_visibility.cpp) define them.
+// client's (renderer/src/probe_visibility.cpp) define them; and, where the native fixture is built
+// (PROBECAST_MOMENTS_FIXTURE, as ctest sets it), the same cubes' moments against the native code's.
 import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
 import { test } from 'node:test';
 import * as THREE from 'three';
 import { kCube, kOct, kTile, lobeTaps, octDecode, octEncode, octahedralMoments, visibilityReach } from '../src/probe_visibility.js';
@@ -88,4 +90,22 @@ test('the reach is 1.5 cell diagonals and a quarter spacing', () => {
   // One probe along y: that axis counts the scene's extent.
   assert.ok(Math.abs(visibilityReach([5, 1, 4], bounds, [4, 3, 6]) - (1.5 * Math.hypot(1, 3, 2) + 0.25)) < 1e-9);
   assert.equal(visibilityReach([1, 1, 1], bounds, [4, 2, 6]), Infinity);
+});
+
+// The page's cubes (three.js cameras, WebGL's rows) and the native ones (Vulkan's) share no code:
+// the same distance functions must give the same moments, texel for texel.
+test('the moments equal the native client\'s for the same cubes', { skip: !process.env.PROBECAST_MOMENTS_FIXTURE }, () => {
+  const native = JSON.parse(execFileSync(process.env.PROBECAST_MOMENTS_FIXTURE, { encoding: 'utf8' }));
+  assert.equal(native.tile, kTile);
+  const functions = {
+    wall: (d) => (d[0] > 1e-6 ? Math.min(10, 1 / d[0]) : 10),
+    smooth: (d) => 1 + 0.5 * d[0] + 0.25 * d[1] * d[1] + 0.1 * d[2],
+  };
+  for (const [name, dist] of Object.entries(functions)) {
+    const { atlas } = momentsOf(dist);
+    assert.equal(native[name].length, atlas.length);
+    let worst = 0;
+    atlas.forEach((v, i) => { worst = Math.max(worst, Math.abs(v - native[name][i]) / Math.max(1, Math.abs(native[name][i]))); });
+    assert.ok(worst < 1e-4, `${name}: the page's moments differ from the native client's by up to ${worst} (relative)`);
+  }
 });
