@@ -89,6 +89,14 @@ void runDemoSession(const DemoOptions& o, DemoRun& run);
 // writes report.json, report.md, charts and images to o.out, and prints the summary.
 void writeDemoReport(const DemoOptions& o, DemoRun& run);
 
+// The pipeline benchmark (small) and the stability suite, written next to the report (in `dir`);
+// their report sections (demo_suites.cpp).
+std::string runSuites(const DemoOptions& o, const std::string& dir, const scene::Scene& finalScene, float finalT,
+                      const ProbeGrid& grid, nlohmann::json& phases);
+// The stream against video of the viewers' own views, written next to the report; its report
+// section (without ffmpeg, a section that says so).
+std::string runVideoComparison(const DemoOptions& o, const DemoRun& run, const std::string& dir, nlohmann::json& report);
+
 double secondsSince(DemoClock::time_point t0);
 // A viewer's current images on disk: a stereo pair side by side, or a light-field quilt.
 void writeViewerImages(const std::string& prefix, const DemoViewer& v, const std::vector<renderer::Image>& images);
