@@ -37,7 +37,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mtp_link  # noqa: E402  (the link phase: namespaces, pose and frame traffic)
-from wan_bench import PROFILES  # noqa: E402
+from wan_bench import PROFILES, percentile  # noqa: E402
 
 
 def log(*a):
@@ -49,11 +49,6 @@ def run(argv, what, **kw):
     if r.returncode != 0:
         raise RuntimeError("%s failed (%d): %s" % (what, r.returncode, (r.stderr or r.stdout)[-2000:]))
     return r.stdout + r.stderr
-
-
-def percentile(values, p):
-    s = sorted(values)
-    return s[min(len(s) - 1, int(round(p / 100.0 * (len(s) - 1))))] if s else float("nan")
 
 
 def video_frames(a, work):
@@ -117,15 +112,15 @@ def render_ms(a, work):
 def summarise(profile, link, render, point):
     enc_ms, dec_ms = point["encode_ms"], point["decode_ms"]
     up, down = link["pose_up_ms"], link["frame_down_ms"]
-    video50 = percentile(up, 50) + render + enc_ms + percentile(down, 50) + dec_ms
-    video99 = percentile(up, 99) + render + enc_ms + percentile(down, 99) + dec_ms
+    video50 = percentile(up, 0.5) + render + enc_ms + percentile(down, 0.5) + dec_ms
+    video99 = percentile(up, 0.99) + render + enc_ms + percentile(down, 0.99) + dec_ms
     return {"profile": profile, "stream": point["stream"], "codec": point["codec"], "crf": point["crf"],
             "probe_pose_to_photon_ms": render, "probe_bytes_per_second": point["stream_bytes_per_second"],
             "lighting_age_ms_p50": link["lighting_age_p50"], "lighting_age_ms_p99": link["lighting_age_p99"],
             "video_pose_to_photon_ms_p50": video50, "video_pose_to_photon_ms_p99": video99,
             "video_bytes_per_second": point["video_bytes_per_second"], "video_reaches_stream": point["reaches_stream"],
-            "components_ms": {"pose_up_p50": percentile(up, 50), "render": render, "encode": enc_ms,
-                              "frame_down_p50": percentile(down, 50), "frame_down_p99": percentile(down, 99),
+            "components_ms": {"pose_up_p50": percentile(up, 0.5), "render": render, "encode": enc_ms,
+                              "frame_down_p50": percentile(down, 0.5), "frame_down_p99": percentile(down, 0.99),
                               "decode": dec_ms, "frames_late": link["frames_late"]}}
 
 

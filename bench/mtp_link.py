@@ -20,7 +20,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from wan_bench import Run  # noqa: E402
+from wan_bench import Run, percentile  # noqa: E402
 
 PORT = 9100
 POSE = struct.Struct("<dI28x")  # 40 bytes: send time, sequence, a pose's 28 (position, orientation)
@@ -153,7 +153,7 @@ def lighting_age(r, a, work):
 def measure(a, work, profile, size_lists, fps):
     """One profile: each point's traffic, then the probe stream, over one emulated link; a link
     figure per point (the lighting's age is the same for all)."""
-    from motion_to_photon import log, percentile
+    from motion_to_photon import log
     folder = os.path.join(work, "link-" + profile)
     os.makedirs(folder, exist_ok=True)
     with Run(a, folder, profile, "direct", True) as r:
@@ -161,12 +161,14 @@ def measure(a, work, profile, size_lists, fps):
         age = lighting_age(r, a, folder)
     if not age:
         raise RuntimeError("%s: the subscriber applied no frame after its first 3 s (see %s)" % (profile, folder))
+    if not all(up and down for up, down, _ in traffics):
+        raise RuntimeError("%s: no pose or no frame crossed the link after its first second (see %s)" % (profile, folder))
     out = []
     for up, down, late in traffics:
         log("%s: pose up %.1f ms, frame down %.1f ms (p99 %.1f), %d frames late, lighting %.0f ms old"
-            % (profile, percentile(up, 50), percentile(down, 50), percentile(down, 99), late, percentile(age, 50)))
+            % (profile, percentile(up, 0.5), percentile(down, 0.5), percentile(down, 0.99), late, percentile(age, 0.5)))
         out.append({"pose_up_ms": up, "frame_down_ms": down, "frames_late": late,
-                    "lighting_age_p50": percentile(age, 50), "lighting_age_p99": percentile(age, 99)})
+                    "lighting_age_p50": percentile(age, 0.5), "lighting_age_p99": percentile(age, 0.99)})
     return out
 
 
