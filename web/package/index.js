@@ -6,5 +6,5 @@ export { AreaLighting } from '../src/area_light_shading.js';
 export { extractAreaLights, kAreaLightRuleVersion } from '../src/area_lights.js';
 export { lightingBackground, decodeEnvironment } from '../src/environment.js';
 export { loadCodec } from '../src/codec.js';
-export { useProbecastCurve } from '../src/tone_curve.js';
+export { useProbecastCurve, LinearLightView } from '../src/tone_curve.js';
 export { checkedManifest, sceneFileUrl, safePath, sha256Hex } from '../src/scene_rules.js';

@@ -14,7 +14,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { ProbeStream } from './probe_stream.js';
-import { useProbecastCurve } from './tone_curve.js';
+import { useProbecastCurve, LinearLightView } from './tone_curve.js';
 import { lightingBackground } from './environment.js';
 import { checkedManifest, printable, sceneFileUrl, sha256Hex } from './scene_rules.js';
 import { LookingGlassOutput, parseCalibration } from './looking_glass.js';
@@ -95,6 +95,7 @@ if (!config.nats) fail('no bus given: open index.html?nats=ws://HOST:PORT&stream
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
 useProbecastCurve(renderer, Number(params.get('exposure') || 1));  // the native viewer's picture
+const linearView = new LinearLightView();  // its anti-aliasing: samples averaged before the curve
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 const scene = new THREE.Scene();
@@ -152,8 +153,11 @@ function frame(now, xrFrame) {
       lookingGlass.render(renderer, scene, camera, distance, renderer.toneMappingExposure);
     }
   } else {
-    if (!renderer.xr.isPresenting) resize();
-    renderer.render(scene, renderer.xr.isPresenting ? xrCamera : camera);
+    if (renderer.xr.isPresenting) renderer.render(scene, xrCamera);
+    else {
+      resize();
+      linearView.render(renderer, scene, camera);
+    }
   }
   if (config.timing) {
     const gl = renderer.getContext();

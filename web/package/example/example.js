@@ -3,7 +3,7 @@
 // The scene should be the one the stream is traced in (the same file `serve --scene` was given).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { ProbeStream, useProbecastCurve } from 'probecast-three';
+import { ProbeStream, useProbecastCurve, LinearLightView } from 'probecast-three';
 
 const params = new URLSearchParams(location.search);
 const token = decodeURIComponent((/(?:^|&)token=([^&]*)/.exec(location.hash.slice(1)) || [])[1] || '');
@@ -14,6 +14,7 @@ const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDraw
 renderer.setPixelRatio(1);
 renderer.shadowMap.enabled = true;
 useProbecastCurve(renderer);  // optional: the native viewer's curve, to compare pictures with it
+const view = new LinearLightView();  // optional: edges averaged in linear light, as the native viewer
 const scene = new THREE.Scene();
 
 // The light: every standard material of the scene takes the stream's probes and area lights.
@@ -57,7 +58,7 @@ renderer.setAnimationLoop(() => {
   camera.aspect = w / Math.max(h, 1);
   camera.updateProjectionMatrix();
   stream.drawShadows(renderer, scene);
-  renderer.render(scene, camera);
+  view.render(renderer, scene, camera);
   state.frames += 1;
 });
 
