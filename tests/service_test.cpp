@@ -19,9 +19,11 @@
 #include "probecast.grpc.pb.h"
 #include "probecast/codec/probe_offsets.h"
 #include "probecast/service/client.h"
+#include "probecast/service/scene_package.h"
 #include "probecast/service/server.h"
 #include "service_test_support.h"
 #include "test_probes.h"
+#include "wire_convert.h"
 
 namespace probecast::service {
 namespace {
@@ -495,6 +497,111 @@ TEST(Service, ProbeOffsetsReachEverySubscriberOnceAndAChangeStartsANewEpoch) {
   ASSERT_TRUE(waitFor([&] { return client.snapshot(snap) && snap.volume.offsets == next; }, 10s))
       << client.stats().lastError;
   client.stop();
+}
+
+// The digest a resume names its held description by, written here from the protocol's words:
+// SHA-256 of the offsets and the manifest, each after its length as 8 bytes little-endian.
+std::string heldDigest(const std::string& offsets, const std::string& manifest) {
+  std::string bytes;
+  for (const std::string* part : {&offsets, &manifest}) {
+    for (int k = 0; k < 8; ++k) bytes.push_back(static_cast<char>((uint64_t{part->size()} >> (8 * k)) & 0xff));
+    bytes += *part;
+  }
+  const SceneHash h = sha256(bytes);
+  return std::string(reinterpret_cast<const char*>(h.data()), h.size());
+}
+
+// A hub with probe offsets and a scene, as a relocating producer of a named scene has.
+SceneStamp offsetsAndScene(ProbeHub& hub, std::vector<float>& offsets) {
+  const ProbeGrid g = gridOf(hub.layout(), hub.bounds());
+  offsets = sampleOffsets(g);
+  hub.setProbeOffsets(offsets);
+  snapProbeOffsets(g, offsets);
+  SceneStamp stamp;
+  stamp.manifest = R"({"files":[],"format":1,"lighting":{},"scene":{"builtin":"cornell"}})";
+  stamp.hash = sha256(stamp.manifest);
+  hub.setScene(stamp);
+  return stamp;
+}
+
+// The first description a raw subscriber gets for `hello` (unpaced: the description comes first).
+pb::VolumeDescription firstDescription(int port, const pb::Hello& hello) {
+  auto stub = pb::ProbeStream::NewStub(
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext ctx;
+  ctx.AddMetadata("authorization", std::string("Bearer ") + kToken);
+  ctx.set_deadline(std::chrono::system_clock::now() + 10s);
+  auto stream = stub->Subscribe(&ctx);
+  pb::ClientMessage m;
+  *m.mutable_hello() = hello;
+  pb::ServerMessage msg;
+  EXPECT_TRUE(stream->Write(m) && stream->Read(&msg) && msg.has_volume());
+  ctx.TryCancel();
+  stream->Finish();
+  return msg.volume();
+}
+
+// A resume in the same epoch names the description it holds by its digest; the server leaves the
+// offsets and the manifest out, and the client puts its own back. Another digest or epoch, or none,
+// gets the whole description.
+TEST(Service, AResumeInTheSameEpochIsNotSentTheOffsetsAndManifestAgain) {
+  ProbeHub hub(volumeConfig());
+  std::vector<float> offsets;
+  const SceneStamp stamp = offsetsAndScene(hub, offsets);
+  ProbeServer server(plaintextConfig(), hub);
+  Producer producer(hub, 3, 20ms);
+  pb::Hello hello;
+  hello.set_protocol_version(4);
+  const pb::VolumeDescription whole = firstDescription(server.port(), hello);
+  ASSERT_EQ(whole.probe_offsets().size(), offsets.size());
+  ASSERT_FALSE(whole.held_parts());
+  hello.set_stream_epoch(whole.stream_epoch());
+  hello.set_held_description(heldDigest(whole.probe_offsets(), whole.scene_manifest()));
+  const pb::VolumeDescription resumed = firstDescription(server.port(), hello);
+  EXPECT_TRUE(resumed.held_parts());
+  EXPECT_TRUE(resumed.probe_offsets().empty());
+  EXPECT_TRUE(resumed.scene_manifest().empty());
+  EXPECT_EQ(resumed.scene_hash(), whole.scene_hash());
+  EXPECT_EQ(resumed.stream_epoch(), whole.stream_epoch());
+  hello.set_held_description(heldDigest(whole.probe_offsets() + "x", whole.scene_manifest()));
+  EXPECT_FALSE(firstDescription(server.port(), hello).held_parts()) << "another digest";
+  hello.set_held_description(heldDigest(whole.probe_offsets(), whole.scene_manifest()));
+  hello.set_stream_epoch(whole.stream_epoch() + 1);
+  EXPECT_FALSE(firstDescription(server.port(), hello).held_parts()) << "another epoch";
+
+  // The client library: a cut connection resumes with the short description, and holds the same.
+  ClientConfig cc = clientFor(server.port());
+  cc.reconnectMaxMs = 200;
+  ProbeClient client(cc);
+  client.start();
+  VolumeSnapshot snap;
+  ASSERT_TRUE(convergedSnapshot(client, hub, producer, snap));
+  EXPECT_EQ(client.stats().descriptionsResumed, 0u);
+  client.dropConnection();
+  ASSERT_TRUE(waitFor([&] { return client.stats().connects >= 2; }, 10s)) << client.stats().lastError;
+  EXPECT_EQ(client.stats().descriptionsResumed, 1u);
+  ASSERT_TRUE(client.snapshot(snap));
+  EXPECT_EQ(snap.volume.offsets, offsets);
+  EXPECT_EQ(snap.volume.scene.hash, stamp.hash);
+  EXPECT_EQ(snap.volume.scene.manifest, stamp.manifest);
+  EXPECT_TRUE(waitFor([&] { return matchesServer(client, hub); }, 10s));
+  client.stop();
+}
+
+// A description that leaves out parts nobody asked to keep is incomplete: GetVolume's caller, or a
+// client that holds nothing, refuses it rather than read it as "no offsets".
+TEST(Service, AShortDescriptionNobodyAskedForIsRefused) {
+  pb::VolumeDescription v;
+  v.set_protocol_version(4);
+  v.set_held_parts(true);
+  StreamLayout layout;
+  GridBounds bounds;
+  std::vector<float> offsets;
+  AreaLightRule rule;
+  SceneStamp scene;
+  std::string why;
+  EXPECT_FALSE(volumeFromWire(v, layout, bounds, offsets, rule, scene, why));
+  EXPECT_NE(why.find("leaves out probe offsets"), std::string::npos) << why;
 }
 
 // The client area light rule travels in the description: a client holds the rule its probes were

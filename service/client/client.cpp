@@ -123,6 +123,10 @@ struct ProbeClient::Impl {
   std::vector<int64_t> offsets64;  // receive − send of the most recent 64 frames, µs
   size_t offsetNext = 0;
   uint64_t epoch = 0;
+  // The description's offsets and manifest as they came (a resume names them by their digest, and
+  // a server that has them unchanged leaves them out: VolumeDescription.held_parts).
+  std::string heldOffsets, heldManifest;
+  bool heldParts = false;  // the two above belong to `epoch`'s description
   uint64_t newestServerTimeUs = 0;
   std::vector<AppliedFrame> applied;  // ring of the most recent 4096
   size_t appliedNext = 0;
@@ -194,10 +198,24 @@ struct ProbeClient::Impl {
 
   // False for a description the client cannot use: the connection is dropped and retried later
   // (or, refuseForGood, never).
-  bool onVolume(const pb::VolumeDescription& v, const std::string& address) {
+  bool onVolume(const pb::VolumeDescription& sent, const std::string& address) {
     Description d;
     std::string why;
     std::lock_guard<std::mutex> lock(mutex);
+    pb::VolumeDescription whole;
+    const bool resumed = sent.held_parts();
+    if (resumed) {
+      // Only the epoch whose parts we hold, asked for in our Hello; else the next Hello asks afresh.
+      if (!decoder || !heldParts || sent.stream_epoch() != epoch) {
+        heldParts = false;
+        return refuse("a resumed description leaves out probe offsets and a manifest of another epoch: asking afresh"), false;
+      }
+      whole = sent;
+      whole.set_probe_offsets(heldOffsets);
+      whole.set_scene_manifest(heldManifest);
+      whole.clear_held_parts();
+    }
+    const pb::VolumeDescription& v = resumed ? whole : sent;
     switch (checkDescription(v, config, d, why)) {
       case Verdict::Accept: break;
       case Verdict::Retry: return refuse(why), false;
@@ -219,6 +237,10 @@ struct ProbeClient::Impl {
     if (sc.hash != scene.hash) hasState = false;
     scene = std::move(sc);
     epoch = v.stream_epoch();
+    heldOffsets = v.probe_offsets();
+    heldManifest = v.scene_manifest();
+    heldParts = true;
+    if (resumed) stats.descriptionsResumed += 1;
     stats.connected = true;
     stats.connects += 1;
     stats.address = address;
@@ -276,6 +298,7 @@ struct ProbeClient::Impl {
     std::lock_guard<std::mutex> lock(mutex);
     if (decoder) {
       h->set_stream_epoch(epoch);
+      if (heldParts) h->set_held_description(descriptionDigest(heldOffsets, heldManifest));
       for (uint32_t b = 0; b < brickCount(layout); ++b)
         if (decoder->brickVersion(b) != 0) {
           pb::BrickVersion* v = h->add_held();

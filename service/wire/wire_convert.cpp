@@ -7,6 +7,7 @@
 #include <google/protobuf/wire_format_lite.h>
 
 #include "probecast/codec/probe_offsets.h"
+#include "probecast/service/scene_package.h"
 
 namespace probecast::service {
 
@@ -49,6 +50,9 @@ bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridB
   if (in.protocol_version() != kProtocolVersion)
     return why = "server speaks protocol version " + std::to_string(in.protocol_version()) + ", not " +
                  std::to_string(kProtocolVersion), false;
+  // A resumed description's held parts are put back by the client that holds them; one that comes
+  // with them left out to anyone else is incomplete.
+  if (in.held_parts()) return why = "the description leaves out probe offsets and a manifest this client does not hold", false;
   if (in.codec_format_version() != kFormatVersion)
     return why = "server sends codec format version " + std::to_string(in.codec_format_version()) + ", not " +
                  std::to_string(kFormatVersion), false;
@@ -237,6 +241,18 @@ bool stateFromWire(const v1::SceneState& in, bus::SceneState& out, std::string& 
   if (!bus::checkSceneState(st, why)) return false;
   out = std::move(st);
   return true;
+}
+
+std::string descriptionDigest(const std::string& probeOffsets, const std::string& sceneManifest) {
+  std::string bytes;
+  bytes.reserve(16 + probeOffsets.size() + sceneManifest.size());
+  for (const std::string* part : {&probeOffsets, &sceneManifest}) {
+    const uint64_t n = part->size();
+    for (int k = 0; k < 8; ++k) bytes.push_back(static_cast<char>((n >> (8 * k)) & 0xff));
+    bytes += *part;
+  }
+  const SceneHash h = sha256(bytes);
+  return std::string(reinterpret_cast<const char*>(h.data()), h.size());
 }
 
 }  // namespace probecast::service

@@ -22,6 +22,9 @@ void volumeToWire(const bus::Volume& volume, v1::VolumeDescription& out);
 // caller's to check) too; `why` says what is wrong.
 bool volumeFromWire(const v1::VolumeDescription& in, StreamLayout& layout, GridBounds& bounds,
                     std::vector<float>& offsets, AreaLightRule& areaLights, SceneStamp& scene, std::string& why);
+// The digest a resuming client names its held description by (Hello.held_description): SHA-256
+// of the probe offsets and the scene manifest, each after its length as 8 bytes little-endian.
+std::string descriptionDigest(const std::string& probeOffsets, const std::string& sceneManifest);
 void stateToWire(const bus::SceneState& in, v1::SceneState& out);
 // Checks a frame's scene state (bus::checkSceneState, 3 floats per light vector).
 bool stateFromWire(const v1::SceneState& in, bus::SceneState& out, std::string& why);

@@ -158,6 +158,7 @@ struct ClientStats {
   uint64_t serverLinkInFlight = 0;   // unacknowledged bytes on the way
   uint32_t serverLinkWaits = 0;      // frames that waited for the window
   uint32_t silences = 0;             // connections dropped for silence (ClientConfig::silenceMs)
+  uint32_t descriptionsResumed = 0;  // descriptions that left out the offsets and manifest held
   // Every description and frame refused, and every failed call, counted by reason (at most 32
   // reasons; later ones count under the last).
   std::vector<Refusal> refusals;
