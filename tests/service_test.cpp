@@ -3,6 +3,11 @@
 // bounded and every test stops its own threads.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/health_check_service_interface.h>
@@ -156,6 +161,56 @@ TEST(Service, APacedSubscriberHearsStatsBeforeTheDescriptionAnUnpacedOneTheDescr
     ctx.TryCancel();
     stream->Finish();
   }
+}
+
+// A port that takes no new connections and refuses none: a listener whose queue is full, so
+// that the kernel drops every further SYN (as a link outage does) and a connect hangs.
+struct BlackHole {
+  int listener = -1;
+  std::vector<int> queued;
+  explicit BlackHole(int port) {
+    listener = socket(AF_INET, SOCK_STREAM, 0);
+    const int one = 1;
+    setsockopt(listener, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    bound = bind(listener, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && listen(listener, 0) == 0;
+    for (int i = 0; bound && i < 2; ++i) {  // fill the accept queue (not waiting: the second hangs)
+      const int c = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0);
+      connect(c, reinterpret_cast<sockaddr*>(&a), sizeof a);
+      queued.push_back(c);
+    }
+  }
+  ~BlackHole() {
+    for (int c : queued) close(c);
+    if (listener >= 0) close(listener);
+  }
+  bool bound = false;
+};
+
+// A reconnect whose connection cannot be made (SYNs lost) is given up after reconnectSilenceMs and
+// tried afresh, not left waiting for TCP: opening the call is under the watchdog too.
+TEST(Service, AReconnectThatCannotConnectIsCutAndTriedAfresh) {
+  ProbeHub hub(volumeConfig());
+  auto server = std::make_unique<ProbeServer>(plaintextConfig(), hub);
+  const int port = server->port();
+  Producer producer(hub, 3, 20ms);
+  ClientConfig cc = clientFor(port);
+  cc.reconnectSilenceMs = 300;
+  ProbeClient client(cc);
+  client.start();
+  ASSERT_TRUE(waitFor([&] { return client.stats().statsReceived >= 1 && client.stats().framesApplied >= 1; }, 10s));
+  server.reset();
+  BlackHole hole(port);
+  ASSERT_TRUE(hole.bound);
+  const uint32_t before = client.stats().silences;
+  EXPECT_TRUE(waitFor([&] { return client.stats().silences >= before + 3; }, 5s))
+      << "silences " << client.stats().silences << ", last error " << client.stats().lastError;
+  EXPECT_NE(client.stats().lastError.find("no answer within 300 ms of connecting"), std::string::npos)
+      << client.stats().lastError;
+  client.stop();
 }
 
 TEST(Service, NetworkFaultKeepsLightingAndResumesWithWhatIsLacking) {

@@ -318,13 +318,19 @@ struct ProbeClient::Impl {
       grpc::ClientContext ctx;
       authorize(config, ctx);
       std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel(servers[at]));
+      {
+        // The watchdog may cut the call from here on: opening it blocks while the connection is
+        // made, which through a link outage takes until TCP gives up (seconds), not one attempt.
+        std::lock_guard<std::mutex> lock(mutex);
+        context = &ctx;
+        stream = nullptr;
+        callStarted = std::chrono::steady_clock::now();
+        silenced = false;
+      }
       std::unique_ptr<Stream> rw = stub->Subscribe(&ctx);
       {
         std::lock_guard<std::mutex> lock(mutex);
-        context = &ctx;
         stream = rw.get();
-        callStarted = std::chrono::steady_clock::now();
-        silenced = false;
       }
       if (stopping) ctx.TryCancel();
       write(hello());
@@ -407,10 +413,14 @@ struct ProbeClient::Impl {
       {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
+        const bool heard = lastMessage > callStarted;
         wasSilenced = silenced;
         silenced = false;
         if (wasCut && !dropped)
           refuse(servers[at] + ": the stream broke off without an end (a message that does not parse): connecting afresh");
+        else if (wasSilenced && !heard)
+          refuse(servers[at] + ": no answer within " + std::to_string(config.reconnectSilenceMs) +
+                 " ms of connecting: connecting afresh");
         else if (wasSilenced)
           refuse(servers[at] + ": the connection went silent (the server promised a message every " +
                  std::to_string(heartbeatMs) + " ms): connecting afresh");
