@@ -5,6 +5,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <sys/select.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -13,6 +14,7 @@
 #include <grpcpp/health_check_service_interface.h>
 
 #include <atomic>
+#include <cerrno>
 #include <condition_variable>
 #include <chrono>
 #include <cstring>
@@ -183,6 +185,21 @@ struct BlackHole {
       queued.push_back(c);
     }
   }
+  // Whether a further connection hangs, as it must for the test (Linux drops the SYN).
+  bool swallows() const {
+    const int c = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0);
+    sockaddr_in a{};
+    socklen_t n = sizeof a;
+    getsockname(listener, reinterpret_cast<sockaddr*>(&a), &n);
+    const bool hangs = connect(c, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 && errno == EINPROGRESS;
+    fd_set w;
+    FD_ZERO(&w);
+    FD_SET(c, &w);
+    timeval t{0, 200000};
+    const bool answered = hangs && select(c + 1, nullptr, &w, nullptr, &t) > 0;
+    close(c);
+    return hangs && !answered;
+  }
   ~BlackHole() {
     for (int c : queued) close(c);
     if (listener >= 0) close(listener);
@@ -205,11 +222,15 @@ TEST(Service, AReconnectThatCannotConnectIsCutAndTriedAfresh) {
   server.reset();
   BlackHole hole(port);
   ASSERT_TRUE(hole.bound);
+  if (!hole.swallows()) GTEST_SKIP() << "this kernel answers connections past a full accept queue";
   const uint32_t before = client.stats().silences;
   EXPECT_TRUE(waitFor([&] { return client.stats().silences >= before + 3; }, 5s))
       << "silences " << client.stats().silences << ", last error " << client.stats().lastError;
-  EXPECT_NE(client.stats().lastError.find("no answer within 300 ms of connecting"), std::string::npos)
-      << client.stats().lastError;
+  // Every other attempt is given twice as long (a link slower than the allowance still gets through).
+  const std::string last = client.stats().lastError;
+  EXPECT_TRUE(last.find("no answer within 300 ms of connecting") != std::string::npos ||
+              last.find("no answer within 600 ms of connecting") != std::string::npos)
+      << last;
   client.stop();
 }
 
@@ -606,7 +627,7 @@ TEST(Service, AResumeInTheSameEpochIsNotSentTheOffsetsAndManifestAgain) {
   ProbeServer server(plaintextConfig(), hub);
   Producer producer(hub, 3, 20ms);
   pb::Hello hello;
-  hello.set_protocol_version(4);
+  hello.set_protocol_version(kProtocolVersion);
   const pb::VolumeDescription whole = firstDescription(server.port(), hello);
   ASSERT_EQ(whole.probe_offsets().size(), offsets.size());
   ASSERT_FALSE(whole.held_parts());

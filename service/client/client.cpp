@@ -140,6 +140,13 @@ struct ProbeClient::Impl {
   std::chrono::steady_clock::time_point callStarted, lastMessage;
   uint32_t heartbeatMs = 0;
   bool silenced = false;
+  // A call not yet answered: its channel (READY once TCP, TLS and HTTP/2 are up, which restarts
+  // its allowance), and how many calls in a row were cut unanswered (every other one gets twice
+  // the allowance, so that a link slower than reconnectSilenceMs still gets through).
+  std::shared_ptr<grpc::Channel> callChannel;
+  std::chrono::steady_clock::time_point readyAt;
+  bool callReady = false;
+  uint32_t unanswered = 0;
   bool finishing = false, finishCut = false;  // in Finish since finishStarted; cut by the watchdog
   std::chrono::steady_clock::time_point finishStarted;
 
@@ -158,8 +165,13 @@ struct ProbeClient::Impl {
       }
       if (heartbeatMs == 0 || silenced || finishing) continue;
       const bool heard = lastMessage > callStarted;
-      const int limit = heard ? config.silenceMs : config.reconnectSilenceMs;
-      if (limit <= 0 || now - (heard ? lastMessage : callStarted) < std::chrono::milliseconds(limit)) continue;
+      if (!heard && !callReady && callChannel && callChannel->GetState(false) == GRPC_CHANNEL_READY) {
+        callReady = true;
+        readyAt = now;
+      }
+      const int limit = heard ? config.silenceMs : config.reconnectSilenceMs * static_cast<int>(1 + unanswered % 2);
+      const auto since = heard ? lastMessage : callReady ? readyAt : callStarted;
+      if (limit <= 0 || now - since < std::chrono::milliseconds(limit)) continue;
       silenced = true;
       stats.silences += 1;
       context->TryCancel();
@@ -216,7 +228,9 @@ struct ProbeClient::Impl {
       whole.clear_held_parts();
     }
     const pb::VolumeDescription& v = resumed ? whole : sent;
-    switch (checkDescription(v, config, d, why)) {
+    const Verdict verdict = checkDescription(v, config, d, why);
+    if (verdict != Verdict::Accept && resumed) heldParts = false;  // the next Hello asks for all of it
+    switch (verdict) {
       case Verdict::Accept: break;
       case Verdict::Retry: return refuse(why), false;
       case Verdict::ForGood: return refuseForGood(why);
@@ -317,7 +331,8 @@ struct ProbeClient::Impl {
     while (!stopping) {
       grpc::ClientContext ctx;
       authorize(config, ctx);
-      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(channel(servers[at]));
+      const std::shared_ptr<grpc::Channel> ch = channel(servers[at]);
+      std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(ch);
       {
         // The watchdog may cut the call from here on: opening it blocks while the connection is
         // made, which through a link outage takes until TCP gives up (seconds), not one attempt.
@@ -326,6 +341,9 @@ struct ProbeClient::Impl {
         stream = nullptr;
         callStarted = std::chrono::steady_clock::now();
         silenced = false;
+        callChannel = ch;
+        callReady = false;
+        if (stopping) ctx.TryCancel();  // stop() came before the context was there to cancel
       }
       std::unique_ptr<Stream> rw = stub->Subscribe(&ctx);
       {
@@ -414,12 +432,14 @@ struct ProbeClient::Impl {
         std::lock_guard<std::mutex> lock(mutex);
         stats.connected = false;
         const bool heard = lastMessage > callStarted;
+        unanswered = heard ? 0 : unanswered + (silenced ? 1 : 0);
+        callChannel.reset();
         wasSilenced = silenced;
         silenced = false;
         if (wasCut && !dropped)
           refuse(servers[at] + ": the stream broke off without an end (a message that does not parse): connecting afresh");
         else if (wasSilenced && !heard)
-          refuse(servers[at] + ": no answer within " + std::to_string(config.reconnectSilenceMs) +
+          refuse(servers[at] + ": no answer within " + std::to_string(config.reconnectSilenceMs * (2 - unanswered % 2)) +
                  " ms of connecting: connecting afresh");
         else if (wasSilenced)
           refuse(servers[at] + ": the connection went silent (the server promised a message every " +

@@ -55,7 +55,9 @@ struct ClientConfig {
   // A server that promises a message at least every so often (Stats heartbeat_ms: it does for a
   // client that acks every frame) and says nothing for silenceMs has a cut connection: a link outage
   // stalls TCP, whose retransmissions back off for seconds after the link returns. The client
-  // drops it and connects afresh at once, giving each new attempt reconnectSilenceMs to answer.
+  // drops it and connects afresh at once, giving each new attempt reconnectSilenceMs to answer
+  // (counted from when its connection is up, TLS and HTTP/2 included, or from the attempt's start
+  // while it is not; every other attempt in a row that gets no answer has twice as long).
   // 0: wait for TCP and the keepalive.
   int silenceMs = 3000;
   int reconnectSilenceMs = 2000;
@@ -157,7 +159,8 @@ struct ClientStats {
   uint64_t serverLinkWindow = 0;     // unacknowledged bytes it allows on the way
   uint64_t serverLinkInFlight = 0;   // unacknowledged bytes on the way
   uint32_t serverLinkWaits = 0;      // frames that waited for the window
-  uint32_t silences = 0;             // connections dropped for silence (ClientConfig::silenceMs)
+  uint32_t silences = 0;             // calls cut for silence (ClientConfig::silenceMs), or unanswered
+                                     // after connecting began (reconnectSilenceMs)
   uint32_t descriptionsResumed = 0;  // descriptions that left out the offsets and manifest held
   // Every description and frame refused, and every failed call, counted by reason (at most 32
   // reasons; later ones count under the last).
