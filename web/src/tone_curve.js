@@ -50,7 +50,9 @@ void main() {
   }
 
   // Draws `scene` from `camera` into the target at the drawing buffer's size, then onto the canvas.
+  // In an XR session three.js draws into the headset's framebuffer as it always does.
   render(renderer, scene, camera) {
+    if (renderer.xr.isPresenting) return renderer.render(scene, camera);
     renderer.getDrawingBufferSize(this.size);
     if (this.target.width !== this.size.x || this.target.height !== this.size.y) this.target.setSize(this.size.x, this.size.y);
     const saved = renderer.getRenderTarget();
