@@ -74,6 +74,8 @@ std::string referenceKeyStem(const nlohmann::json& key);
 void writeFileAtomically(const std::string& path, const std::string& bytes);
 // A 64-bit hash of the loaded scene's content, as 16 hex digits.
 std::string sceneContentHash(const scene::Scene& scene);
+// The same hash of an image's float pixels (a reference half's, checked when read back).
+std::string pixelHash(const std::vector<float>& rgb);
 // $XDG_CACHE_HOME/probecast/references, else $HOME/.cache/probecast/references.
 std::string defaultReferenceCacheDir();
 
