@@ -34,6 +34,7 @@ void writeSubscribeJson(const std::string& path, const service::ProbeClient& cli
   j["keyframes"] = st.keyframesReceived;
   j["deltas"] = st.deltasReceived;
   j["connects"] = st.connects;
+  j["connect_attempts"] = st.connectAttempts;
   j["descriptions_resumed"] = st.descriptionsResumed;
   j["silences"] = st.silences;
   j["bricks"] = brickCount(snap.layout);
@@ -131,8 +132,9 @@ void runSubscribe(const SubscribeOptions& so) {
   staySubscribed(client, so);
   client.stop();
   const service::ClientStats st = client.stats();
-  fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects ({} resumed without offsets and manifest){}\n",
-             st.framesApplied, st.framesRejected, st.bytesReceived, st.connects, st.descriptionsResumed,
+  fmt::print("subscribe: {} frames applied, {} rejected, {} bytes, {} connects of {} attempts ({} resumed without "
+             "offsets and manifest){}\n",
+             st.framesApplied, st.framesRejected, st.bytesReceived, st.connects, st.connectAttempts, st.descriptionsResumed,
              st.lastError.empty() ? "" : ", last error: " + st.lastError);
   for (const std::string& line : service::refusalLines(st)) fmt::print("subscribe: refused: {}\n", line);
   if (st.fatal) throw std::runtime_error("the server refused the subscription: " + st.lastError);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <atomic>
 #include <condition_variable>
+#include <map>
 #include <cstdlib>
 #include <thread>
 
@@ -95,6 +96,54 @@ class StallGuard {
   uint64_t progress_ = 0;
   bool done_ = false, stalled_ = false;
   std::thread thread_;  // last: it starts once the members above are made
+};
+
+// Connection attempts to one server that overlap (ClientConfig::connectRaceMs). A channel makes
+// progress only while someone polls it: a call, or here a watch of its state on the queue.
+class ConnectRace {
+ public:
+  ConnectRace() = default;
+  ConnectRace(const ConnectRace&) = delete;
+  ConnectRace& operator=(const ConnectRace&) = delete;
+  ~ConnectRace() {  // every watch ends by its deadline
+    queue_.Shutdown();
+    void* tag;
+    bool ok;
+    while (queue_.Next(&tag, &ok)) {
+    }
+  }
+  // Begins connecting `channel`; the oldest attempt is dropped past kConnectRaceAttempts.
+  void begin(std::shared_ptr<grpc::Channel> channel) {
+    if (attempts_.size() == static_cast<size_t>(kConnectRaceAttempts)) attempts_.erase(attempts_.begin());
+    const uintptr_t id = ++serial_;
+    channel->GetState(true);
+    watch(id, *channel, GRPC_CHANNEL_IDLE);
+    attempts_.emplace(id, std::move(channel));
+  }
+  // An attempt that came up or failed before `until`, or null.
+  std::shared_ptr<grpc::Channel> wait(std::chrono::steady_clock::time_point until) {
+    void* tag;
+    bool ok;
+    const auto deadline = std::chrono::system_clock::now() + (until - std::chrono::steady_clock::now());
+    while (queue_.AsyncNext(&tag, &ok, deadline) == grpc::CompletionQueue::GOT_EVENT) {
+      const auto it = attempts_.find(reinterpret_cast<uintptr_t>(tag));
+      if (it == attempts_.end()) continue;  // dropped; its watch has ended
+      const grpc_connectivity_state s = it->second->GetState(false);
+      if (s == GRPC_CHANNEL_READY || s == GRPC_CHANNEL_TRANSIENT_FAILURE || s == GRPC_CHANNEL_SHUTDOWN) return it->second;
+      watch(it->first, *it->second, s);
+    }
+    return nullptr;
+  }
+
+ private:
+  // The watch's deadline bounds how long a dropped attempt lives on and how long the end waits.
+  void watch(uintptr_t id, grpc::Channel& channel, grpc_connectivity_state seen) {
+    channel.NotifyOnStateChange(seen, std::chrono::system_clock::now() + std::chrono::milliseconds(100), &queue_,
+                                reinterpret_cast<void*>(id));
+  }
+  grpc::CompletionQueue queue_;
+  std::map<uintptr_t, std::shared_ptr<grpc::Channel>> attempts_;  // by serial, oldest first
+  uintptr_t serial_ = 0;
 };
 
 }  // namespace
@@ -190,6 +239,31 @@ struct ProbeClient::Impl {
   }
 
   std::shared_ptr<grpc::Channel> channel(const std::string& address) const { return makeChannel(config, address); }
+
+  // A channel to `address` whose connection is up (READY), or one that failed to connect (a call
+  // on it fails at once, as it would have), by overlapping attempts in `race`
+  // (ClientConfig::connectRaceMs); null once stopping. `suspect`: the link was just cut for
+  // silence, so attempts overlap at once.
+  std::shared_ptr<grpc::Channel> connect(ConnectRace& race, const std::string& address, bool suspect) {
+    if (config.connectRaceMs <= 0) return channel(address);
+    using Clock = std::chrono::steady_clock;
+    int interval = config.connectRaceMs;
+    uint32_t begun = 0;
+    auto next = Clock::now();
+    while (!stopping) {
+      if (Clock::now() >= next) {
+        race.begin(channel(address));
+        if (++begun % (2 * kConnectRaceAttempts) == 0) interval = std::min(interval * 2, config.connectRaceMs * 4);
+        next = Clock::now() + std::chrono::milliseconds(begun == 1 && !suspect ? 1000 : interval);
+        std::lock_guard<std::mutex> lock(mutex);
+        stats.connectAttempts += 1;
+      }
+      // Short waits, so that stop() is heard.
+      std::shared_ptr<grpc::Channel> up = race.wait(std::min(next, Clock::now() + std::chrono::milliseconds(50)));
+      if (up) return up;
+    }
+    return nullptr;
+  }
 
   // Counts `reason` (mutex held) and keeps it as the last error, escaped for printing.
   void refuse(const std::string& reason) {
@@ -328,10 +402,14 @@ struct ProbeClient::Impl {
     size_t at = 0;
     size_t failedInTurn = 0;  // servers tried since the last one that answered
     int backoff = config.reconnectMinMs;
+    bool suspect = false;  // the last call was cut for silence
     while (!stopping) {
+      ConnectRace race;  // its attempts end with the call
+      const std::shared_ptr<grpc::Channel> ch = connect(race, servers[at], suspect);
+      suspect = false;
+      if (!ch) return;  // stopping
       grpc::ClientContext ctx;
       authorize(config, ctx);
-      const std::shared_ptr<grpc::Channel> ch = channel(servers[at]);
       std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(ch);
       {
         // The watchdog may cut the call from here on: opening it blocks while the connection is
@@ -461,6 +539,7 @@ struct ProbeClient::Impl {
       // Cut for silence (a link outage stalls TCP, whose retransmissions back off for seconds after
       // the link returns): a fresh connection at once, on the next server if there are several.
       if (wasSilenced) {
+        suspect = true;
         if (servers.size() > 1) at = (at + 1) % servers.size();
         continue;
       }

@@ -18,6 +18,9 @@
 
 namespace probecast::service {
 
+// The most connection attempts a client has open at once (ClientConfig::connectRaceMs).
+inline constexpr int kConnectRaceAttempts = 32;
+
 struct ClientConfig {
   std::string address;                  // host:port
   // Servers to fail over between, in order (edges of one producer); empty: `address` alone.
@@ -61,6 +64,15 @@ struct ClientConfig {
   // 0: wait for TCP and the keepalive.
   int silenceMs = 3000;
   int reconnectSilenceMs = 2000;
+  // Overlapping connection attempts: while no connection to the server is up (TCP, TLS and HTTP/2),
+  // another is begun every connectRaceMs and the first to come up is kept. A link back from an
+  // outage is then met by the next attempt's SYN, not by TCP's retransmission a second or more
+  // later, and a lost handshake packet costs one interval. They begin at once after a cut for
+  // silence (the link is suspect), otherwise once the first attempt has waited a second (TCP's
+  // first SYN retransmission), so a slow but reachable server is not sent more. At most
+  // kConnectRaceAttempts are open (the oldest is dropped); the interval doubles after every twice
+  // as many, up to 4x. 0: one attempt at a time.
+  int connectRaceMs = 125;
   // The scene this client draws for (the hash describeScene returned, whose package it loaded): a
   // volume description that names another scene is refused and the client stops (fatal), for
   // what it would draw is not what the probes were traced in. Empty: any scene.
@@ -161,6 +173,7 @@ struct ClientStats {
   uint32_t serverLinkWaits = 0;      // frames that waited for the window
   uint32_t silences = 0;             // calls cut for silence (ClientConfig::silenceMs), or unanswered
                                      // after connecting began (reconnectSilenceMs)
+  uint64_t connectAttempts = 0;     // connections begun (several overlap: ClientConfig::connectRaceMs)
   uint32_t descriptionsResumed = 0;  // descriptions that left out the offsets and manifest held
   // Every description and frame refused, and every failed call, counted by reason (at most 32
   // reasons; later ones count under the last).
