@@ -63,9 +63,11 @@ TEST(LinkEstimator, StartsWithTheInitialWindowAndNoEstimate) {
   LinkEstimator link;
   EXPECT_FALSE(link.measured());
   EXPECT_EQ(link.window(), LinkEstimator::kInitialWindow);
+  // The first frame carries what fits a fresh connection's first flight, the next ones at most a
+  // quarter of the window.
+  EXPECT_EQ(link.allowance(at(0)), LinkEstimator::kFirstFrame);
   link.sent(1, 1000, false, at(0));
   EXPECT_EQ(link.inFlight(), 1000u);
-  // A frame carries at most a quarter of the window.
   EXPECT_EQ(link.allowance(at(0)), LinkEstimator::kInitialWindow / 4);
 }
 

@@ -120,7 +120,7 @@ uint64_t LinkEstimator::allowance(Time now) {
   if (phase_ == Phase::Probing) return probeSent_ ? 0 : kProbeFrame;
   const uint64_t w = window(), f = inFlight();
   if (f >= w) return 0;
-  return std::min(w - f, std::max(kMinFrame, w / 4));
+  return std::min(w - f, sentBytes_ == 0 ? kFirstFrame : std::max(kMinFrame, w / 4));
 }
 
 LinkStats LinkEstimator::stats() const {

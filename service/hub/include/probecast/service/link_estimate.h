@@ -35,6 +35,11 @@ class LinkEstimator {
   // packets of this estimate, and several must be on the way at once for their acks to measure the
   // link's rate rather than one frame's round trip.
   static constexpr uint64_t kMinFrame = 8 * 1024;
+  // The first frame carries at most this much. A fresh connection's first flight (TCP's initial
+  // window: 10 segments, about 14 kB, RFC 6928) also carries the volume description and HTTP/2's
+  // framing; a first frame that spills past it arrives a round trip later (a quarter of a second
+  // on a mobile link), and with it the first lighting after a resume.
+  static constexpr uint64_t kFirstFrame = 8 * 1024;
   // The round trip's minimum is only seen with nothing queued. A stream that always has more to send
   // keeps the window's standing queue, so every kProbeIntervalSeconds without a frame that went out
   // onto an empty link, the hub lets everything on the way arrive and sends one frame of at most
