@@ -63,11 +63,12 @@ export class MapMaterials {
     return m;
   }
 
-  // (A cut-out's map, cutoff and opacity are taken when first drawn.)
+  // The map's material for the scene's material `m`, as `m` is now.
   for(m) {
     if (!(m?.alphaTest > 0 && m.map)) return this.solid;
     let d = this.cutouts.get(m);
     if (!d) this.cutouts.set(m, (d = this.make(m)));
+    else follow(d, m);
     return d;
   }
 
@@ -75,6 +76,21 @@ export class MapMaterials {
     this.solid.dispose();
     for (const m of this.made) m.dispose();
   }
+}
+
+// A cut-out's later edits: its map, cutoff and opacity as the application has them now (a new
+// map may read another uv channel, so the shader is made again).
+function follow(d, m) {
+  const u = d.uniforms;
+  u.opacity.value = m.opacity;
+  u.alphaTest.value = m.alphaTest;
+  d.alphaTest = m.alphaTest;
+  if (u.map.value !== m.map || d.map.channel !== m.map.channel) {
+    u.map.value = m.map;
+    d.map = m.map;
+    d.needsUpdate = true;
+  }
+  u.mapTransform.value = m.map.matrix;
 }
 
 // Runs draw() with `target` bound and cleared to (clearColor, clearAlpha), the visible objects for
