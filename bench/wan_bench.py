@@ -45,11 +45,11 @@ def log(*a):
     print("wan_bench:", *a, file=sys.stderr, flush=True)
 
 
-class Run:
-    """One profile on one path: namespaces, link, server side, subscribers."""
+class Bed:
+    """Two network namespaces joined by the emulated link, and the processes started in them."""
 
-    def __init__(self, args, work, profile, path, pacing):
-        self.args, self.work, self.profile, self.path, self.pacing = args, work, profile, path, pacing
+    def __init__(self, args, work, profile):
+        self.args, self.work, self.profile = args, work, profile
         tag = "%d%d" % (os.getpid() % 10000, int(time.time() * 10) % 1000)
         self.ns_a, self.ns_b = "pcba" + tag, "pcbb" + tag
         self.procs = []
@@ -98,66 +98,90 @@ class Run:
         for ns in (self.ns_a, self.ns_b):
             subprocess.run(["ip", "netns", "del", ns], stderr=subprocess.DEVNULL)
 
+    # nats-server with JetStream and a token; the token's file.
+    def start_bus(self):
+        nats = shutil.which("nats-server") or "/usr/sbin/nats-server"
+        bus_token = os.path.join(self.work, "bus-token")
+        with open(bus_token, "w") as f:
+            f.write("bus-%d\n" % os.getpid())
+        with open(os.path.join(self.work, "nats.conf"), "w") as f:
+            f.write('authorization { token: "bus-%d" }\n' % os.getpid())
+        self.spawn(self.ns_a, [nats, "-c", os.path.join(self.work, "nats.conf"), "-a", "127.0.0.1", "-p", "4222", "-js",
+                               "-sd", os.path.join(self.work, "nats")], "nats.log")
+        self.wait_for("nats.log", "Server is ready", 10)
+        return bus_token
+
+    # The link goes down and comes back at the timeline's times; when it did.
+    def cut_link(self, start, span):
+        time.sleep(max(0.0, start + span[0] - time.time()))
+        self.link.send_signal(signal.SIGUSR1)
+        down = time.time()
+        time.sleep(max(0.0, start + span[1] - time.time()))
+        self.link.send_signal(signal.SIGUSR2)
+        return (down, time.time())
+
+
+class Run(Bed):
+    """One profile on one path: the server side, the subscribers, the outage, their results."""
+
+    def __init__(self, args, work, profile, path, pacing):
+        super().__init__(args, work, profile)
+        self.path, self.pacing = path, pacing
+        self.token = os.path.join(work, "token")
+
     def go(self):
-        a = self.args
-        T = a.timeline
-        token = os.path.join(self.work, "token")
-        with open(token, "w") as f:
+        T = self.args.timeline
+        t0 = time.time()
+        address = self.start_server()
+        start = time.time()  # the timeline's 0: the server is up
+        subs = [self.subscriber("reference", self.ns_a, start, T["first"], address),
+                self.subscriber("first", self.ns_b, start, T["first"], address),
+                self.subscriber("late", self.ns_b, start, T["late"], address)]
+        outage = self.cut_link(start, T["outage"]) if T.get("outage") else None
+        for _, _, p in subs:
+            p.wait(timeout=T["end"] + 60)
+        return self.results(subs, t0, start, outage)
+
+    # serve (and, for the bus path, nats-server and an edge) in the first namespace; the address
+    # subscribers connect to.
+    def start_server(self):
+        a, T = self.args, self.args.timeline
+        with open(self.token, "w") as f:
             f.write("wan-%d\n" % os.getpid())
         pacing = ["--link-pacing", "on" if self.pacing else "off"]
         serve = [a.probecast, "serve", "--scene", a.scene, "--grid", a.grid, "--repr", a.repr, "--hz", str(a.hz),
                  "--spp", str(a.spp), "--bounces", str(a.bounces),
                  "--animate", str(a.animate), "--noise-scale", "0", "--deadzone", "0", "--listen", "10.88.0.1:50051",
-                 "--plaintext", "--token-file", token, "--hold-after", str(T["hold"]), "--seconds", str(T["end"] + 15)]
+                 "--plaintext", "--token-file", self.token, "--hold-after", str(T["hold"]), "--seconds", str(T["end"] + 15)]
         serve += pacing
-        address = "10.88.0.1:50051"
-        if self.path == "edge":
-            nats = shutil.which("nats-server") or "/usr/sbin/nats-server"
-            bus_token = os.path.join(self.work, "bus-token")
-            with open(bus_token, "w") as f:
-                f.write("bus-%d\n" % os.getpid())
-            with open(os.path.join(self.work, "nats.conf"), "w") as f:
-                f.write('authorization { token: "bus-%d" }\n' % os.getpid())
-            self.spawn(self.ns_a, [nats, "-c", os.path.join(self.work, "nats.conf"), "-a", "127.0.0.1", "-p", "4222", "-js",
-                                   "-sd", os.path.join(self.work, "nats")], "nats.log")
-            self.wait_for("nats.log", "Server is ready", 10)
-            serve += ["--publish", "nats://127.0.0.1:4222", "--stream", "wan", "--nats-token-file", bus_token,
-                      "--nats-plaintext"]
-        t0 = time.time()
-        self.spawn(self.ns_a, serve, "serve.log")
+        if self.path != "edge":
+            self.spawn(self.ns_a, serve, "serve.log")
+            self.wait_for("serve.log", "on port", 120)
+            return "10.88.0.1:50051"
+        bus_token = self.start_bus()
+        self.spawn(self.ns_a, serve + ["--publish", "nats://127.0.0.1:4222", "--stream", "wan", "--nats-token-file",
+                                       bus_token, "--nats-plaintext"], "serve.log")
         self.wait_for("serve.log", "on port", 120)
-        if self.path == "edge":
-            self.spawn(self.ns_a, [a.probecast, "edge", "--nats", "nats://127.0.0.1:4222", "--stream", "wan",
-                                   "--nats-token-file", os.path.join(self.work, "bus-token"), "--nats-plaintext",
-                                   "--listen", "10.88.0.1:50052", "--plaintext", "--token-file", token,
-                                   "--seconds", str(T["end"] + 15)] + pacing, "edge.log")
-            self.wait_for("edge.log", "on port", 30)
-            address = "10.88.0.1:50052"
-        start = time.time()  # the timeline's 0: the server is up
+        self.spawn(self.ns_a, [a.probecast, "edge", "--nats", "nats://127.0.0.1:4222", "--stream", "wan",
+                               "--nats-token-file", bus_token, "--nats-plaintext",
+                               "--listen", "10.88.0.1:50052", "--plaintext", "--token-file", self.token,
+                               "--seconds", str(T["end"] + 15)] + pacing, "edge.log")
+        self.wait_for("edge.log", "on port", 30)
+        return "10.88.0.1:50052"
 
-        def subscriber(name, ns, at, until, addr):
-            delay = start + at - time.time()
-            if delay > 0:
-                time.sleep(delay)
-            argv = [a.probecast, "subscribe", "--connect", addr, "--token-file", token, "--seconds", str(until - at),
-                    "--json", os.path.join(self.work, name + ".json")]
-            if a.gap_period > 0 and name in ("reference", "first"):  # their pictures are compared afterwards
-                argv += ["--snapshot-every", str(a.gap_period), "--snapshot-dir", os.path.join(self.work, name + "-snapshots")]
-            return (name, time.time(), self.spawn(ns, argv, name + ".log"))
+    # `probecast subscribe` in namespace `ns` from `at` s after `start` to the timeline's end.
+    def subscriber(self, name, ns, start, at, addr):
+        a, until = self.args, self.args.timeline["end"]
+        delay = start + at - time.time()
+        if delay > 0:
+            time.sleep(delay)
+        argv = [a.probecast, "subscribe", "--connect", addr, "--token-file", self.token, "--seconds", str(until - at),
+                "--json", os.path.join(self.work, name + ".json")]
+        if a.gap_period > 0 and name in ("reference", "first"):  # their pictures are compared afterwards
+            argv += ["--snapshot-every", str(a.gap_period), "--snapshot-dir", os.path.join(self.work, name + "-snapshots")]
+        return (name, time.time(), self.spawn(ns, argv, name + ".log"))
 
-        subs = [subscriber("reference", self.ns_a, T["first"], T["end"], address),
-                subscriber("first", self.ns_b, T["first"], T["end"], address)]
-        subs.append(subscriber("late", self.ns_b, T["late"], T["end"], address))
-        outage = None
-        if T.get("outage"):
-            time.sleep(max(0.0, start + T["outage"][0] - time.time()))
-            self.link.send_signal(signal.SIGUSR1)
-            down = time.time()
-            time.sleep(max(0.0, start + T["outage"][1] - time.time()))
-            self.link.send_signal(signal.SIGUSR2)
-            outage = (down, time.time())
-        for _, _, p in subs:
-            p.wait(timeout=T["end"] + 60)
+    def results(self, subs, t0, start, outage):
         serve_log = open(os.path.join(self.work, "serve.log")).read()
         held = [l for l in serve_log.splitlines() if "holding the lighting" in l]
         server_checksum = held[0].rsplit(" ", 1)[1] if held else None
@@ -171,11 +195,11 @@ class Run:
         # A usable volume: as many bricks as the perfect link's subscriber ends with (bricks whose
         # probes are all inactive are never sent).
         ref = loaded["reference"][0]["frames"]
-        T = dict(T, bricks=ref[-1][5] if ref else 0)
+        T = dict(self.args.timeline, bricks=ref[-1][5] if ref else 0)
         for name, (j, began, rc) in loaded.items():
             out[name] = summarise(j, began, start, T, outage, server_checksum, rc)
-        if a.gap_period > 0:
-            out["first"]["picture_gap"] = picture_gap(a, self.work, T, start, t0, outage)
+        if self.args.gap_period > 0:
+            out["first"]["picture_gap"] = picture_gap(self.args, self.work, T, start, t0, outage)
         return out
 
 
