@@ -22,8 +22,12 @@ using Stream = grpc::ClientReaderWriter<pb::ClientMessage, pb::ServerMessage>;
 
 namespace {
 
-std::shared_ptr<grpc::Channel> makeChannel(const ClientConfig& config, const std::string& address) {
+// connectTimeoutMs (0: gRPC's 20 s): how long the connection may take to come up before the channel
+// gives it up.
+std::shared_ptr<grpc::Channel> makeChannel(const ClientConfig& config, const std::string& address,
+                                           int connectTimeoutMs = 0) {
   grpc::ChannelArguments args;
+  if (connectTimeoutMs > 0) args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, connectTimeoutMs);
   args.SetMaxReceiveMessageSize(256 << 20);
   args.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, config.keepaliveMs);
   args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, config.keepaliveTimeoutMs);
@@ -119,6 +123,10 @@ class ConnectRace {
     channel->GetState(true);
     watch(id, *channel, GRPC_CHANNEL_IDLE);
     attempts_.emplace(id, std::move(channel));
+  }
+  // Drops every attempt but `winner` (their watches end within their deadline).
+  void keepOnly(const std::shared_ptr<grpc::Channel>& winner) {
+    std::erase_if(attempts_, [&](const auto& a) { return a.second != winner; });
   }
   // An attempt that came up or failed before `until`, or null.
   std::shared_ptr<grpc::Channel> wait(std::chrono::steady_clock::time_point until) {
@@ -240,27 +248,28 @@ struct ProbeClient::Impl {
 
   std::shared_ptr<grpc::Channel> channel(const std::string& address) const { return makeChannel(config, address); }
 
-  // A channel to `address` whose connection is up (READY), or one that failed to connect (a call
-  // on it fails at once, as it would have), by overlapping attempts in `race`
-  // (ClientConfig::connectRaceMs); null once stopping. `suspect`: the link was just cut for
-  // silence, so attempts overlap at once.
-  std::shared_ptr<grpc::Channel> connect(ConnectRace& race, const std::string& address, bool suspect) {
-    if (config.connectRaceMs <= 0) return channel(address);
+  // After a cut for silence: a channel to `address` whose connection is up (READY), or one that
+  // failed to connect (a call on it fails at once, as it would have), by overlapping attempts in
+  // `race` (ClientConfig::connectRaceMs), the others dropped; null once stopping or when none came
+  // up within `allowanceMs`.
+  std::shared_ptr<grpc::Channel> connect(ConnectRace& race, const std::string& address, int allowanceMs) {
     using Clock = std::chrono::steady_clock;
+    const auto end = Clock::now() + std::chrono::milliseconds(allowanceMs);
     int interval = config.connectRaceMs;
     uint32_t begun = 0;
     auto next = Clock::now();
-    while (!stopping) {
+    while (!stopping && Clock::now() < end) {
       if (Clock::now() >= next) {
-        race.begin(channel(address));
+        // An attempt lives no longer than the race (and a second), dropped or not.
+        race.begin(makeChannel(config, address, allowanceMs + 1000));
         if (++begun % (2 * kConnectRaceAttempts) == 0) interval = std::min(interval * 2, config.connectRaceMs * 4);
-        next = Clock::now() + std::chrono::milliseconds(begun == 1 && !suspect ? 1000 : interval);
+        next = Clock::now() + std::chrono::milliseconds(interval);
         std::lock_guard<std::mutex> lock(mutex);
         stats.connectAttempts += 1;
       }
       // Short waits, so that stop() is heard.
-      std::shared_ptr<grpc::Channel> up = race.wait(std::min(next, Clock::now() + std::chrono::milliseconds(50)));
-      if (up) return up;
+      std::shared_ptr<grpc::Channel> up = race.wait(std::min({next, end, Clock::now() + std::chrono::milliseconds(50)}));
+      if (up) return race.keepOnly(up), up;
     }
     return nullptr;
   }
@@ -404,16 +413,27 @@ struct ProbeClient::Impl {
     int backoff = config.reconnectMinMs;
     bool suspect = false;  // the last call was cut for silence
     while (!stopping) {
-      ConnectRace race;  // its attempts end with the call
-      const std::shared_ptr<grpc::Channel> ch = connect(race, servers[at], suspect);
+      ConnectRace race;  // its winner's watch ends with the call
+      const bool racing = suspect && config.connectRaceMs > 0;
+      const int allowance = config.reconnectSilenceMs * static_cast<int>(1 + unanswered % 2);
+      const std::shared_ptr<grpc::Channel> ch = racing ? connect(race, servers[at], allowance) : channel(servers[at]);
+      if (stopping) return;
+      if (!ch) {  // no attempt came up: as a call unanswered, on the next server if there are several
+        std::lock_guard<std::mutex> lock(mutex);
+        stats.silences += 1;
+        unanswered += 1;
+        refuse(servers[at] + ": no answer within " + std::to_string(allowance) + " ms of connecting: connecting afresh");
+        if (servers.size() > 1) at = (at + 1) % servers.size();
+        continue;
+      }
       suspect = false;
-      if (!ch) return;  // stopping
       grpc::ClientContext ctx;
       authorize(config, ctx);
       std::unique_ptr<pb::ProbeStream::Stub> stub = pb::ProbeStream::NewStub(ch);
       {
-        // The watchdog may cut the call from here on: opening it blocks while the connection is
-        // made, which through a link outage takes until TCP gives up (seconds), not one attempt.
+        // The watchdog may cut the call from here on: opening it on a channel not yet connected
+        // blocks while the connection is made, which through a link outage takes until TCP gives
+        // up (seconds), not one attempt.
         std::lock_guard<std::mutex> lock(mutex);
         context = &ctx;
         stream = nullptr;

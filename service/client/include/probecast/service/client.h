@@ -58,20 +58,21 @@ struct ClientConfig {
   // A server that promises a message at least every so often (Stats heartbeat_ms: it does for a
   // client that acks every frame) and says nothing for silenceMs has a cut connection: a link outage
   // stalls TCP, whose retransmissions back off for seconds after the link returns. The client
-  // drops it and connects afresh at once, giving each new attempt reconnectSilenceMs to answer
-  // (counted from when its connection is up, TLS and HTTP/2 included, or from the attempt's start
-  // while it is not; every other attempt in a row that gets no answer has twice as long).
+  // drops it and connects afresh at once, giving each new attempt reconnectSilenceMs to connect
+  // (connectRaceMs) and again to answer once connected (every other attempt in a row that gets no
+  // answer has twice as long).
   // 0: wait for TCP and the keepalive.
   int silenceMs = 3000;
   int reconnectSilenceMs = 2000;
-  // Overlapping connection attempts: while no connection to the server is up (TCP, TLS and HTTP/2),
-  // another is begun every connectRaceMs and the first to come up is kept. A link back from an
-  // outage is then met by the next attempt's SYN, not by TCP's retransmission a second or more
-  // later, and a lost handshake packet costs one interval. They begin at once after a cut for
-  // silence (the link is suspect), otherwise once the first attempt has waited a second (TCP's
-  // first SYN retransmission), so a slow but reachable server is not sent more. At most
-  // kConnectRaceAttempts are open (the oldest is dropped); the interval doubles after every twice
-  // as many, up to 4x. 0: one attempt at a time.
+  // Overlapping connection attempts after a cut for silence (the link is suspect): while no
+  // connection to the server is up (TCP, TLS and HTTP/2), another is begun every connectRaceMs; the
+  // first to come up is kept and the others dropped. A link back from an outage is then met by the
+  // next attempt's SYN, not by TCP's retransmission a second or more later, and a lost handshake
+  // packet costs one interval. When none comes up within reconnectSilenceMs (twice that every
+  // other time in a row), it counts as unanswered and the next server is tried the same way. At
+  // most kConnectRaceAttempts are open (the oldest is dropped), none lives past its race by more
+  // than a second; the interval doubles after every twice as many, up to 4x. 0: one attempt at a
+  // time, under the watchdog.
   int connectRaceMs = 125;
   // The scene this client draws for (the hash describeScene returned, whose package it loaded): a
   // volume description that names another scene is refused and the client stops (fatal), for
