@@ -131,8 +131,7 @@ class Run(Bed):
 
     def go(self):
         T = self.args.timeline
-        t0 = time.time()
-        address = self.start_server()
+        t0, address = self.start_server()
         start = time.time()  # the timeline's 0: the server is up
         subs = [self.subscriber("reference", self.ns_a, start, T["first"], address),
                 self.subscriber("first", self.ns_b, start, T["first"], address),
@@ -142,8 +141,8 @@ class Run(Bed):
             p.wait(timeout=T["end"] + 60)
         return self.results(subs, t0, start, outage)
 
-    # serve (and, for the bus path, nats-server and an edge) in the first namespace; the address
-    # subscribers connect to.
+    # serve (and, for the bus path, nats-server and an edge) in the first namespace; when serve
+    # began, and the address subscribers connect to.
     def start_server(self):
         a, T = self.args, self.args.timeline
         with open(self.token, "w") as f:
@@ -155,10 +154,12 @@ class Run(Bed):
                  "--plaintext", "--token-file", self.token, "--hold-after", str(T["hold"]), "--seconds", str(T["end"] + 15)]
         serve += pacing
         if self.path != "edge":
+            t0 = time.time()
             self.spawn(self.ns_a, serve, "serve.log")
             self.wait_for("serve.log", "on port", 120)
-            return "10.88.0.1:50051"
+            return t0, "10.88.0.1:50051"
         bus_token = self.start_bus()
+        t0 = time.time()
         self.spawn(self.ns_a, serve + ["--publish", "nats://127.0.0.1:4222", "--stream", "wan", "--nats-token-file",
                                        bus_token, "--nats-plaintext"], "serve.log")
         self.wait_for("serve.log", "on port", 120)
@@ -167,7 +168,7 @@ class Run(Bed):
                                "--listen", "10.88.0.1:50052", "--plaintext", "--token-file", self.token,
                                "--seconds", str(T["end"] + 15)] + pacing, "edge.log")
         self.wait_for("edge.log", "on port", 30)
-        return "10.88.0.1:50052"
+        return t0, "10.88.0.1:50052"
 
     # `probecast subscribe` in namespace `ns` from `at` s after `start` to the timeline's end.
     def subscriber(self, name, ns, start, at, addr):

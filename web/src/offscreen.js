@@ -57,6 +57,7 @@ export class MapMaterials {
     });
     if (cutout) {
       m.map = cutout.map;  // USE_MAP and its uv channel
+      m.userData.channel = cutout.map.channel;
       m.alphaTest = cutout.alphaTest;
       this.made.push(m);
     }
@@ -85,9 +86,10 @@ function follow(d, m) {
   u.opacity.value = m.opacity;
   u.alphaTest.value = m.alphaTest;
   d.alphaTest = m.alphaTest;
-  if (u.map.value !== m.map || d.map.channel !== m.map.channel) {
+  if (u.map.value !== m.map || d.userData.channel !== m.map.channel) {
     u.map.value = m.map;
     d.map = m.map;
+    d.userData.channel = m.map.channel;
     d.needsUpdate = true;
   }
   u.mapTransform.value = m.map.matrix;

@@ -33,6 +33,11 @@ test('a cut-out follows its material: map, cutoff and opacity', () => {
   assert.equal(d.uniforms.mapTransform.value, second.matrix);
   assert.ok(d.version > version, 'the shader is made again');
 
+  const remade = d.version;
+  second.channel = 2;  // the same map, read from another uv channel
+  assert.equal(maps.for(m), d);
+  assert.ok(d.version > remade, 'the shader is made again for the new channel');
+
   m.alphaTest = 0;  // no longer a cut-out: drawn solid
   assert.equal(maps.for(m), maps.solid);
   m.alphaTest = 0.5;
