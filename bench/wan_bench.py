@@ -151,8 +151,7 @@ class Run(Bed):
         serve = [a.probecast, "serve", "--scene", a.scene, "--grid", a.grid, "--repr", a.repr, "--hz", str(a.hz),
                  "--spp", str(a.spp), "--bounces", str(a.bounces),
                  "--animate", str(a.animate), "--noise-scale", "0", "--deadzone", "0", "--listen", "10.88.0.1:50051",
-                 "--plaintext", "--token-file", self.token, "--hold-after", str(T["hold"]), "--seconds", str(T["end"] + 15)]
-        serve += pacing
+                 "--plaintext", "--token-file", self.token, "--hold-after", str(T["hold"]), "--seconds", str(T["end"] + 15)] + pacing
         if self.path != "edge":
             t0 = time.time()
             self.spawn(self.ns_a, serve, "serve.log")
